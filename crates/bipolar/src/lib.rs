@@ -1,0 +1,3 @@
+//! The bipolar invariant descriptor.
+//!
+//! Not implemented yet (issue 4): this crate currently exports nothing.

@@ -1,0 +1,14 @@
+//! `bipolar landmarks` (not implemented yet, issue 6).
+
+/// Arguments of `bipolar landmarks`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Remaining arguments (the command is not implemented yet).
+    #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+    rest: Vec<String>,
+}
+
+/// Runs the command.
+pub fn run(args: Args) -> anyhow::Result<()> {
+    anyhow::bail!("`bipolar landmarks` is not implemented yet (issue 6); arguments: {:?}", args.rest)
+}

@@ -1,0 +1,62 @@
+//! `bipolar`: the command-line tool of the bipolar workspace.
+
+use clap::{Parser, Subcommand};
+
+mod cmd_convert;
+mod cmd_describe;
+mod cmd_distance;
+mod cmd_geodesic;
+mod cmd_info;
+mod cmd_landmarks;
+mod cmd_matrix;
+mod cmd_render;
+
+/// Bipolar invariant representation of 3D surfaces: inspect meshes, compute geodesic fields and
+/// descriptors, compare faces.
+#[derive(Debug, Parser)]
+#[command(name = "bipolar", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Print statistics and checks of a mesh (counts, bbox, edges, components, defects).
+    Info(cmd_info::Args),
+    /// Convert a mesh between formats (chosen by file extension).
+    Convert(cmd_convert::Args),
+    /// Compute a geodesic distance field from a source vertex or point.
+    Geodesic(cmd_geodesic::Args),
+    /// Compute the bipolar descriptor of a mesh.
+    Describe(cmd_describe::Args),
+    /// Render a mesh with level curves and descriptor points (SVG, PNG or GLB).
+    Render(cmd_render::Args),
+    /// Normalised shape distance between two descriptor files.
+    Distance(cmd_distance::Args),
+    /// Pairwise distance matrix of descriptor files.
+    Matrix(cmd_matrix::Args),
+    /// Detect face landmarks (outer eye corners, nose tip).
+    Landmarks(cmd_landmarks::Args),
+}
+
+fn main() -> std::process::ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Info(a) => cmd_info::run(a),
+        Command::Convert(a) => cmd_convert::run(a),
+        Command::Geodesic(a) => cmd_geodesic::run(a),
+        Command::Describe(a) => cmd_describe::run(a),
+        Command::Render(a) => cmd_render::run(a),
+        Command::Distance(a) => cmd_distance::run(a),
+        Command::Matrix(a) => cmd_matrix::run(a),
+        Command::Landmarks(a) => cmd_landmarks::run(a),
+    };
+    match result {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,26 @@
+use thiserror::Error;
+
+/// Errors of the geodesic solvers.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum GeodesicError {
+    /// The mesh itself is invalid.
+    #[error(transparent)]
+    Mesh(#[from] meshcore::MeshError),
+    /// No source was given.
+    #[error("no source given")]
+    NoSource,
+    /// A source vertex does not exist.
+    #[error("source vertex {vertex} does not exist (the mesh has {vertices} vertices)")]
+    SourceOutOfRange {
+        /// The vertex asked for.
+        vertex: u32,
+        /// Number of vertices.
+        vertices: usize,
+    },
+    /// A method name was not recognised.
+    #[error("unknown geodesic method {0:?} (expected exact, fmm, heat or dijkstra)")]
+    UnknownMethod(String),
+    /// A negative or NaN cut-off.
+    #[error("invalid max_distance {0}: must be positive")]
+    InvalidCutoff(f64),
+}

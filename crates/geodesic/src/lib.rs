@@ -1,0 +1,78 @@
+//! Geodesic distance fields on triangle meshes.
+//!
+//! Every method sits behind one narrow trait, [`GeodesicSolver`]: a solver is prepared once per
+//! mesh (it owns what it needs, so it is `'static` and can be shared across threads), then asked
+//! for distance fields from one or several [`Source`]s.
+//!
+//! | method | type | what it computes |
+//! |---|---|---|
+//! | [`Method::Dijkstra`] | [`Dijkstra`] | shortest paths along mesh edges (the paper's baseline; overestimates) |
+//!
+//! Unreachable vertices (other components, or beyond the cut-off) get `f64::INFINITY`.
+
+mod dijkstra;
+mod error;
+
+pub use dijkstra::Dijkstra;
+pub use error::GeodesicError;
+pub use meshcore::{SurfacePoint, TriMesh};
+
+/// Where a distance field starts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Source {
+    /// A mesh vertex.
+    Vertex(u32),
+    /// An arbitrary surface point (face + barycentric coordinates).
+    Point(SurfacePoint),
+}
+
+/// Options of one solve.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct SolveOptions {
+    /// Stop propagating past this distance; vertices farther away get `f64::INFINITY`.
+    /// Methods that cannot stop early (heat) compute everything and then apply the cut-off.
+    pub max_distance: Option<f64>,
+}
+
+/// The available methods.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Method {
+    /// Dijkstra on mesh edges.
+    Dijkstra,
+}
+
+impl Method {
+    /// Short lowercase name, as used on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Dijkstra => "dijkstra",
+        }
+    }
+}
+
+impl std::str::FromStr for Method {
+    type Err = GeodesicError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "dijkstra" => Ok(Method::Dijkstra),
+            other => Err(GeodesicError::UnknownMethod(other.to_string())),
+        }
+    }
+}
+
+/// A geodesic distance solver prepared for one mesh.
+pub trait GeodesicSolver: Send + Sync + std::fmt::Debug {
+    /// Which method this is.
+    fn method(&self) -> Method;
+    /// Number of vertices of the mesh the solver was prepared for.
+    fn n_vertices(&self) -> usize;
+    /// Distance from the nearest of `sources` to every vertex, in vertex order.
+    fn distances(&self, sources: &[Source], opts: &SolveOptions) -> Result<Vec<f64>, GeodesicError>;
+}
+
+/// Prepares a solver of the given method for `mesh`.
+pub fn new_solver(mesh: &TriMesh, method: Method) -> Result<Box<dyn GeodesicSolver>, GeodesicError> {
+    Ok(match method {
+        Method::Dijkstra => Box::new(Dijkstra::new(mesh)?),
+    })
+}

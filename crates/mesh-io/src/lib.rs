@@ -1,0 +1,3 @@
+//! Mesh readers and writers.
+//!
+//! Not implemented yet (issue 2): this crate currently exports nothing.

@@ -1,0 +1,33 @@
+//! Project tasks, run as `cargo xtask <task>` (the alias lives in `.cargo/config.toml`).
+
+use clap::{Parser, Subcommand};
+
+/// Experiments and evaluations of the bipolar workspace.
+#[derive(Debug, Parser)]
+#[command(name = "xtask")]
+struct Cli {
+    #[command(subcommand)]
+    task: Task,
+}
+
+#[derive(Debug, Subcommand)]
+enum Task {
+    /// The paper's section 3: the descriptor on a sphere against analytic curves (issue 4).
+    SphereValidate,
+    /// The paper's sections 4-6 on the face set (issue 7).
+    Robustness,
+    /// Identification/verification benchmark on sampled faces (issue 7).
+    Recognition,
+    /// Landmark detection accuracy on sampled faces (issue 6).
+    LandmarksEval,
+}
+
+fn main() -> anyhow::Result<()> {
+    let cli = Cli::parse();
+    match cli.task {
+        Task::SphereValidate => anyhow::bail!("sphere-validate is not implemented yet (issue 4)"),
+        Task::Robustness => anyhow::bail!("robustness is not implemented yet (issue 7)"),
+        Task::Recognition => anyhow::bail!("recognition is not implemented yet (issue 7)"),
+        Task::LandmarksEval => anyhow::bail!("landmarks-eval is not implemented yet (issue 6)"),
+    }
+}
