@@ -10,5 +10,8 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("`bipolar distance` is not implemented yet (issue 5); arguments: {:?}", args.rest)
+    anyhow::bail!(
+        "`bipolar distance` is not implemented yet (issue 5); arguments: {:?}",
+        args.rest
+    )
 }

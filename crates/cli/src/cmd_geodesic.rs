@@ -10,5 +10,8 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("`bipolar geodesic` is not implemented yet (issue 3); arguments: {:?}", args.rest)
+    anyhow::bail!(
+        "`bipolar geodesic` is not implemented yet (issue 3); arguments: {:?}",
+        args.rest
+    )
 }

@@ -10,5 +10,8 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("`bipolar info` is not implemented yet (issue 2); arguments: {:?}", args.rest)
+    anyhow::bail!(
+        "`bipolar info` is not implemented yet (issue 2); arguments: {:?}",
+        args.rest
+    )
 }

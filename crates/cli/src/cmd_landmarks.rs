@@ -10,5 +10,8 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("`bipolar landmarks` is not implemented yet (issue 6); arguments: {:?}", args.rest)
+    anyhow::bail!(
+        "`bipolar landmarks` is not implemented yet (issue 6); arguments: {:?}",
+        args.rest
+    )
 }

@@ -82,12 +82,13 @@ pub(crate) fn seeds(
                 out.push((v, 0.0));
             }
             Source::Point(sp) => {
-                let tri = triangles.get(sp.face as usize).ok_or(
-                    meshcore::MeshError::FaceOutOfRange {
-                        face: sp.face,
-                        faces: triangles.len(),
-                    },
-                )?;
+                let tri =
+                    triangles
+                        .get(sp.face as usize)
+                        .ok_or(meshcore::MeshError::FaceOutOfRange {
+                            face: sp.face,
+                            faces: triangles.len(),
+                        })?;
                 let b = sp.bary;
                 if !b.is_finite() || b.min_element() < -1e-9 || (b.element_sum() - 1.0).abs() > 1e-9
                 {
@@ -112,7 +113,11 @@ impl GeodesicSolver for Dijkstra {
     fn n_vertices(&self) -> usize {
         self.positions.len()
     }
-    fn distances(&self, sources: &[Source], opts: &SolveOptions) -> Result<Vec<f64>, GeodesicError> {
+    fn distances(
+        &self,
+        sources: &[Source],
+        opts: &SolveOptions,
+    ) -> Result<Vec<f64>, GeodesicError> {
         let cut = match opts.max_distance {
             Some(c) if c.is_nan() || c <= 0.0 => return Err(GeodesicError::InvalidCutoff(c)),
             Some(c) => c,
@@ -130,7 +135,10 @@ impl GeodesicSolver for Dijkstra {
             if d > dist[v as usize] || d > cut {
                 continue;
             }
-            let (a, b) = (self.offsets[v as usize] as usize, self.offsets[v as usize + 1] as usize);
+            let (a, b) = (
+                self.offsets[v as usize] as usize,
+                self.offsets[v as usize + 1] as usize,
+            );
             for &(w, l) in &self.neighbors[a..b] {
                 let nd = d + l;
                 if nd < dist[w as usize] {
@@ -140,7 +148,9 @@ impl GeodesicSolver for Dijkstra {
             }
         }
         if cut.is_finite() {
-            dist.iter_mut().filter(|d| **d > cut).for_each(|d| *d = f64::INFINITY);
+            dist.iter_mut()
+                .filter(|d| **d > cut)
+                .for_each(|d| *d = f64::INFINITY);
         }
         Ok(dist)
     }
@@ -154,17 +164,26 @@ mod tests {
     #[test]
     fn path_graph_distances() {
         let m = TriMesh::new(
-            vec![DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::new(9.0, 9.0, 9.0)],
+            vec![
+                DVec3::ZERO,
+                DVec3::X,
+                DVec3::new(1.0, 1.0, 0.0),
+                DVec3::new(9.0, 9.0, 9.0),
+            ],
             vec![[0, 1, 2]],
         )
         .unwrap();
         let d = Dijkstra::new(&m).unwrap();
-        let f = d.distances(&[Source::Vertex(0)], &SolveOptions::default()).unwrap();
+        let f = d
+            .distances(&[Source::Vertex(0)], &SolveOptions::default())
+            .unwrap();
         assert_eq!(f[0], 0.0);
         assert!((f[1] - 1.0).abs() < 1e-15);
         assert!((f[2] - 2f64.sqrt()).abs() < 1e-15);
         assert!(f[3].is_infinite());
-        assert!(d.distances(&[Source::Vertex(7)], &SolveOptions::default()).is_err());
+        assert!(d
+            .distances(&[Source::Vertex(7)], &SolveOptions::default())
+            .is_err());
         assert!(d.distances(&[], &SolveOptions::default()).is_err());
     }
 }

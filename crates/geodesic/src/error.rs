@@ -20,6 +20,9 @@ pub enum GeodesicError {
     /// A method name was not recognised.
     #[error("unknown geodesic method {0:?} (expected exact, fmm, heat or dijkstra)")]
     UnknownMethod(String),
+    /// The method is not available yet.
+    #[error("geodesic method {0} is not implemented yet")]
+    NotImplemented(&'static str),
     /// A negative or NaN cut-off.
     #[error("invalid max_distance {0}: must be positive")]
     InvalidCutoff(f64),

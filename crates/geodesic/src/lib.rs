@@ -12,9 +12,15 @@
 
 mod dijkstra;
 mod error;
+mod exact;
+mod fmm;
+mod heat;
 
 pub use dijkstra::Dijkstra;
 pub use error::GeodesicError;
+pub use exact::ExactGeodesic;
+pub use fmm::FastMarching;
+pub use heat::HeatMethod;
 pub use meshcore::{SurfacePoint, TriMesh};
 
 /// Where a distance field starts.
@@ -37,6 +43,12 @@ pub struct SolveOptions {
 /// The available methods.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Method {
+    /// Exact polyhedral distance (window propagation).
+    Exact,
+    /// Fast marching on triangulated domains (Kimmel-Sethian) with obtuse-angle unfolding.
+    Fmm,
+    /// Heat method (Crane et al.) with a reusable sparse Cholesky factorisation.
+    Heat,
     /// Dijkstra on mesh edges.
     Dijkstra,
 }
@@ -45,6 +57,9 @@ impl Method {
     /// Short lowercase name, as used on the command line.
     pub fn name(self) -> &'static str {
         match self {
+            Method::Exact => "exact",
+            Method::Fmm => "fmm",
+            Method::Heat => "heat",
             Method::Dijkstra => "dijkstra",
         }
     }
@@ -54,6 +69,9 @@ impl std::str::FromStr for Method {
     type Err = GeodesicError;
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         match s {
+            "exact" => Ok(Method::Exact),
+            "fmm" => Ok(Method::Fmm),
+            "heat" => Ok(Method::Heat),
             "dijkstra" => Ok(Method::Dijkstra),
             other => Err(GeodesicError::UnknownMethod(other.to_string())),
         }
@@ -67,12 +85,19 @@ pub trait GeodesicSolver: Send + Sync + std::fmt::Debug {
     /// Number of vertices of the mesh the solver was prepared for.
     fn n_vertices(&self) -> usize;
     /// Distance from the nearest of `sources` to every vertex, in vertex order.
-    fn distances(&self, sources: &[Source], opts: &SolveOptions) -> Result<Vec<f64>, GeodesicError>;
+    fn distances(&self, sources: &[Source], opts: &SolveOptions)
+        -> Result<Vec<f64>, GeodesicError>;
 }
 
 /// Prepares a solver of the given method for `mesh`.
-pub fn new_solver(mesh: &TriMesh, method: Method) -> Result<Box<dyn GeodesicSolver>, GeodesicError> {
+pub fn new_solver(
+    mesh: &TriMesh,
+    method: Method,
+) -> Result<Box<dyn GeodesicSolver>, GeodesicError> {
     Ok(match method {
+        Method::Exact => Box::new(ExactGeodesic::new(mesh)?),
+        Method::Fmm => Box::new(FastMarching::new(mesh)?),
+        Method::Heat => Box::new(HeatMethod::new(mesh)?),
         Method::Dijkstra => Box::new(Dijkstra::new(mesh)?),
     })
 }

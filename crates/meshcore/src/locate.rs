@@ -85,7 +85,9 @@ impl<'a> FaceLocator<'a> {
     /// Builds the grid (about one face per cell).
     pub fn new(mesh: &'a TriMesh) -> Self {
         let bb = mesh.bbox();
-        let size = bb.size().max(DVec3::splat(bb.diagonal() * 1e-9 + f64::MIN_POSITIVE));
+        let size = bb
+            .size()
+            .max(DVec3::splat(bb.diagonal() * 1e-9 + f64::MIN_POSITIVE));
         let volume = size.x * size.y * size.z;
         let target = (mesh.n_faces() as f64).max(1.0);
         let mut cell = (volume / target).cbrt();

@@ -28,7 +28,11 @@ pub fn weld_vertices(mesh: &TriMesh, tol: f64) -> Result<(TriMesh, RepairReport)
                 (p.z * inv).floor() as i64,
             )
         } else {
-            (p.x.to_bits() as i64, p.y.to_bits() as i64, p.z.to_bits() as i64)
+            (
+                p.x.to_bits() as i64,
+                p.y.to_bits() as i64,
+                p.z.to_bits() as i64,
+            )
         }
     };
     let mut grid: HashMap<(i64, i64, i64), Vec<u32>> = HashMap::new();
@@ -69,7 +73,13 @@ pub fn weld_vertices(mesh: &TriMesh, tol: f64) -> Result<(TriMesh, RepairReport)
     let tris: Vec<[u32; 3]> = mesh
         .triangles()
         .iter()
-        .map(|t| [remap[t[0] as usize], remap[t[1] as usize], remap[t[2] as usize]])
+        .map(|t| {
+            [
+                remap[t[0] as usize],
+                remap[t[1] as usize],
+                remap[t[2] as usize],
+            ]
+        })
         .collect();
     let (m, r) = compact(mesh.positions(), tris, 0.0)?;
     report.removed_faces = r.removed_faces;

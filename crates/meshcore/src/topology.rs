@@ -250,7 +250,9 @@ impl Topology {
             let mut lp = vec![s];
             let mut cur = s;
             loop {
-                let Some(list) = next.get_mut(&cur) else { break };
+                let Some(list) = next.get_mut(&cur) else {
+                    break;
+                };
                 let Some(n) = list.pop() else { break };
                 if n == s {
                     break;
