@@ -1,18 +1,953 @@
-use crate::{GeodesicError, GeodesicSolver, Method, SolveOptions, Source, TriMesh};
+//! Exact polyhedral geodesic distance by window propagation ("VTP-S").
+//!
+//! A triangle-oriented, vertex-ordered window-list propagation in the style of VTP (Qin et al.
+//! 2016) that only uses pruning rules which never remove a window part carrying a shortest path
+//! (the vertex filter, the split at the apex's separating point, and a sorted pairwise trim of
+//! the lower envelope). Vertices are ordered by `(distance, vertex id)`; see
+//! `shared/docs/exact-geodesics.md` for the algorithm and the soundness argument.
+//!
+//! Mesh handling (done once in [`ExactGeodesic::new`], reported by [`ExactGeodesic::report`]):
+//! * faces repeating a vertex or having an edge shorter than `1e-12` x bbox diagonal are dropped
+//!   (weld coincident vertices first with `meshcore::repair` if that matters);
+//! * zero-area faces with distinct corners are kept and crossed ("pass-through");
+//! * non-manifold edges (3+ faces) are cut: each incident face sees a boundary there, so paths
+//!   can pass through the edge's end vertices but not across its interior;
+//! * non-manifold vertices, boundary vertices and saddles (total angle > 2 pi - 1e-5) are
+//!   pseudo-sources; inconsistent orientation is handled by reflecting the frames.
 
-/// Exact polyhedral geodesic distance (not implemented yet).
-#[derive(Debug, Clone)]
-pub struct ExactGeodesic {
-    n: usize,
+mod trace;
+mod window;
+
+use crate::{GeodesicError, GeodesicSolver, Method, SolveOptions, Source, SurfacePoint, TriMesh};
+use glam::DVec3;
+use std::cmp::Ordering;
+use std::collections::{BinaryHeap, VecDeque};
+use window::{pair_trim, Trim, Window, TAU};
+
+const NONE: u32 = u32::MAX;
+const REV: u32 = 1 << 31;
+const IDX: u32 = !REV;
+/// Barycentric coordinates below this snap to zero (edge or vertex points).
+const BARY_SNAP: f64 = 1e-12;
+
+/// Geometry of a half-edge `a -> b` of face `(a, b, c)` in its frame: origin at `a`, x towards
+/// `b`, +y into the face.
+#[derive(Debug, Clone, Copy, Default)]
+struct HeGeom {
+    /// |ab|.
+    l: f64,
+    /// Apex x.
+    cx: f64,
+    /// Apex y (> 0 unless the face is flat).
+    cy: f64,
+    /// |ac|: length of the left child edge.
+    lac: f64,
+    /// |bc|: length of the right child edge.
+    lbc: f64,
+    /// (cx, cy) / |ac|.
+    cos_a: f64,
+    sin_a: f64,
+    /// (l - cx, -cy) / |bc|.
+    ux: f64,
+    uy: f64,
 }
 
+/// What [`ExactGeodesic::new`] found and repaired in the mesh.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct ExactMeshReport {
+    /// Faces ignored because they repeat a vertex or have a (near) zero-length edge.
+    pub dropped_faces: Vec<u32>,
+    /// Number of non-manifold edges (3+ faces) that were cut into boundary edges.
+    pub cut_edges: usize,
+    /// Vertices whose faces form several fans (treated as pseudo-sources).
+    pub non_manifold_vertices: Vec<u32>,
+    /// Number of interior edges whose two faces disagree on orientation (handled by reflection).
+    pub inconsistent_edges: usize,
+    /// Number of pseudo-source vertices (boundary, saddle or non-manifold).
+    pub pseudo_sources: usize,
+}
+
+/// Exact polyhedral geodesic distance (window propagation, VTP-S).
+///
+/// Prepared once per mesh (half-edge structure and per-half-edge frames, about 100 bytes per
+/// half-edge); each solve allocates its own state, so the solver can be shared across threads.
+#[derive(Debug, Clone)]
+pub struct ExactGeodesic {
+    positions: Vec<DVec3>,
+    tris: Vec<[u32; 3]>,
+    live: Vec<bool>,
+    /// Twin half-edge index, possibly with the [`REV`] bit (same direction), or [`NONE`].
+    twin: Vec<u32>,
+    geom: Vec<HeGeom>,
+    /// Per vertex (CSR), the half-edges opposite it in its live faces.
+    vopp_off: Vec<u32>,
+    vopp: Vec<u32>,
+    pseudo: Vec<bool>,
+    report: ExactMeshReport,
+}
+
+/// How a vertex got its current distance (recorded for path tracing).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Pred {
+    /// Not reached.
+    None,
+    /// A source vertex.
+    Source,
+    /// Straight line from the point source with this index.
+    Point(u32),
+    /// Along an edge from a pseudo-source vertex.
+    Vertex(u32),
+    /// As the apex of a window record, via the edge point at parameter `t`.
+    Window(u32, f64),
+}
+
+/// Where a recorded window came from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Origin {
+    /// Child of another record.
+    Window(u32),
+    /// Emitted by a pseudo-source (or source) vertex.
+    Vertex(u32),
+    /// Emitted by the point source with this index.
+    Point(u32),
+}
+
+/// A window as emitted, with its half-edge and origin (path-tracing mode).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Record {
+    pub h: u32,
+    pub w: Window,
+    pub origin: Origin,
+}
+
+#[derive(PartialEq)]
+struct Item(f64, u32);
+impl Eq for Item {}
+impl Ord for Item {
+    fn cmp(&self, o: &Self) -> Ordering {
+        o.0.total_cmp(&self.0).then_with(|| o.1.cmp(&self.1))
+    }
+}
+impl PartialOrd for Item {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+
+const OUTSIDE: u8 = 0;
+const FRONT: u8 = 1;
+const INSIDE: u8 = 2;
+
 impl ExactGeodesic {
-    /// Prepares the solver for `mesh` (currently always an error: not implemented yet).
+    /// Prepares the solver: half-edge structure, frames, pseudo-source flags.
+    ///
+    /// Never fails on a valid [`TriMesh`]; degenerate and non-manifold parts are handled as
+    /// described in the module documentation and listed in [`ExactGeodesic::report`].
     pub fn new(mesh: &TriMesh) -> Result<Self, GeodesicError> {
-        let _ = Self {
-            n: mesh.n_vertices(),
+        let positions = mesh.positions().to_vec();
+        let tris = mesh.triangles().to_vec();
+        let n = positions.len();
+        let m = tris.len();
+        let nh = 3 * m;
+        let min_edge = 1e-12 * mesh.bbox().diagonal();
+        let mut report = ExactMeshReport::default();
+        let mut live = vec![true; m];
+        for (f, t) in tris.iter().enumerate() {
+            let bad = t[0] == t[1]
+                || t[1] == t[2]
+                || t[0] == t[2]
+                || (0..3).any(|k| {
+                    (positions[t[k] as usize] - positions[t[(k + 1) % 3] as usize]).length()
+                        <= min_edge
+                });
+            if bad {
+                live[f] = false;
+                report.dropped_faces.push(f as u32);
+            }
+        }
+        // Twins by sorting undirected edge keys.
+        let mut keys: Vec<(u64, u32)> = Vec::with_capacity(nh);
+        for (f, t) in tris.iter().enumerate() {
+            if !live[f] {
+                continue;
+            }
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                let key = ((a.min(b) as u64) << 32) | a.max(b) as u64;
+                keys.push((key, (3 * f + k) as u32));
+            }
+        }
+        keys.sort_unstable();
+        let mut twin = vec![NONE; nh];
+        let tail = |h: u32| tris[(h / 3) as usize][(h % 3) as usize];
+        let mut i = 0;
+        while i < keys.len() {
+            let mut j = i + 1;
+            while j < keys.len() && keys[j].0 == keys[i].0 {
+                j += 1;
+            }
+            match j - i {
+                1 => {}
+                2 => {
+                    let (h1, h2) = (keys[i].1, keys[i + 1].1);
+                    let rev = if tail(h1) == tail(h2) {
+                        report.inconsistent_edges += 1;
+                        REV
+                    } else {
+                        0
+                    };
+                    twin[h1 as usize] = h2 | rev;
+                    twin[h2 as usize] = h1 | rev;
+                }
+                _ => report.cut_edges += 1,
+            }
+            i = j;
+        }
+        // Frames.
+        let mut geom = vec![HeGeom::default(); nh];
+        let mut angle = vec![0.0f64; n];
+        let mut boundary = vec![false; n];
+        let mut deg = vec![0u32; n + 1];
+        for (f, t) in tris.iter().enumerate() {
+            if !live[f] {
+                continue;
+            }
+            for k in 0..3 {
+                let (a, b, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+                let (pa, pb, pc) = (
+                    positions[a as usize],
+                    positions[b as usize],
+                    positions[c as usize],
+                );
+                let ab = pb - pa;
+                let ac = pc - pa;
+                let bc = pc - pb;
+                let l = ab.length();
+                let cx = ac.dot(ab) / l;
+                let cy = ab.cross(ac).length() / l;
+                let lac = ac.length();
+                let lbc = bc.length();
+                geom[3 * f + k] = HeGeom {
+                    l,
+                    cx,
+                    cy,
+                    lac,
+                    lbc,
+                    cos_a: cx / lac,
+                    sin_a: cy / lac,
+                    ux: (l - cx) / lbc,
+                    uy: -cy / lbc,
+                };
+                // Corner angle at a.
+                angle[a as usize] += ab.cross(ac).length().atan2(ab.dot(ac));
+                if twin[3 * f + k] == NONE {
+                    boundary[a as usize] = true;
+                    boundary[b as usize] = true;
+                }
+                deg[c as usize + 1] += 1;
+            }
+        }
+        for v in 0..n {
+            deg[v + 1] += deg[v];
+        }
+        let mut fill = deg.clone();
+        let mut vopp = vec![0u32; deg[n] as usize];
+        for (f, t) in tris.iter().enumerate() {
+            if !live[f] {
+                continue;
+            }
+            for k in 0..3 {
+                let c = t[(k + 2) % 3] as usize;
+                vopp[fill[c] as usize] = (3 * f + k) as u32;
+                fill[c] += 1;
+            }
+        }
+        let two_pi = 2.0 * std::f64::consts::PI;
+        let mut pseudo: Vec<bool> = (0..n)
+            .map(|v| boundary[v] || angle[v] > two_pi - 1e-5)
+            .collect();
+        // Non-manifold vertices: faces around v not connected through edges at v.
+        let mut seen: Vec<u32> = Vec::new();
+        let mut stack: Vec<u32> = Vec::new();
+        for v in 0..n {
+            let opp = &vopp[deg[v] as usize..deg[v + 1] as usize];
+            if opp.len() <= 1 {
+                continue;
+            }
+            seen.clear();
+            stack.clear();
+            seen.push(opp[0] / 3);
+            stack.push(opp[0]);
+            while let Some(g) = stack.pop() {
+                // The two half-edges of face(g) at v: next(g) and prev(g).
+                for h in [next(g), prev(g)] {
+                    let t = twin[h as usize];
+                    if t == NONE {
+                        continue;
+                    }
+                    let f2 = (t & IDX) / 3;
+                    if !seen.contains(&f2) {
+                        seen.push(f2);
+                        if let Some(&g2) = opp.iter().find(|&&g2| g2 / 3 == f2) {
+                            stack.push(g2);
+                        }
+                    }
+                }
+            }
+            if seen.len() < opp.len() {
+                pseudo[v] = true;
+                report.non_manifold_vertices.push(v as u32);
+            }
+        }
+        report.pseudo_sources = pseudo.iter().filter(|&&p| p).count();
+        Ok(Self {
+            positions,
+            tris,
+            live,
+            twin,
+            geom,
+            vopp_off: deg,
+            vopp,
+            pseudo,
+            report,
+        })
+    }
+
+    /// What was found and repaired when preparing the mesh.
+    pub fn report(&self) -> &ExactMeshReport {
+        &self.report
+    }
+
+    /// Distance field, also returning the number of window propagations (for benchmarks).
+    pub fn distances_with_stats(
+        &self,
+        sources: &[Source],
+        opts: &SolveOptions,
+    ) -> Result<(Vec<f64>, u64), GeodesicError> {
+        let cut = check_cutoff(opts)?;
+        let mut s = Solve::new(self, cut, false);
+        s.seed(sources)?;
+        s.run();
+        let props = s.propagations;
+        Ok((s.finish(), props))
+    }
+
+    #[inline]
+    fn tail(&self, h: u32) -> u32 {
+        self.tris[(h / 3) as usize][(h % 3) as usize]
+    }
+    #[inline]
+    fn head(&self, h: u32) -> u32 {
+        self.tris[(h / 3) as usize][((h % 3 + 1) % 3) as usize]
+    }
+    #[inline]
+    fn apex(&self, h: u32) -> u32 {
+        self.tris[(h / 3) as usize][((h % 3 + 2) % 3) as usize]
+    }
+    #[inline]
+    fn opp(&self, v: u32) -> &[u32] {
+        &self.vopp[self.vopp_off[v as usize] as usize..self.vopp_off[v as usize + 1] as usize]
+    }
+}
+
+#[inline]
+fn next(h: u32) -> u32 {
+    if h % 3 == 2 {
+        h - 2
+    } else {
+        h + 1
+    }
+}
+#[inline]
+fn prev(h: u32) -> u32 {
+    if h % 3 == 0 {
+        h + 2
+    } else {
+        h - 1
+    }
+}
+
+fn check_cutoff(opts: &SolveOptions) -> Result<f64, GeodesicError> {
+    match opts.max_distance {
+        Some(c) if c.is_nan() || c <= 0.0 => Err(GeodesicError::InvalidCutoff(c)),
+        Some(c) => Ok(c),
+        None => Ok(f64::INFINITY),
+    }
+}
+
+/// A validated source after barycentric snapping.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Seed {
+    Vertex(u32),
+    /// A point in a live face (barycentrics snapped); `skip` is the host half-edge of an edge
+    /// point (no window is started on it).
+    Face {
+        face: u32,
+        bary: [f64; 3],
+        skip: u32,
+    },
+    /// A point on a dropped (degenerate) face: only the corners get straight-line distances.
+    Degenerate {
+        face: u32,
+        pos: DVec3,
+    },
+}
+
+/// State of one solve.
+pub(crate) struct Solve<'a> {
+    g: &'a ExactGeodesic,
+    cut: f64,
+    pub(crate) d: Vec<f64>,
+    state: Vec<u8>,
+    emitted: Vec<f64>,
+    emit_flag: Vec<bool>,
+    lists: Vec<Vec<Window>>,
+    queued: Vec<bool>,
+    fifo: VecDeque<u32>,
+    heap: BinaryHeap<Item>,
+    pool: Vec<Vec<Window>>,
+    pending_emit: Vec<u32>,
+    tc_buf: Vec<f64>,
+    draining: bool,
+    propagations: u64,
+    /// Path-tracing mode: every emitted window, and how each vertex got its distance.
+    pub(crate) records: Option<Vec<Record>>,
+    pub(crate) pred: Vec<Pred>,
+    /// Point sources (position), indexed by `Pred::Point` / `Origin::Point`.
+    pub(crate) points: Vec<(u32, [f64; 3], DVec3)>,
+    cur_origin: Origin,
+}
+
+impl<'a> Solve<'a> {
+    pub(crate) fn new(g: &'a ExactGeodesic, cut: f64, record: bool) -> Self {
+        let n = g.positions.len();
+        let nh = g.twin.len();
+        Self {
+            g,
+            cut,
+            d: vec![f64::INFINITY; n],
+            state: vec![OUTSIDE; n],
+            emitted: vec![f64::NAN; n],
+            emit_flag: g.pseudo.clone(),
+            lists: (0..nh).map(|_| Vec::new()).collect(),
+            queued: vec![false; nh],
+            fifo: VecDeque::new(),
+            heap: BinaryHeap::new(),
+            pool: Vec::new(),
+            pending_emit: Vec::new(),
+            tc_buf: Vec::new(),
+            draining: false,
+            propagations: 0,
+            records: if record { Some(Vec::new()) } else { None },
+            pred: if record {
+                vec![Pred::None; n]
+            } else {
+                Vec::new()
+            },
+            points: Vec::new(),
+            cur_origin: Origin::Vertex(0),
+        }
+    }
+
+    /// Validates and snaps one source.
+    pub(crate) fn classify(g: &ExactGeodesic, s: &Source) -> Result<Seed, GeodesicError> {
+        match *s {
+            Source::Vertex(v) => {
+                if v as usize >= g.positions.len() {
+                    return Err(GeodesicError::SourceOutOfRange {
+                        vertex: v,
+                        vertices: g.positions.len(),
+                    });
+                }
+                Ok(Seed::Vertex(v))
+            }
+            Source::Point(sp) => classify_point(g, &sp),
+        }
+    }
+
+    pub(crate) fn seed(&mut self, sources: &[Source]) -> Result<(), GeodesicError> {
+        if sources.is_empty() {
+            return Err(GeodesicError::NoSource);
+        }
+        let seeds = sources
+            .iter()
+            .map(|s| Self::classify(self.g, s))
+            .collect::<Result<Vec<_>, _>>()?;
+        for s in seeds {
+            match s {
+                Seed::Vertex(v) => {
+                    self.emit_flag[v as usize] = true;
+                    self.relax(v, 0.0, Pred::Source);
+                }
+                Seed::Face { face, bary, skip } => self.seed_face_point(face, bary, skip),
+                Seed::Degenerate { face, pos } => {
+                    let i = self.points.len() as u32;
+                    self.points.push((face, [f64::NAN; 3], pos));
+                    for &v in &self.g.tris[face as usize] {
+                        let dv = (self.g.positions[v as usize] - pos).length();
+                        self.emit_flag[v as usize] = true;
+                        self.relax(v, dv, Pred::Point(i));
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn seed_face_point(&mut self, face: u32, bary: [f64; 3], skip: u32) {
+        let g = self.g;
+        let t = g.tris[face as usize];
+        let pos = bary[0] * g.positions[t[0] as usize]
+            + bary[1] * g.positions[t[1] as usize]
+            + bary[2] * g.positions[t[2] as usize];
+        let idx = self.points.len() as u32;
+        self.points.push((face, bary, pos));
+        let mut faces = vec![(face, bary, skip)];
+        if skip != NONE {
+            let tw = g.twin[skip as usize];
+            if tw != NONE {
+                let h2 = tw & IDX;
+                let f2 = h2 / 3;
+                let t2 = g.tris[f2 as usize];
+                let mut b2 = [0.0; 3];
+                for k in 0..3 {
+                    if let Some(j) = t.iter().position(|&v| v == t2[k]) {
+                        b2[k] = bary[j];
+                    }
+                }
+                faces.push((f2, b2, h2));
+            }
+        }
+        self.cur_origin = Origin::Point(idx);
+        for (f, b, sk) in faces {
+            let tf = g.tris[f as usize];
+            for k in 0..3u32 {
+                let h = 3 * f + k;
+                if h == sk {
+                    continue;
+                }
+                let geo = g.geom[h as usize];
+                let (k0, k1, k2) = (k as usize, ((k + 1) % 3) as usize, ((k + 2) % 3) as usize);
+                let _ = k0;
+                let px = b[k1] * geo.l + b[k2] * geo.cx;
+                let py = b[k2] * geo.cy;
+                self.emit_vertex_like(h, px, py, 0.0);
+            }
+            for k in 0..3 {
+                let v = tf[k];
+                let dv = (g.positions[v as usize] - pos).length();
+                self.relax(v, dv, Pred::Point(idx));
+            }
+        }
+    }
+
+    /// Starts a full-edge window on the twin of `h` from the point `(px, py)` of `h`'s frame
+    /// (a point of face(h)) with distance `sigma`.
+    fn emit_vertex_like(&mut self, h: u32, px: f64, py: f64, sigma: f64) {
+        let g = self.g;
+        let tw = g.twin[h as usize];
+        if tw == NONE {
+            return;
+        }
+        let th = tw & IDX;
+        let geo = &g.geom[h as usize];
+        let l = geo.l;
+        let sx = if tw & REV != 0 { px } else { l - px };
+        let sy = (-py).min(-1e-14 * l);
+        let w = Window {
+            b0: 0.0,
+            b1: l,
+            sigma,
+            sx,
+            sy,
+            id: u32::MAX,
         };
-        Err(GeodesicError::NotImplemented("exact"))
+        if w.min_dist() > self.cut {
+            return;
+        }
+        self.add_window(th, w, self.cur_origin);
+    }
+
+    #[inline]
+    fn add_window(&mut self, h: u32, mut w: Window, origin: Origin) {
+        if let Some(rec) = self.records.as_mut() {
+            w.id = rec.len() as u32;
+            rec.push(Record { h, w, origin });
+        }
+        let list = &mut self.lists[h as usize];
+        if list.capacity() == 0 {
+            if let Some(v) = self.pool.pop() {
+                *list = v;
+            }
+        }
+        list.push(w);
+        if !self.queued[h as usize] {
+            let g = self.g;
+            if self.draining
+                || self.state[g.tail(h) as usize] == INSIDE
+                || self.state[g.head(h) as usize] == INSIDE
+            {
+                self.queued[h as usize] = true;
+                self.fifo.push_back(h);
+            }
+        }
+    }
+
+    #[inline]
+    fn relax(&mut self, v: u32, dist: f64, pred: Pred) {
+        let vi = v as usize;
+        if dist < self.d[vi] {
+            self.d[vi] = dist;
+            if !self.pred.is_empty() {
+                self.pred[vi] = pred;
+            }
+            if self.state[vi] != INSIDE {
+                self.state[vi] = FRONT;
+                self.heap.push(Item(dist, v));
+            } else if self.emit_flag[vi] {
+                self.pending_emit.push(v);
+            }
+        }
+    }
+
+    /// Emits the pseudo-source windows of `v` (and relaxes its neighbours along edges).
+    fn emit_from_vertex(&mut self, v: u32) {
+        let dv = self.d[v as usize];
+        if self.emitted[v as usize] == dv || dv > self.cut {
+            return;
+        }
+        self.emitted[v as usize] = dv;
+        let g = self.g;
+        self.cur_origin = Origin::Vertex(v);
+        for &gh in g.opp(v) {
+            let geo = g.geom[gh as usize];
+            self.emit_vertex_like(gh, geo.cx, geo.cy, dv);
+            self.relax(g.tail(gh), dv + geo.lac, Pred::Vertex(v));
+            self.relax(g.head(gh), dv + geo.lbc, Pred::Vertex(v));
+        }
+    }
+
+    fn push_list(&mut self, h: u32) {
+        if !self.queued[h as usize] && !self.lists[h as usize].is_empty() {
+            self.queued[h as usize] = true;
+            self.fifo.push_back(h);
+        }
+    }
+
+    fn pop_vertex(&mut self, v: u32) {
+        let g = self.g;
+        self.state[v as usize] = INSIDE;
+        if self.emit_flag[v as usize] {
+            self.emit_from_vertex(v);
+        }
+        for &gh in g.opp(v) {
+            for h in [next(gh), prev(gh)] {
+                self.push_list(h);
+                let t = g.twin[h as usize];
+                if t != NONE {
+                    self.push_list(t & IDX);
+                }
+            }
+            for u in [g.tail(gh), g.head(gh)] {
+                if self.state[u as usize] == OUTSIDE {
+                    self.state[u as usize] = FRONT;
+                }
+            }
+            let t = g.twin[gh as usize];
+            let ok = t == NONE || self.state[g.apex(t & IDX) as usize] != OUTSIDE;
+            if ok {
+                self.push_list(gh);
+                if t != NONE {
+                    self.push_list(t & IDX);
+                }
+            }
+        }
+    }
+
+    pub(crate) fn run(&mut self) {
+        loop {
+            if let Some(v) = self.pending_emit.pop() {
+                self.emit_from_vertex(v);
+                continue;
+            }
+            if let Some(h) = self.fifo.pop_front() {
+                self.queued[h as usize] = false;
+                self.process(h);
+                continue;
+            }
+            let mut popped = false;
+            while let Some(&Item(dv, v)) = self.heap.peek() {
+                if dv != self.d[v as usize] || self.state[v as usize] == INSIDE {
+                    self.heap.pop();
+                    continue;
+                }
+                if dv > self.cut {
+                    break;
+                }
+                self.heap.pop();
+                self.pop_vertex(v);
+                popped = true;
+                break;
+            }
+            if popped {
+                continue;
+            }
+            // Heap exhausted (or beyond the cut-off): drain every list still holding windows.
+            self.draining = true;
+            let mut any = false;
+            for h in 0..self.lists.len() as u32 {
+                if !self.lists[h as usize].is_empty() && !self.queued[h as usize] {
+                    self.queued[h as usize] = true;
+                    self.fifo.push_back(h);
+                    any = true;
+                }
+            }
+            if !any {
+                break;
+            }
+        }
+    }
+
+    pub(crate) fn finish(mut self) -> Vec<f64> {
+        if self.cut.is_finite() {
+            for d in &mut self.d {
+                if *d > self.cut {
+                    *d = f64::INFINITY;
+                }
+            }
+        }
+        self.d
+    }
+
+    /// The triangle step: filters the list of `h` and pushes its windows across face(h).
+    fn process(&mut self, h: u32) {
+        let mut ws = std::mem::take(&mut self.lists[h as usize]);
+        if ws.is_empty() {
+            return;
+        }
+        let g = self.g;
+        let geo = g.geom[h as usize];
+        let (a, b, c) = (g.tail(h), g.head(h), g.apex(h));
+        let (da, db) = (self.d[a as usize], self.d[b as usize]);
+        let l = geo.l;
+        // P0: vertex filter.
+        ws.retain(|w| {
+            !(da + w.b1 < w.dist(w.b1) * (1.0 - TAU)
+                || db + (l - w.b0) < w.dist(w.b0) * (1.0 - TAU))
+        });
+        // P1: sorted lower-envelope trim.
+        if ws.len() > 1 {
+            ws.sort_by(|x, y| x.b0.total_cmp(&y.b0));
+            let mut cur = 0;
+            for j in 1..ws.len() {
+                let (lo, hi) = ws.split_at_mut(j);
+                match pair_trim(&mut lo[cur], &mut hi[0]) {
+                    Trim::FirstDead => cur = j,
+                    Trim::SecondDead => {}
+                    Trim::Both => {
+                        if hi[0].b1 > lo[cur].b1 {
+                            cur = j;
+                        }
+                    }
+                }
+            }
+            ws.retain(|w| !w.is_dead());
+        }
+        if ws.is_empty() {
+            self.recycle(ws);
+            return;
+        }
+        // P2: best window for the apex and the split point.
+        let (cx, cy) = (geo.cx, geo.cy);
+        let mut tcs = std::mem::take(&mut self.tc_buf);
+        tcs.clear();
+        let mut best = f64::INFINITY;
+        let mut p_star = 0.0;
+        let mut best_id = u32::MAX;
+        let mut best_sigma = f64::INFINITY;
+        for w in &ws {
+            let tc = w.sx + (-w.sy) * (cx - w.sx) / (cy - w.sy);
+            tcs.push(tc);
+            let t = tc.clamp(w.b0, w.b1);
+            let dc = if t == tc {
+                w.sigma + (cx - w.sx).hypot(cy - w.sy)
+            } else {
+                w.dist(t) + (cx - t).hypot(cy)
+            };
+            if dc < best || (dc == best && w.sigma < best_sigma) {
+                best = dc;
+                p_star = t;
+                best_id = w.id;
+                best_sigma = w.sigma;
+            }
+        }
+        if best < self.d[c as usize] {
+            self.relax(c, best, Pred::Window(best_id, p_star));
+        }
+        // P3: split rule and propagation.
+        let tl_tw = g.twin[prev(h) as usize];
+        let tr_tw = g.twin[next(h) as usize];
+        for (i, w) in ws.iter().enumerate() {
+            let tc = tcs[i];
+            if tl_tw != NONE {
+                let tl = w.b1.min(p_star).min(tc);
+                if tl > w.b0 {
+                    self.emit_left(&geo, tl_tw, w, w.b0, tl, tl == tc);
+                }
+            }
+            if tr_tw != NONE {
+                let tr = w.b0.max(p_star).max(tc);
+                if tr < w.b1 {
+                    self.emit_right(&geo, tr_tw, w, tr, w.b1, tr == tc);
+                }
+            }
+        }
+        self.tc_buf = tcs;
+        self.recycle(ws);
+    }
+
+    fn recycle(&mut self, mut ws: Vec<Window>) {
+        ws.clear();
+        if ws.capacity() > 0 && self.pool.len() < 4096 {
+            self.pool.push(ws);
+        }
+    }
+
+    /// Child on the left edge a -> c: frame origin a, x towards c.
+    #[inline]
+    fn emit_left(&mut self, geo: &HeGeom, tw: u32, w: &Window, t0: f64, t1: f64, apex_end: bool) {
+        let (cs, sn) = (geo.cos_a, geo.sin_a);
+        let ell = geo.lac;
+        let sx = w.sx * cs + w.sy * sn;
+        let sy = -w.sx * sn + w.sy * cs;
+        // T' = (t cos, -t sin).
+        let x_of = |t: f64| -> f64 {
+            let (tx, ty) = (t * cs, -t * sn);
+            let den = sy - ty;
+            if den > -1e-15 * ell {
+                if tx > sx {
+                    ell
+                } else {
+                    0.0
+                }
+            } else {
+                sx + (tx - sx) * sy / den
+            }
+        };
+        let x0 = if t0 <= 0.0 { 0.0 } else { x_of(t0) };
+        let x1 = if apex_end { ell } else { x_of(t1) };
+        self.push_child(tw, ell, w, sx, sy, x0, x1);
+    }
+
+    /// Child on the right edge c -> b: frame origin c, x towards b.
+    #[inline]
+    fn emit_right(&mut self, geo: &HeGeom, tw: u32, w: &Window, t0: f64, t1: f64, apex_end: bool) {
+        let (ux, uy) = (geo.ux, geo.uy);
+        let ell = geo.lbc;
+        let (dx, dy) = (w.sx - geo.cx, w.sy - geo.cy);
+        let sx = dx * ux + dy * uy;
+        let sy = -dx * uy + dy * ux;
+        let x_of = |t: f64| -> f64 {
+            let (ex, ey) = (t - geo.cx, -geo.cy);
+            let (tx, ty) = (ex * ux + ey * uy, -ex * uy + ey * ux);
+            let den = sy - ty;
+            if den > -1e-15 * ell {
+                if tx > sx {
+                    ell
+                } else {
+                    0.0
+                }
+            } else {
+                sx + (tx - sx) * sy / den
+            }
+        };
+        let x0 = if apex_end { 0.0 } else { x_of(t0) };
+        let x1 = if t1 >= geo.l { ell } else { x_of(t1) };
+        self.push_child(tw, ell, w, sx, sy, x0, x1);
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn push_child(&mut self, tw: u32, ell: f64, w: &Window, sx: f64, sy: f64, x0: f64, x1: f64) {
+        let mut x0 = x0.clamp(0.0, ell);
+        let x1 = x1.clamp(0.0, ell);
+        if x0 > x1 {
+            x0 = x1;
+        }
+        let sy = sy.min(-1e-14 * ell);
+        let (b0, b1, sx) = if tw & REV != 0 {
+            (ell - x1, ell - x0, ell - sx)
+        } else {
+            (x0, x1, sx)
+        };
+        let child = Window {
+            b0,
+            b1,
+            sigma: w.sigma,
+            sx,
+            sy,
+            id: u32::MAX,
+        };
+        if self.cut.is_finite() && child.min_dist() > self.cut {
+            return;
+        }
+        self.propagations += 1;
+        let origin = Origin::Window(w.id);
+        self.add_window(tw & IDX, child, origin);
+    }
+}
+
+fn classify_point(g: &ExactGeodesic, sp: &SurfacePoint) -> Result<Seed, GeodesicError> {
+    let m = g.tris.len();
+    if sp.face as usize >= m {
+        return Err(meshcore::MeshError::FaceOutOfRange {
+            face: sp.face,
+            faces: m,
+        }
+        .into());
+    }
+    let b = sp.bary;
+    if !b.is_finite() || b.min_element() < -1e-9 || (b.element_sum() - 1.0).abs() > 1e-9 {
+        return Err(meshcore::MeshError::InvalidBarycentric(b.x, b.y, b.z).into());
+    }
+    let t = g.tris[sp.face as usize];
+    if !g.live[sp.face as usize] {
+        let pos = b.x * g.positions[t[0] as usize]
+            + b.y * g.positions[t[1] as usize]
+            + b.z * g.positions[t[2] as usize];
+        return Ok(Seed::Degenerate { face: sp.face, pos });
+    }
+    let mut bb = [b.x.max(0.0), b.y.max(0.0), b.z.max(0.0)];
+    for x in &mut bb {
+        if *x < BARY_SNAP {
+            *x = 0.0;
+        }
+    }
+    let s: f64 = bb.iter().sum();
+    if s <= 0.0 {
+        return Err(meshcore::MeshError::InvalidBarycentric(b.x, b.y, b.z).into());
+    }
+    bb.iter_mut().for_each(|x| *x /= s);
+    let zeros: Vec<usize> = (0..3).filter(|&k| bb[k] == 0.0).collect();
+    match zeros.len() {
+        0 => Ok(Seed::Face {
+            face: sp.face,
+            bary: bb,
+            skip: NONE,
+        }),
+        1 => {
+            // Edge point: the host half-edge is the one opposite the zero corner.
+            let k = zeros[0] as u32;
+            Ok(Seed::Face {
+                face: sp.face,
+                bary: bb,
+                skip: 3 * sp.face + (k + 1) % 3,
+            })
+        }
+        _ => {
+            let k = (0..3).find(|&k| bb[k] > 0.0).unwrap_or(0);
+            Ok(Seed::Vertex(t[k]))
+        }
     }
 }
 
@@ -21,9 +956,13 @@ impl GeodesicSolver for ExactGeodesic {
         Method::Exact
     }
     fn n_vertices(&self) -> usize {
-        self.n
+        self.positions.len()
     }
-    fn distances(&self, _s: &[Source], _o: &SolveOptions) -> Result<Vec<f64>, GeodesicError> {
-        Err(GeodesicError::NotImplemented("exact"))
+    fn distances(
+        &self,
+        sources: &[Source],
+        opts: &SolveOptions,
+    ) -> Result<Vec<f64>, GeodesicError> {
+        self.distances_with_stats(sources, opts).map(|(d, _)| d)
     }
 }

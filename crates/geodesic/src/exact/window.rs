@@ -1,0 +1,334 @@
+//! Windows (intervals of an edge with an unfolded virtual source) and the sound pairwise trim.
+
+/// Relative tolerance of strict domination: a window part is removed only when it is beaten by
+/// more than `TAU` relative.
+pub(crate) const TAU: f64 = 1e-12;
+
+/// An interval `[b0, b1]` of a half-edge with a virtual source `(sx, sy)` (`sy <= 0`) in that
+/// half-edge's frame and an additive distance `sigma`: `D(x) = sigma + |(sx, sy) - (x, 0)|`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Window {
+    /// Start of the interval along the half-edge.
+    pub b0: f64,
+    /// End of the interval.
+    pub b1: f64,
+    /// Distance already travelled when reaching the virtual source.
+    pub sigma: f64,
+    /// Virtual source, x coordinate.
+    pub sx: f64,
+    /// Virtual source, y coordinate (`<= 0`: behind the edge).
+    pub sy: f64,
+    /// Record index in path-tracing mode (`u32::MAX` otherwise).
+    pub id: u32,
+}
+
+impl Window {
+    /// The distance function at `x` on the edge.
+    #[inline]
+    pub fn dist(&self, x: f64) -> f64 {
+        let dx = x - self.sx;
+        self.sigma + (dx * dx + self.sy * self.sy).sqrt()
+    }
+
+    /// Minimum of the distance function over the interval.
+    #[inline]
+    pub fn min_dist(&self) -> f64 {
+        let x = self.sx.clamp(self.b0, self.b1);
+        self.dist(x)
+    }
+
+    /// Marks the window as removed.
+    #[inline]
+    pub fn kill(&mut self) {
+        self.b0 = f64::INFINITY;
+        self.b1 = f64::NEG_INFINITY;
+    }
+
+    /// True if the window was removed.
+    #[inline]
+    pub fn is_dead(&self) -> bool {
+        !(self.b0 <= self.b1)
+    }
+
+    fn scale(&self) -> f64 {
+        self.sigma.abs() + self.sx.hypot(self.sy)
+    }
+}
+
+/// Outcome of [`pair_trim`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Trim {
+    /// The first window is removed.
+    FirstDead,
+    /// The second window is removed (dominated or merged into the first).
+    SecondDead,
+    /// Both survive (possibly shortened).
+    Both,
+}
+
+/// Real roots of `D1(x) = D2(x)` (a superset: squaring may add spurious ones), written into
+/// `out`; returns how many.
+fn equal_distance_roots(w1: &Window, w2: &Window, out: &mut [f64; 2]) -> usize {
+    let scale = w1.scale().max(w2.scale());
+    let delta = w2.sigma - w1.sigma;
+    let u = w1.sx - w2.sx;
+    // |S1|^2 - |S2|^2 written to avoid cancellation.
+    let k = u * (w1.sx + w2.sx) + (w1.sy - w2.sy) * (w1.sy + w2.sy);
+    if delta.abs() <= 1e-14 * scale {
+        // Perpendicular bisector of the two sources.
+        if u != 0.0 {
+            out[0] = k / (2.0 * u);
+            return 1;
+        }
+        return 0;
+    }
+    let b = -2.0 * u;
+    let a0 = k - delta * delta;
+    let d2 = 4.0 * delta * delta;
+    let qa = b * b - d2;
+    let qb = 2.0 * b * a0 + 2.0 * d2 * w2.sx;
+    let qc = a0 * a0 - d2 * (w2.sx * w2.sx + w2.sy * w2.sy);
+    if qa == 0.0 {
+        if qb != 0.0 {
+            out[0] = -qc / qb;
+            return 1;
+        }
+        return 0;
+    }
+    let mut disc = qb * qb - 4.0 * qa * qc;
+    if disc < 0.0 {
+        if disc > -1e-10 * qb * qb {
+            disc = 0.0;
+        } else {
+            return 0;
+        }
+    }
+    let q = -0.5 * (qb + qb.signum() * disc.sqrt());
+    let mut n = 0;
+    if q != 0.0 {
+        out[n] = q / qa;
+        n += 1;
+        out[n] = qc / q;
+        n += 1;
+    } else {
+        // qb == 0 and disc == 0: double root at 0.
+        out[n] = 0.0;
+        n += 1;
+    }
+    n
+}
+
+/// Sound pairwise trim of two windows of the same half-edge (same frame).
+///
+/// A part of a window is removed only when the other window is strictly shorter there (by more
+/// than [`TAU`] relative); windows are never split in the middle. Identical distance functions
+/// whose intervals overlap or touch are merged into `w1`.
+pub(crate) fn pair_trim(w1: &mut Window, w2: &mut Window) -> Trim {
+    let s = 1e-12 * w1.scale();
+    if (w1.sigma - w2.sigma).abs() <= s
+        && (w1.sx - w2.sx).abs() <= s
+        && (w1.sy - w2.sy).abs() <= s
+        && w2.b0 <= w1.b1
+        && w1.b0 <= w2.b1
+        && w1.id == u32::MAX
+    {
+        w1.b0 = w1.b0.min(w2.b0);
+        w1.b1 = w1.b1.max(w2.b1);
+        w2.kill();
+        return Trim::SecondDead;
+    }
+    let l = w1.b0.max(w2.b0);
+    let r = w1.b1.min(w2.b1);
+    if r <= l {
+        return Trim::Both;
+    }
+    let mut roots = [0.0; 2];
+    let nr = equal_distance_roots(w1, w2, &mut roots);
+    // Breakpoints l < p1 < p2 < r.
+    let mut pts = [l, 0.0, 0.0, r];
+    let mut np = 1;
+    let mut rs = [roots[0], roots[1]];
+    if nr == 2 && rs[1] < rs[0] {
+        rs.swap(0, 1);
+    }
+    for &x in &rs[..nr] {
+        if x > pts[np - 1] && x < r {
+            pts[np] = x;
+            np += 1;
+        }
+    }
+    pts[np] = r;
+    let nseg = np; // segments pts[i]..pts[i+1], i < nseg
+    let mut lose1 = [false; 3];
+    let mut lose2 = [false; 3];
+    for i in 0..nseg {
+        let m = 0.5 * (pts[i] + pts[i + 1]);
+        let d1 = w1.dist(m);
+        let d2 = w2.dist(m);
+        let tol = TAU * d1.max(d2);
+        lose1[i] = d1 > d2 + tol;
+        lose2[i] = d2 > d1 + tol;
+    }
+    let all1 = lose1[..nseg].iter().all(|&b| b);
+    let all2 = lose2[..nseg].iter().all(|&b| b);
+    if all1 && w1.b0 >= l && w1.b1 <= r {
+        w1.kill();
+        return Trim::FirstDead;
+    }
+    if all2 && w2.b0 >= l && w2.b1 <= r {
+        w2.kill();
+        return Trim::SecondDead;
+    }
+    trim_ends(w1, &pts, nseg, &lose1, l, r);
+    trim_ends(w2, &pts, nseg, &lose2, l, r);
+    Trim::Both
+}
+
+/// Moves the ends of `w` that lie at `l` (or `r`) past the lost segments touching them.
+fn trim_ends(w: &mut Window, pts: &[f64; 4], nseg: usize, lose: &[bool; 3], l: f64, r: f64) {
+    let (b0, b1) = (w.b0, w.b1);
+    if b0 >= l {
+        let mut i = 0;
+        while i < nseg && lose[i] {
+            i += 1;
+        }
+        if i > 0 {
+            w.b0 = pts[i];
+        }
+    }
+    if b1 <= r {
+        let mut j = nseg;
+        while j > 0 && lose[j - 1] {
+            j -= 1;
+        }
+        if j < nseg {
+            w.b1 = pts[j];
+        }
+    }
+    if w.b0 > w.b1 {
+        w.kill();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn win(b0: f64, b1: f64, sigma: f64, sx: f64, sy: f64) -> Window {
+        Window {
+            b0,
+            b1,
+            sigma,
+            sx,
+            sy,
+            id: u32::MAX,
+        }
+    }
+
+    /// After a trim, every point of the original union is still served (within tolerance) by
+    /// a surviving window at no more than the original lower envelope.
+    fn check_sound(a: Window, b: Window, rng: &mut ChaCha8Rng) {
+        let (mut x, mut y) = (a, b);
+        let out = pair_trim(&mut x, &mut y);
+        match out {
+            Trim::FirstDead => assert!(x.is_dead()),
+            Trim::SecondDead => assert!(y.is_dead()),
+            Trim::Both => {}
+        }
+        let lo = a.b0.min(b.b0);
+        let hi = a.b1.max(b.b1);
+        for _ in 0..64 {
+            let t = rng.random_range(lo..=hi);
+            let mut env = f64::INFINITY;
+            for w in [&a, &b] {
+                if t >= w.b0 && t <= w.b1 {
+                    env = env.min(w.dist(t));
+                }
+            }
+            if !env.is_finite() {
+                continue;
+            }
+            let mut got = f64::INFINITY;
+            for w in [&x, &y] {
+                if !w.is_dead() && t >= w.b0 - 1e-12 && t <= w.b1 + 1e-12 {
+                    got = got.min(w.dist(t));
+                }
+            }
+            assert!(
+                got <= env * (1.0 + 1e-9) + 1e-12,
+                "unsound trim at {t}: env {env}, got {got}; {a:?} {b:?} -> {x:?} {y:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn random_pairs_are_trimmed_soundly() {
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        for i in 0..20000 {
+            let l = 1.0;
+            let mk = |rng: &mut ChaCha8Rng, eq_sigma: bool| {
+                let b0: f64 = rng.random_range(0.0..l);
+                let b1: f64 = rng.random_range(b0..=l);
+                let sigma = if eq_sigma {
+                    0.0
+                } else {
+                    rng.random_range(0.0..3.0)
+                };
+                win(
+                    b0,
+                    b1,
+                    sigma,
+                    rng.random_range(-3.0..4.0),
+                    -rng.random_range(1e-3..3.0),
+                )
+            };
+            let eq = i % 3 == 0;
+            let a = mk(&mut rng, eq);
+            let b = mk(&mut rng, eq);
+            check_sound(a, b, &mut rng);
+        }
+    }
+
+    #[test]
+    fn linear_branch_equal_sigma() {
+        // Two sources with equal sigma: the bisector x = 0.5 splits the edge.
+        let mut a = win(0.0, 1.0, 0.0, 0.0, -1.0);
+        let mut b = win(0.0, 1.0, 0.0, 1.0, -1.0);
+        assert_eq!(pair_trim(&mut a, &mut b), Trim::Both);
+        assert!((a.b1 - 0.5).abs() < 1e-12, "{a:?}");
+        assert!((b.b0 - 0.5).abs() < 1e-12, "{b:?}");
+        assert_eq!(a.b0, 0.0);
+        assert_eq!(b.b1, 1.0);
+    }
+
+    #[test]
+    fn hyperbola_branch() {
+        // sigma differs by 0.2: root where sqrt(x^2+1) = 0.2 + sqrt((x-1)^2+1).
+        let mut a = win(0.0, 1.0, 0.0, 0.0, -1.0);
+        let mut b = win(0.0, 1.0, 0.2, 1.0, -1.0);
+        assert_eq!(pair_trim(&mut a, &mut b), Trim::Both);
+        let x = a.b1;
+        let f = |x: f64| (x * x + 1.0).sqrt() - 0.2 - ((x - 1.0) * (x - 1.0) + 1.0).sqrt();
+        assert!(f(x).abs() < 1e-12, "root {x}: {}", f(x));
+        assert!((b.b0 - x).abs() < 1e-15);
+    }
+
+    #[test]
+    fn dominated_window_dies_and_duplicates_merge() {
+        let mut a = win(0.2, 0.8, 0.0, 0.5, -1.0);
+        let mut b = win(0.0, 1.0, 0.0, 0.5, -0.5);
+        assert_eq!(pair_trim(&mut a, &mut b), Trim::FirstDead);
+        assert!(a.is_dead());
+        let mut a = win(0.0, 0.5, 1.0, 0.3, -0.4);
+        let mut b = win(0.5, 0.9, 1.0, 0.3, -0.4);
+        assert_eq!(pair_trim(&mut a, &mut b), Trim::SecondDead);
+        assert_eq!((a.b0, a.b1), (0.0, 0.9));
+        // Disjoint windows are left alone.
+        let mut a = win(0.0, 0.4, 0.0, 0.0, -1.0);
+        let mut b = win(0.5, 0.9, 5.0, 0.3, -0.4);
+        assert_eq!(pair_trim(&mut a, &mut b), Trim::Both);
+        assert_eq!((a.b0, a.b1, b.b0, b.b1), (0.0, 0.4, 0.5, 0.9));
+    }
+}
