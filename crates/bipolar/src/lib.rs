@@ -1,3 +1,41 @@
-//! The bipolar invariant descriptor.
+//! The bipolar invariant descriptor of a surface (the paper's sections 2 and 3).
 //!
-//! Not implemented yet (issue 4): this crate currently exports nothing.
+//! Two reference points `r`, `q` on a mesh give two geodesic distance fields `U_r`, `U_q`.
+//! Their level curves at a constant geodesic step intersect; at each intersection the two
+//! level curves open an angle whose cosine is invariant under rigid motions. The descriptor is
+//! the set of points whose opening falls on the levels `alpha k / K`, each with a [`Key`] that
+//! puts descriptors of different surfaces in correspondence.
+//!
+//! * [`describe`] (mesh + geodesic solver + reference points) and [`describe_fields`] /
+//!   [`describe_fields_with_refs`] (precomputed fields) build a [`Descriptor`].
+//! * [`DescriptorOptions`]: step ([`LevelSpec`]), region (`max_level`, `vertex_mask`), `K`,
+//!   `alpha`, the selection rule ([`SelectionRule::Filter`], [`SelectionRule::IsoAngle`],
+//!   [`SelectionRule::All`]) and the tangent method ([`TangentMethod::Gradient`] = M0 exact
+//!   per-face gradient, [`TangentMethod::Strip`] = the paper's method 1,
+//!   [`TangentMethod::Spline`] = the paper's method 2).
+//! * More than two reference points: every pair `a < b` contributes, keys carry the pair.
+//! * [`io`]: CSV / JSON / PLY files. [`synthetic`]: test meshes with analytic fields.
+//!   [`linalg`]: 3x3 eigen-decomposition and the keyed Kabsch distance.
+//!
+//! Determinism: points are sorted by key, then position. Errors: [`BipolarError`]; an empty
+//! result is an error ([`BipolarError::NoIntersections`]) carrying the reason.
+
+// Index loops over 3x3 matrices and reference pairs read better than iterator chains.
+#![allow(clippy::needless_range_loop)]
+
+mod build;
+mod error;
+pub mod io;
+mod key;
+pub mod linalg;
+pub mod synthetic;
+mod types;
+
+pub use build::{describe, describe_fields, describe_fields_with_refs};
+pub use error::BipolarError;
+pub use geodesic::Source;
+pub use key::Key;
+pub use types::{
+    Descriptor, DescriptorOptions, DescriptorPoint, DescriptorStats, LevelSpec, SelectionRule,
+    SplineOptions, StripOptions, TangentMethod,
+};

@@ -1,0 +1,225 @@
+//! Public data types: options, points, descriptor.
+
+use crate::Key;
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+/// How the constant geodesic step is given.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum LevelSpec {
+    /// `N` levels between the first two reference points: `step = d(r, q) / N`.
+    Count(u32),
+    /// An explicit step (mesh units).
+    Step(f64),
+}
+
+/// The tangent method (specification §2.4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum TangentMethod {
+    /// M0: exact tangent of the piecewise-linear isoline, `normalize(n_f x grad_f U)`
+    /// (for the iso-angle rule: the smoothed per-vertex gradient, M0s, interpolated).
+    #[default]
+    Gradient,
+    /// M1, the paper's method 1: principal axis of the strip of vertices with
+    /// `|U - lambda| <= epsilon` within a radius of the point.
+    Strip,
+    /// M2, the paper's method 2: derivative of a least-squares cubic B-spline fitted to the
+    /// level-curve polyline.
+    Spline,
+}
+
+impl std::str::FromStr for TangentMethod {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "gradient" => Ok(Self::Gradient),
+            "strip" => Ok(Self::Strip),
+            "spline" => Ok(Self::Spline),
+            o => Err(format!(
+                "unknown tangent method {o:?} (expected gradient, strip or spline)"
+            )),
+        }
+    }
+}
+
+/// Which intersection points are kept (the two readings of the paper's rule, §2.5).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub enum SelectionRule {
+    /// A: intersections of level `i` of the first field and level `j` of the second whose
+    /// `|cos|` is within `tolerance` of an angle level `alpha k / K`. Keys `(i, j, side)`.
+    Filter {
+        /// Half-width of the acceptance band (e.g. `alpha / (4 K)`).
+        tolerance: f64,
+    },
+    /// B: points along the level curves of the first field where `|cos|` equals exactly an
+    /// angle level `alpha k / K`. Keys `(i, k, side, sign(cos))`. The default.
+    #[default]
+    IsoAngle,
+    /// Every intersection of the two level families (no angle selection). Keys `(i, j, side)`.
+    All,
+}
+
+/// Settings of the strip tangent method (M1).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct StripOptions {
+    /// Strip half-width `epsilon` in units of the mean edge length.
+    pub epsilon: f64,
+    /// Neighbourhood radius `rho` in units of the mean edge length.
+    pub radius: f64,
+    /// Minimum number of strip vertices (else fall back to M0).
+    pub min_vertices: usize,
+    /// Minimum ratio of the two largest covariance eigenvalues (else fall back to M0).
+    pub min_ratio: f64,
+}
+
+impl Default for StripOptions {
+    fn default() -> Self {
+        Self {
+            epsilon: 0.6,
+            radius: 4.0,
+            min_vertices: 5,
+            min_ratio: 2.0,
+        }
+    }
+}
+
+/// Settings of the B-spline tangent method (M2).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SplineOptions {
+    /// Control-point spacing in units of the mean edge length (`None`: the bspline crate's
+    /// default, 4 x the median chord of the polyline).
+    pub control_spacing: Option<f64>,
+    /// Dimensionless smoothing weight (P-spline penalty).
+    pub smoothing: f64,
+    /// Pieces with fewer points use M0 instead.
+    pub min_points: usize,
+}
+
+impl Default for SplineOptions {
+    fn default() -> Self {
+        Self {
+            control_spacing: None,
+            smoothing: 1e-3,
+            min_points: 8,
+        }
+    }
+}
+
+/// Options of the descriptor.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DescriptorOptions {
+    /// Geodesic step.
+    pub levels: LevelSpec,
+    /// Region: keep levels `1..=max_level` of both fields (`None`: as far as the fields go).
+    pub max_level: Option<u32>,
+    /// Region: vertices to use (`false` vertices act as holes); one entry per vertex.
+    #[serde(skip)]
+    pub vertex_mask: Option<Vec<bool>>,
+    /// Number of angle levels `K` (targets `alpha k / K`, `k = 0..=K`).
+    pub angles: u32,
+    /// Maximum angular opening `alpha` in `(0, 1]` (below 1: `k = K` is then not a tangency).
+    pub alpha: f64,
+    /// Selection rule.
+    pub rule: SelectionRule,
+    /// Tangent method.
+    pub tangent: TangentMethod,
+    /// Strip method settings.
+    pub strip: StripOptions,
+    /// Spline method settings.
+    pub spline: SplineOptions,
+    /// Intersections with `|sin| < min_sin` between the level curves are dropped (their
+    /// position is ill-conditioned, §2.3).
+    pub min_sin: f64,
+}
+
+impl Default for DescriptorOptions {
+    fn default() -> Self {
+        Self {
+            levels: LevelSpec::Count(10),
+            max_level: None,
+            vertex_mask: None,
+            angles: 8,
+            alpha: 0.95,
+            rule: SelectionRule::IsoAngle,
+            tangent: TangentMethod::Gradient,
+            strip: StripOptions::default(),
+            spline: SplineOptions::default(),
+            min_sin: 1e-3,
+        }
+    }
+}
+
+/// One point of the descriptor.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DescriptorPoint {
+    /// Position.
+    pub position: DVec3,
+    /// Key (§2.6).
+    pub key: Key,
+    /// Signed cosine of the opening between the two level curves (tangents oriented along
+    /// `n x grad U`).
+    pub cos: f64,
+    /// Face containing the point (`u32::MAX` when read from a CSV/PLY file).
+    pub face: u32,
+    /// Barycentric coordinates in that face (zero when read from a CSV/PLY file).
+    pub bary: DVec3,
+    /// True when several points share this key (decided on all intersections before any
+    /// angle selection; correspondence-based distances should ignore such points).
+    pub ambiguous: bool,
+}
+
+/// Counters describing how a descriptor was built.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct DescriptorStats {
+    /// Level-curve intersections found (after merging duplicates on shared edges).
+    pub intersections: usize,
+    /// Intersections dropped as ill-conditioned (`|sin| < min_sin` or singular face).
+    pub ill_conditioned: usize,
+    /// Tangents for which the strip or spline method fell back to the gradient method.
+    pub tangent_fallbacks: usize,
+    /// Points marked ambiguous.
+    pub ambiguous: usize,
+    /// Degenerate faces skipped.
+    pub degenerate_faces: usize,
+}
+
+/// The bipolar descriptor of a surface.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Descriptor {
+    /// Points, sorted by key then position.
+    pub points: Vec<DescriptorPoint>,
+    /// Geodesic step between levels.
+    pub step: f64,
+    /// Highest level used.
+    pub max_level: u32,
+    /// Geodesic distance between the first two reference points (NaN when unknown).
+    pub reference_distance: f64,
+    /// Reference point positions (empty when unknown).
+    pub references: Vec<DVec3>,
+    /// Options used.
+    pub options: DescriptorOptions,
+    /// Build counters.
+    pub stats: DescriptorStats,
+}
+
+impl Descriptor {
+    /// Positions of the points, in point order.
+    pub fn positions(&self) -> Vec<DVec3> {
+        self.points.iter().map(|p| p.position).collect()
+    }
+
+    /// Packed keys ([`Key::pack`]) of the points, in point order.
+    pub fn packed_keys(&self) -> Vec<u64> {
+        self.points.iter().map(|p| p.key.pack()).collect()
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    /// True when there are no points.
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+}
