@@ -1,0 +1,101 @@
+//! Criterion benches: keyed closed form on 10k pairs, point-to-point ICP on 10k points
+//! (50 iterations, plain and coarse-to-fine), global ICP from 90 and 180 degrees.
+//!
+//! The point sets follow the ICP peers' `make_clouds.py` patch (a smooth asymmetric height
+//! field over an ellipse, noise sigma 0.005); `examples/icp_compare.rs` runs on the peers' own
+//! `.npy` files for the side-by-side with Open3D.
+#![allow(missing_docs)]
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use shapedist::glam::{DMat3, DVec3};
+use shapedist::*;
+
+fn patch(r: &mut ChaCha8Rng, n: usize) -> Vec<DVec3> {
+    let mut s = ChaCha8Rng::seed_from_u64(10_000);
+    let bumps: Vec<[f64; 4]> = (0..8)
+        .map(|_| {
+            [
+                (s.random::<f64>() * 1.4 - 0.7) * 0.8,
+                s.random::<f64>() * 1.4 - 0.7,
+                s.random::<f64>() * 0.37 - 0.12,
+                s.random::<f64>() * 0.23 + 0.12,
+            ]
+        })
+        .collect();
+    let mut out = Vec::with_capacity(n);
+    while out.len() < n {
+        let x = (r.random::<f64>() * 2.0 - 1.0) * 0.8;
+        let y = r.random::<f64>() * 2.0 - 1.0;
+        if (x / 0.8).powi(2) + y * y > 1.0 {
+            continue;
+        }
+        let mut z = 0.35 * (1.0 - (x / 0.8).powi(2) - y * y);
+        for b in &bumps {
+            z += b[2] * (-((x - b[0]).powi(2) + (y - b[1]).powi(2)) / (2.0 * b[3] * b[3])).exp();
+        }
+        out.push(DVec3::new(x, y, z));
+    }
+    out
+}
+
+fn case(deg: f64) -> (Vec<DVec3>, Vec<DVec3>) {
+    let mut r = ChaCha8Rng::seed_from_u64(1);
+    let src = patch(&mut r, 10_000);
+    let rot = DMat3::from_axis_angle(DVec3::new(0.3, -0.5, 0.8).normalize(), deg.to_radians());
+    let tgt = src
+        .iter()
+        .map(|&p| {
+            rot * p
+                + DVec3::new(
+                    r.random::<f64>() - 0.5,
+                    r.random::<f64>() - 0.5,
+                    r.random::<f64>() - 0.5,
+                ) * 0.017
+        })
+        .collect();
+    (tgt, src)
+}
+
+fn benches(c: &mut Criterion) {
+    let mut g = c.benchmark_group("shapedist");
+    g.sample_size(10);
+    let (tgt, src) = case(30.0);
+    let keys: Vec<u64> = (0..10_000u64)
+        .map(|k| k.wrapping_mul(0x9E37_79B9_7F4A_7C15))
+        .collect();
+    g.bench_function("keyed_kabsch_10k_pairs", |bch| {
+        bch.iter(|| keyed_distance(&keys, &tgt, &keys, &src, &KeyedOptions::default()).unwrap())
+    });
+    let po = PrepareOptions::default();
+    for deg in [30.0, 90.0, 180.0] {
+        let (tgt, src) = case(deg);
+        let a = PreparedSet::new(&tgt, &po, Which::A).unwrap();
+        let b = PreparedSet::new(&src, &po, Which::B).unwrap();
+        let plain = IcpOptions {
+            max_iterations: 50,
+            tolerance: 0.0,
+            ..Default::default()
+        };
+        g.bench_function(format!("icp_p2p_10k_50it_from_{deg}deg"), |bch| {
+            bch.iter(|| icp(&a, &b, DMat3::IDENTITY, &plain).unwrap())
+        });
+        let sched = IcpOptions {
+            max_iterations: 10,
+            tolerance: 0.0,
+            coarse_iterations: 40,
+            ..Default::default()
+        };
+        g.bench_function(format!("icp_p2p_10k_40it@500+10it_from_{deg}deg"), |bch| {
+            bch.iter(|| icp(&a, &b, DMat3::IDENTITY, &sched).unwrap())
+        });
+        g.bench_function(format!("global_icp_10k_from_{deg}deg"), |bch| {
+            bch.iter(|| global_icp(&a, &b, &GlobalOptions::default()).unwrap())
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(shapedist_benches, benches);
+criterion_main!(shapedist_benches);

@@ -1,0 +1,815 @@
+//! Iterative closest point without correspondences: point-to-point (the paper's definition)
+//! and point-to-plane, trimmed pairs, convergence test, and a global multi-start strategy
+//! against local minima.
+//!
+//! Convention: `A` is the target (fixed, k-d tree), `B` the source; the result `R` maps
+//! centred B onto centred A (`a ~ R b`). Both sets are centred on their own centroid
+//! first, so the search is over SO(3) as in the paper's `inf_h ||S1 - h S2||`
+//! (optionally a translation is estimated too).
+
+#![allow(clippy::needless_range_loop)] // index loops read best in the 6x6 normal equations
+
+use std::num::NonZero;
+use std::sync::OnceLock;
+
+use glam::{DMat3, DVec3};
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use rand::seq::SliceRandom;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use serde::Serialize;
+
+use crate::error::{ShapeDistError, Which};
+use crate::linalg::{axis_angle, kabsch_rotation, solve_sym, sym_eigen3};
+use crate::points::{centred, check_spread, outer, principal_axes, radius, validate};
+
+/// Below this many source points the correspondence search runs on one thread (rayon's
+/// overhead dominates; the global search parallelises over starts instead).
+const PAR_MIN: usize = 2048;
+
+/// A point set prepared for repeated comparisons: centred, with a k-d tree, a random
+/// subsample (and its tree) for the coarse global search, and lazily estimated normals.
+#[derive(Debug)]
+pub struct PreparedSet {
+    points: Vec<DVec3>,
+    centroid: DVec3,
+    radius: f64,
+    tree: ImmutableKdTree<f64, 3>,
+    sub_points: Vec<DVec3>,
+    sub_tree: ImmutableKdTree<f64, 3>,
+    normals_k: usize,
+    normals: OnceLock<Vec<DVec3>>,
+}
+
+/// Options of [`PreparedSet::new`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct PrepareOptions {
+    /// Size of the random subsample used by the coarse global search (all points when the set
+    /// is smaller).
+    pub subsample: usize,
+    /// Neighbours used for PCA normals (point-to-plane ICP).
+    pub normals_k: usize,
+    /// Seed of the subsample.
+    pub seed: u64,
+}
+
+impl Default for PrepareOptions {
+    fn default() -> Self {
+        Self {
+            subsample: 500,
+            normals_k: 12,
+            seed: 0x5eed,
+        }
+    }
+}
+
+fn build_tree(points: &[DVec3]) -> ImmutableKdTree<f64, 3> {
+    let arr: Vec<[f64; 3]> = points.iter().map(|p| p.to_array()).collect();
+    ImmutableKdTree::new_from_slice(&arr)
+}
+
+impl PreparedSet {
+    /// Validates (non-empty, finite, not collinear), centres, and builds the search trees.
+    pub fn new(
+        points: &[DVec3],
+        opts: &PrepareOptions,
+        which: Which,
+    ) -> Result<Self, ShapeDistError> {
+        validate(points, which)?;
+        let (pts, c) = centred(points);
+        check_spread(&pts, which)?;
+        let tree = build_tree(&pts);
+        let sub_points = if pts.len() <= opts.subsample.max(3) {
+            pts.clone()
+        } else {
+            let mut idx: Vec<usize> = (0..pts.len()).collect();
+            idx.shuffle(&mut ChaCha8Rng::seed_from_u64(opts.seed));
+            idx.truncate(opts.subsample.max(3));
+            idx.sort_unstable();
+            idx.iter().map(|&i| pts[i]).collect()
+        };
+        let sub_tree = build_tree(&sub_points);
+        Ok(Self {
+            radius: radius(&pts),
+            points: pts,
+            centroid: c,
+            tree,
+            sub_points,
+            sub_tree,
+            normals_k: opts.normals_k.max(3),
+            normals: OnceLock::new(),
+        })
+    }
+
+    /// Centred points.
+    pub fn points(&self) -> &[DVec3] {
+        &self.points
+    }
+
+    /// Centroid of the input points.
+    pub fn centroid(&self) -> DVec3 {
+        self.centroid
+    }
+
+    /// `max |p - centroid|`.
+    pub fn radius(&self) -> f64 {
+        self.radius
+    }
+
+    /// Mean squared norm of the centred points.
+    pub fn mean_sq_norm(&self) -> f64 {
+        self.points.iter().map(|p| p.length_squared()).sum::<f64>() / self.points.len() as f64
+    }
+
+    /// Unit normals by PCA of the `normals_k` nearest neighbours (computed on first use; the
+    /// sign is arbitrary, which point-to-plane does not care about).
+    pub fn normals(&self) -> &[DVec3] {
+        self.normals.get_or_init(|| {
+            let k = NonZero::new(self.normals_k.min(self.points.len()).max(1))
+                .unwrap_or(NonZero::<usize>::MIN);
+            self.points
+                .par_iter()
+                .map(|p| {
+                    let nn = self.tree.nearest_n::<SquaredEuclidean>(&p.to_array(), k);
+                    let m = nn
+                        .iter()
+                        .map(|n| self.points[n.item as usize])
+                        .sum::<DVec3>()
+                        / nn.len() as f64;
+                    let cov = nn.iter().fold(DMat3::ZERO, |acc, n| {
+                        let d = self.points[n.item as usize] - m;
+                        acc + outer(d, d)
+                    });
+                    let (_, axes) = sym_eigen3(cov);
+                    axes[2]
+                })
+                .collect()
+        })
+    }
+
+    fn nearest(&self, q: DVec3) -> (f64, usize) {
+        let n = self.tree.nearest_one::<SquaredEuclidean>(&q.to_array());
+        (n.distance, n.item as usize)
+    }
+}
+
+/// Point-to-point or point-to-plane error.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+pub enum IcpVariant {
+    /// Besl & McKay: minimise the squared distances to the closest points (closed form per
+    /// iteration).
+    #[default]
+    PointToPoint,
+    /// Chen & Medioni: minimise squared distances to the tangent planes of the target
+    /// (linearised rotation per iteration); converges in far fewer iterations on surfaces.
+    PointToPlane,
+}
+
+/// Options of one ICP run.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct IcpOptions {
+    /// Error variant.
+    pub variant: IcpVariant,
+    /// Maximum number of iterations.
+    pub max_iterations: usize,
+    /// Stop when the relative change of the RMS pair distance is below this.
+    pub tolerance: f64,
+    /// Fraction of pairs with the largest distances rejected at each iteration (trimmed ICP),
+    /// in [0, 0.9].
+    pub trim: f64,
+    /// Also estimate a translation (the paper's distance is over rotations only: `false`).
+    pub translation: bool,
+    /// Coarse-to-fine schedule: when > 0, first run up to this many iterations on the
+    /// random subsamples of both sets ([`PrepareOptions::subsample`]), then the
+    /// `max_iterations` on all points. Far fewer points are far from their partner on the
+    /// full sets, which is where exact nearest-neighbour queries are expensive.
+    pub coarse_iterations: usize,
+}
+
+impl Default for IcpOptions {
+    fn default() -> Self {
+        Self {
+            variant: IcpVariant::PointToPoint,
+            max_iterations: 50,
+            tolerance: 1e-6,
+            trim: 0.0,
+            translation: false,
+            coarse_iterations: 0,
+        }
+    }
+}
+
+/// Result of an ICP run.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct IcpResult {
+    /// Rotation mapping centred B onto centred A.
+    pub rotation: DMat3,
+    /// Translation after the rotation (zero unless [`IcpOptions::translation`]).
+    pub translation: DVec3,
+    /// Iterations run.
+    pub iterations: usize,
+    /// RMS distance of the kept pairs at the final pose.
+    pub rmse: f64,
+    /// Whether the convergence test was met (rather than the iteration limit).
+    pub converged: bool,
+    /// Iterations run on the subsamples first (see [`IcpOptions::coarse_iterations`]).
+    pub coarse_iterations: usize,
+}
+
+fn check_icp_options(o: &IcpOptions) -> Result<(), ShapeDistError> {
+    if !(0.0..=0.9).contains(&o.trim) {
+        return Err(ShapeDistError::InvalidOption(format!(
+            "trim fraction must be in [0, 0.9], got {}",
+            o.trim
+        )));
+    }
+    if o.tolerance.is_nan() || o.tolerance < 0.0 || o.max_iterations == 0 {
+        return Err(ShapeDistError::InvalidOption(
+            "tolerance must be >= 0 and max_iterations >= 1".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// Correspondence search: for each source point (transformed), squared distance and index of
+/// its nearest target point. With `warm`, `out` holds the previous correspondences and the
+/// distance to the previous partner bounds the search (still the exact nearest neighbour,
+/// but far fewer tree cells are visited when the pose changes little).
+#[allow(clippy::too_many_arguments)]
+fn correspond(
+    tree: &ImmutableKdTree<f64, 3>,
+    tgt: &[DVec3],
+    src: &[DVec3],
+    r: DMat3,
+    t: DVec3,
+    out: &mut [(f64, u32)],
+    parallel: bool,
+    warm: bool,
+) {
+    let q = |b: &DVec3, prev: (f64, u32)| {
+        let p = r * *b + t;
+        if warm {
+            let bound = (p - tgt[prev.1 as usize]).length_squared();
+            let res = tree.nearest_n_within::<SquaredEuclidean>(
+                &p.to_array(),
+                bound,
+                NonZero::<usize>::MIN,
+                true,
+            );
+            if let Some(n) = res.first() {
+                return (n.distance, n.item as u32);
+            }
+        }
+        let n = tree.nearest_one::<SquaredEuclidean>(&p.to_array());
+        (n.distance, n.item as u32)
+    };
+    if parallel {
+        out.par_chunks_mut(512)
+            .zip(src.par_chunks(512))
+            .for_each(|(o, s)| {
+                for (oi, b) in o.iter_mut().zip(s) {
+                    *oi = q(b, *oi);
+                }
+            });
+    } else {
+        for (oi, b) in out.iter_mut().zip(src) {
+            *oi = q(b, *oi);
+        }
+    }
+}
+
+/// Squared-distance threshold keeping the `(1 - trim)` closest pairs (`inf` = keep all).
+fn trim_threshold(corr: &[(f64, u32)], trim: f64, scratch: &mut Vec<f64>) -> f64 {
+    if trim <= 0.0 {
+        return f64::INFINITY;
+    }
+    let keep = ((corr.len() as f64) * (1.0 - trim)).ceil().max(3.0) as usize;
+    if keep >= corr.len() {
+        return f64::INFINITY;
+    }
+    scratch.clear();
+    scratch.extend(corr.iter().map(|c| c.0));
+    let (_, kth, _) = scratch.select_nth_unstable_by(keep - 1, f64::total_cmp);
+    *kth
+}
+
+#[derive(Clone, Copy)]
+struct Sums {
+    n: f64,
+    ss: f64,
+    sa: DVec3,
+    sb: DVec3,
+    k: DMat3,
+}
+
+impl Sums {
+    const ZERO: Sums = Sums {
+        n: 0.0,
+        ss: 0.0,
+        sa: DVec3::ZERO,
+        sb: DVec3::ZERO,
+        k: DMat3::ZERO,
+    };
+    fn add(self, o: Sums) -> Sums {
+        Sums {
+            n: self.n + o.n,
+            ss: self.ss + o.ss,
+            sa: self.sa + o.sa,
+            sb: self.sb + o.sb,
+            k: self.k + o.k,
+        }
+    }
+}
+
+/// Runs ICP of `src` (centred B, or a subsample) onto a target given by its points, tree
+/// and (for point-to-plane) normals, from the initial rotation `init`.
+#[allow(clippy::too_many_arguments)]
+fn icp_core(
+    tgt_pts: &[DVec3],
+    tree: &ImmutableKdTree<f64, 3>,
+    normals: Option<&[DVec3]>,
+    src: &[DVec3],
+    init: DMat3,
+    init_t: DVec3,
+    o: &IcpOptions,
+    parallel: bool,
+) -> IcpResult {
+    let parallel = parallel && src.len() >= PAR_MIN;
+    let mut r = init;
+    let mut t = init_t;
+    let mut corr = vec![(0.0, 0u32); src.len()];
+    let mut scratch = Vec::new();
+    let mut prev_rmse = f64::INFINITY;
+    let mut rmse = f64::INFINITY;
+    let mut iterations = 0;
+    let mut converged = false;
+    while iterations < o.max_iterations {
+        correspond(
+            tree,
+            tgt_pts,
+            src,
+            r,
+            t,
+            &mut corr,
+            parallel,
+            iterations > 0,
+        );
+        let thr = trim_threshold(&corr, o.trim, &mut scratch);
+        iterations += 1;
+        // Statistics of the kept pairs at the current pose.
+        let (n, ss) = corr
+            .iter()
+            .filter(|c| c.0 <= thr)
+            .fold((0usize, 0.0), |(n, s), c| (n + 1, s + c.0));
+        rmse = (ss / n.max(1) as f64).sqrt();
+        if rmse == 0.0
+            || (prev_rmse.is_finite() && (prev_rmse - rmse).abs() <= o.tolerance * prev_rmse)
+        {
+            converged = true;
+            break;
+        }
+        prev_rmse = rmse;
+        let (nr, nt) = match (o.variant, normals) {
+            (IcpVariant::PointToPlane, Some(nrm)) => {
+                plane_step(tgt_pts, nrm, src, &corr, thr, r, t, o.translation)
+            }
+            _ => point_step(tgt_pts, src, &corr, thr, r, t, o.translation, parallel),
+        };
+        r = nr;
+        t = nt;
+    }
+    if !converged {
+        // Report the error at the returned pose.
+        correspond(tree, tgt_pts, src, r, t, &mut corr, parallel, true);
+        let thr = trim_threshold(&corr, o.trim, &mut scratch);
+        let (n, ss) = corr
+            .iter()
+            .filter(|c| c.0 <= thr)
+            .fold((0usize, 0.0), |(n, s), c| (n + 1, s + c.0));
+        rmse = (ss / n.max(1) as f64).sqrt();
+    }
+    IcpResult {
+        rotation: r,
+        translation: t,
+        iterations,
+        rmse,
+        converged,
+        coarse_iterations: 0,
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn point_step(
+    tgt: &[DVec3],
+    src: &[DVec3],
+    corr: &[(f64, u32)],
+    thr: f64,
+    r: DMat3,
+    t: DVec3,
+    translation: bool,
+    parallel: bool,
+) -> (DMat3, DVec3) {
+    let acc = |c: &(f64, u32), b: &DVec3| -> Sums {
+        if c.0 > thr {
+            return Sums::ZERO;
+        }
+        let a = tgt[c.1 as usize];
+        Sums {
+            n: 1.0,
+            ss: 0.0,
+            sa: a,
+            sb: *b,
+            k: outer(a, *b),
+        }
+    };
+    let s = if parallel {
+        corr.par_chunks(1024)
+            .zip(src.par_chunks(1024))
+            .map(|(c, b)| {
+                c.iter()
+                    .zip(b)
+                    .fold(Sums::ZERO, |s, (c, b)| s.add(acc(c, b)))
+            })
+            .reduce(|| Sums::ZERO, Sums::add)
+    } else {
+        corr.iter()
+            .zip(src)
+            .fold(Sums::ZERO, |s, (c, b)| s.add(acc(c, b)))
+    };
+    if s.n < 3.0 {
+        return (r, t);
+    }
+    let mut k = s.k;
+    if translation {
+        let (ma, mb) = (s.sa / s.n, s.sb / s.n);
+        k -= outer(ma, mb) * s.n;
+        let (nr, _) = kabsch_rotation(k);
+        (nr, ma - nr * mb)
+    } else {
+        (kabsch_rotation(k).0, DVec3::ZERO)
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn plane_step(
+    tgt: &[DVec3],
+    nrm: &[DVec3],
+    src: &[DVec3],
+    corr: &[(f64, u32)],
+    thr: f64,
+    r: DMat3,
+    t: DVec3,
+    translation: bool,
+) -> (DMat3, DVec3) {
+    // Residual (p - a).n + w.(p x n) + d.n, p = R b + t; unknowns w (and d).
+    let mut ata = [[0.0; 6]; 6];
+    let mut atb = [0.0; 6];
+    for (c, b) in corr.iter().zip(src) {
+        if c.0 > thr {
+            continue;
+        }
+        let j = c.1 as usize;
+        let (a, n) = (tgt[j], nrm[j]);
+        let p = r * *b + t;
+        let cr = p.cross(n);
+        let row = [cr.x, cr.y, cr.z, n.x, n.y, n.z];
+        let res = (p - a).dot(n);
+        for u in 0..6 {
+            for v in u..6 {
+                ata[u][v] += row[u] * row[v];
+            }
+            atb[u] -= row[u] * res;
+        }
+    }
+    for u in 0..6 {
+        for v in 0..u {
+            ata[u][v] = ata[v][u];
+        }
+    }
+    let tr: f64 = (0..6).map(|i| ata[i][i]).sum();
+    let reg = tr * 1e-12 + f64::MIN_POSITIVE;
+    let (w, d) = if translation {
+        let mut m = ata;
+        (0..6).for_each(|i| m[i][i] += reg);
+        match solve_sym(m, atb) {
+            Some(x) => (DVec3::new(x[0], x[1], x[2]), DVec3::new(x[3], x[4], x[5])),
+            None => return (r, t),
+        }
+    } else {
+        let mut m = [[0.0; 3]; 3];
+        for u in 0..3 {
+            for v in 0..3 {
+                m[u][v] = ata[u][v];
+            }
+            m[u][u] += reg;
+        }
+        match solve_sym(m, [atb[0], atb[1], atb[2]]) {
+            Some(x) => (DVec3::new(x[0], x[1], x[2]), DVec3::ZERO),
+            None => return (r, t),
+        }
+    };
+    let dr = axis_angle(w, w.length());
+    let nr = crate::linalg::orthonormalise(dr * r);
+    let nt = if translation { dr * t + d } else { DVec3::ZERO };
+    (nr, nt)
+}
+
+/// One ICP run of B onto A from the rotation `init` (about the centroids).
+pub fn icp(
+    a: &PreparedSet,
+    b: &PreparedSet,
+    init: DMat3,
+    opts: &IcpOptions,
+) -> Result<IcpResult, ShapeDistError> {
+    check_icp_options(opts)?;
+    if !init.is_finite() {
+        return Err(ShapeDistError::InvalidOption(
+            "initial rotation is not finite".into(),
+        ));
+    }
+    let normals = (opts.variant == IcpVariant::PointToPlane).then(|| a.normals());
+    let (mut r0, mut t0, mut coarse_it) = (init, DVec3::ZERO, 0);
+    if opts.coarse_iterations > 0 {
+        let c = icp_core(
+            &a.sub_points,
+            &a.sub_tree,
+            None,
+            &b.sub_points,
+            init,
+            DVec3::ZERO,
+            &IcpOptions {
+                variant: IcpVariant::PointToPoint,
+                max_iterations: opts.coarse_iterations,
+                ..*opts
+            },
+            false,
+        );
+        (r0, t0, coarse_it) = (c.rotation, c.translation, c.iterations);
+    }
+    let mut res = icp_core(&a.points, &a.tree, normals, &b.points, r0, t0, opts, true);
+    res.coarse_iterations = coarse_it;
+    Ok(res)
+}
+
+/// Options of the global strategy.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct GlobalOptions {
+    /// Iterations of point-to-point ICP from each start on the subsamples.
+    pub coarse_iterations: usize,
+    /// Also start from the 24 rotations of the cube group (a uniform grid; every rotation is
+    /// within 62.8 degrees of one of them) besides the 4 principal-axes alignments.
+    pub grid: bool,
+    /// Refine the best coarse candidates (whose subsample RMS is within this factor of the
+    /// best one, at most 2 of them, distinct by more than 10 degrees) on all points.
+    pub refine_ratio: f64,
+    /// Point-to-plane iterations on all points before the final refinement (0 = none);
+    /// brings the pose close quickly when the final variant is point-to-point.
+    pub plane_warmup: usize,
+    /// Options of the final refinement on all points.
+    pub refine: IcpOptions,
+}
+
+impl Default for GlobalOptions {
+    fn default() -> Self {
+        Self {
+            coarse_iterations: 30,
+            grid: true,
+            refine_ratio: 1.15,
+            plane_warmup: 0,
+            refine: IcpOptions {
+                max_iterations: 100,
+                ..IcpOptions::default()
+            },
+        }
+    }
+}
+
+/// Result of [`global_icp`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct GlobalResult {
+    /// Final ICP result on all points.
+    pub icp: IcpResult,
+    /// Number of starting rotations tried on the subsamples.
+    pub starts: usize,
+    /// Subsample RMS of the best start.
+    pub coarse_rmse: f64,
+    /// Number of candidates refined on all points.
+    pub refined: usize,
+}
+
+/// The 24 rotations of the cube (signed permutation matrices with determinant +1).
+pub fn cube_group() -> Vec<DMat3> {
+    let perms = [
+        [0, 1, 2],
+        [0, 2, 1],
+        [1, 0, 2],
+        [1, 2, 0],
+        [2, 0, 1],
+        [2, 1, 0],
+    ];
+    let mut out = Vec::with_capacity(24);
+    for p in perms {
+        for s in 0..8u32 {
+            let sg = |i: u32| if s >> i & 1 == 1 { -1.0 } else { 1.0 };
+            let mut cols = [DVec3::ZERO; 3];
+            for (row, &col) in p.iter().enumerate() {
+                cols[col][row] = sg(row as u32);
+            }
+            let m = DMat3::from_cols(cols[0], cols[1], cols[2]);
+            if m.determinant() > 0.0 {
+                out.push(m);
+            }
+        }
+    }
+    out
+}
+
+/// The 4 rotations aligning the principal axes of B with those of A (the sign ambiguity of
+/// the axes leaves 4 proper choices).
+pub fn principal_axes_starts(a: &[DVec3], b: &[DVec3]) -> Vec<DMat3> {
+    let frame = |p: &[DVec3]| {
+        let (_, ax) = principal_axes(p);
+        let m = DMat3::from_cols(ax[0], ax[1], ax[2]);
+        if m.determinant() < 0.0 {
+            DMat3::from_cols(ax[0], ax[1], -ax[2])
+        } else {
+            m
+        }
+    };
+    let (fa, fb) = (frame(a), frame(b));
+    [
+        [1.0, 1.0, 1.0],
+        [1.0, -1.0, -1.0],
+        [-1.0, 1.0, -1.0],
+        [-1.0, -1.0, 1.0],
+    ]
+    .iter()
+    .map(|s| fa * DMat3::from_diagonal(DVec3::from_array(*s)) * fb.transpose())
+    .collect()
+}
+
+/// Global ICP: point-to-point ICP from every start (principal axes and optionally the cube
+/// group) on the subsamples, in parallel; the best candidates are refined on all points and
+/// the lowest final RMS wins.
+pub fn global_icp(
+    a: &PreparedSet,
+    b: &PreparedSet,
+    opts: &GlobalOptions,
+) -> Result<GlobalResult, ShapeDistError> {
+    check_icp_options(&opts.refine)?;
+    let mut starts = principal_axes_starts(&a.points, &b.points);
+    if opts.grid {
+        starts.extend(cube_group());
+    }
+    let coarse_opts = IcpOptions {
+        variant: IcpVariant::PointToPoint,
+        max_iterations: opts.coarse_iterations.max(1),
+        tolerance: 1e-4,
+        trim: opts.refine.trim,
+        translation: opts.refine.translation,
+        coarse_iterations: 0,
+    };
+    let mut coarse: Vec<(usize, IcpResult)> = starts
+        .par_iter()
+        .enumerate()
+        .map(|(i, &r0)| {
+            (
+                i,
+                icp_core(
+                    &a.sub_points,
+                    &a.sub_tree,
+                    None,
+                    &b.sub_points,
+                    r0,
+                    DVec3::ZERO,
+                    &coarse_opts,
+                    false,
+                ),
+            )
+        })
+        .collect();
+    coarse.sort_by(|x, y| x.1.rmse.total_cmp(&y.1.rmse).then(x.0.cmp(&y.0)));
+    let best = coarse[0].1.rmse;
+    let mut cands: Vec<IcpResult> = Vec::new();
+    for (_, c) in &coarse {
+        if cands.len() >= 2 || c.rmse > best * opts.refine_ratio.max(1.0) + 1e-300 {
+            break;
+        }
+        if cands.iter().all(|d| {
+            crate::linalg::rotation_angle_between(d.rotation, c.rotation) > 10f64.to_radians()
+        }) {
+            cands.push(*c);
+        }
+    }
+    let mut finals = Vec::with_capacity(cands.len());
+    for c in &cands {
+        let (mut r, mut t) = (c.rotation, c.translation);
+        if opts.plane_warmup > 0 {
+            let w = icp_core(
+                &a.points,
+                &a.tree,
+                Some(a.normals()),
+                &b.points,
+                r,
+                t,
+                &IcpOptions {
+                    variant: IcpVariant::PointToPlane,
+                    max_iterations: opts.plane_warmup,
+                    tolerance: 1e-6,
+                    ..opts.refine
+                },
+                true,
+            );
+            r = w.rotation;
+            t = w.translation;
+        }
+        let normals = (opts.refine.variant == IcpVariant::PointToPlane).then(|| a.normals());
+        finals.push(icp_core(
+            &a.points,
+            &a.tree,
+            normals,
+            &b.points,
+            r,
+            t,
+            &opts.refine,
+            true,
+        ));
+    }
+    let refined = finals.len();
+    let icp = finals
+        .into_iter()
+        .min_by(|x, y| x.rmse.total_cmp(&y.rmse))
+        .ok_or_else(|| ShapeDistError::InvalidOption("no ICP candidate".into()))?;
+    Ok(GlobalResult {
+        icp,
+        starts: starts.len(),
+        coarse_rmse: best,
+        refined,
+    })
+}
+
+/// Closest-point statistics of two centred sets after the rotation `r` (B moved by `r`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ClosestPointStats {
+    /// Symmetric Hausdorff distance `max(max_a min_b, max_b min_a)`.
+    pub hausdorff: f64,
+    /// Symmetric mean closest-point distance `(mean_b min_a + mean_a min_b) / 2`.
+    pub mean: f64,
+    /// Symmetric RMS closest-point distance `sqrt((mean_b min_a^2 + mean_a min_b^2) / 2)`.
+    pub rms: f64,
+    /// `hausdorff / (rho_A + rho_B)`, in [0, 1].
+    pub hausdorff_normalised: f64,
+    /// `mean / (rho_A + rho_B)`, in [0, 1].
+    pub mean_normalised: f64,
+    /// `rms / sqrt(mean|a|^2 + mean|b|^2)`, in [0, 1] (the closest-point analogue of the
+    /// keyed L2 distance).
+    pub rms_normalised: f64,
+}
+
+/// Evaluates [`ClosestPointStats`] for the pose `a ~ r b + t` of centred sets.
+pub fn closest_point_stats(
+    a: &PreparedSet,
+    b: &PreparedSet,
+    r: DMat3,
+    t: DVec3,
+) -> ClosestPointStats {
+    let dir = |tgt: &PreparedSet, src: &[DVec3], r: DMat3, t: DVec3| -> (f64, f64, f64) {
+        src.par_chunks(1024)
+            .map(|ch| {
+                ch.iter().fold((0.0f64, 0.0f64, 0.0f64), |(mx, s, s2), p| {
+                    let (d2, _) = tgt.nearest(r * *p + t);
+                    let d = d2.sqrt();
+                    (mx.max(d), s + d, s2 + d2)
+                })
+            })
+            .reduce(
+                || (0.0, 0.0, 0.0),
+                |x, y| (x.0.max(y.0), x.1 + y.1, x.2 + y.2),
+            )
+    };
+    let (mb, sb, s2b) = dir(a, &b.points, r, t);
+    let rt = r.transpose();
+    let (ma, sa, s2a) = dir(b, &a.points, rt, -(rt * t));
+    let (na, nb) = (a.points.len() as f64, b.points.len() as f64);
+    let hausdorff = ma.max(mb);
+    let mean = 0.5 * (sb / nb + sa / na);
+    let ms = 0.5 * (s2b / nb + s2a / na);
+    let rho = a.radius + b.radius;
+    let norm2 = a.mean_sq_norm() + b.mean_sq_norm();
+    let div = |x: f64, d: f64| {
+        if d > 0.0 {
+            (x / d).clamp(0.0, 1.0)
+        } else {
+            0.0
+        }
+    };
+    ClosestPointStats {
+        hausdorff,
+        mean,
+        rms: ms.sqrt(),
+        hausdorff_normalised: div(hausdorff, rho),
+        mean_normalised: div(mean, rho),
+        rms_normalised: div(ms, norm2).sqrt(),
+    }
+}
