@@ -2,6 +2,9 @@
 
 use clap::{Parser, Subcommand};
 
+mod experiments;
+mod robustness;
+
 /// Experiments and evaluations of the bipolar workspace.
 #[derive(Debug, Parser)]
 #[command(name = "xtask")]
@@ -15,7 +18,7 @@ enum Task {
     /// The paper's section 3: the descriptor on a sphere against analytic curves (issue 4).
     SphereValidate,
     /// The paper's sections 4-6 on the face set (issue 7).
-    Robustness,
+    Robustness(robustness::Args),
     /// Identification/verification benchmark on sampled faces (issue 7).
     Recognition,
     /// Landmark detection accuracy on sampled faces (issue 6).
@@ -26,7 +29,7 @@ fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
     match cli.task {
         Task::SphereValidate => anyhow::bail!("sphere-validate is not implemented yet (issue 4)"),
-        Task::Robustness => anyhow::bail!("robustness is not implemented yet (issue 7)"),
+        Task::Robustness(args) => robustness::run(args),
         Task::Recognition => anyhow::bail!("recognition is not implemented yet (issue 7)"),
         Task::LandmarksEval => anyhow::bail!("landmarks-eval is not implemented yet (issue 6)"),
     }

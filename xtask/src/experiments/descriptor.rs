@@ -1,0 +1,468 @@
+//! Keyed point sets, the bipolar grid descriptor used by the experiments, isoline segments for
+//! renders, and the keyed closed-form shape distance.
+//!
+//! Until the `bipolar` and `shapedist` crates land, the descriptor here is the grid reading of
+//! the paper (selection rule A without angle filter: every intersection of level `i` of `U_r`
+//! with level `j` of `U_q`, key `(i, j, side)`), and the distance is the keyed L2 distance
+//! after the optimal rotation (Horn's quaternion closed form), normalised to [0, 1]:
+//! `d = sqrt((|A|^2 + |B|^2 - 2 max_R sum a.Rb) / (|A|^2 + |B|^2))` on centred paired points.
+
+use meshcore::{DVec3, TriMesh};
+
+/// A descriptor: points with keys (sorted by key), and which keys are ambiguous.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct KeyedPoints {
+    /// Packed keys, ascending.
+    pub keys: Vec<u64>,
+    /// Positions.
+    pub points: Vec<DVec3>,
+    /// True where a key occurs at several distinct places (such keys are not paired).
+    pub ambiguous: Vec<bool>,
+}
+
+impl KeyedPoints {
+    /// Builds a keyed set from unsorted `(key, point)` pairs: duplicates of a key closer than
+    /// `tol` are merged (points found from two faces), farther ones make the key ambiguous.
+    pub fn from_pairs(mut pairs: Vec<(u64, DVec3)>, tol: f64) -> Self {
+        pairs.sort_by(|a, b| {
+            a.0.cmp(&b.0)
+                .then(a.1.x.total_cmp(&b.1.x))
+                .then(a.1.y.total_cmp(&b.1.y))
+                .then(a.1.z.total_cmp(&b.1.z))
+        });
+        let mut out = KeyedPoints::default();
+        let mut i = 0;
+        while i < pairs.len() {
+            let mut j = i + 1;
+            while j < pairs.len() && pairs[j].0 == pairs[i].0 {
+                j += 1;
+            }
+            let first = pairs[i].1;
+            let ambiguous = pairs[i..j].iter().any(|p| (p.1 - first).length() > tol);
+            out.keys.push(pairs[i].0);
+            out.points.push(first);
+            out.ambiguous.push(ambiguous);
+            i = j;
+        }
+        out
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.keys.len()
+    }
+
+    /// True if there is no point.
+    #[allow(dead_code)] // pairs with `len`
+    pub fn is_empty(&self) -> bool {
+        self.keys.is_empty()
+    }
+
+    /// Unambiguous keys and points (for distances).
+    pub fn unambiguous(&self) -> (Vec<u64>, Vec<DVec3>) {
+        let mut k = Vec::new();
+        let mut p = Vec::new();
+        for i in 0..self.len() {
+            if !self.ambiguous[i] {
+                k.push(self.keys[i]);
+                p.push(self.points[i]);
+            }
+        }
+        (k, p)
+    }
+}
+
+/// Packs a grid key `(i, j, side)`.
+pub fn grid_key(i: u32, j: u32, side: bool) -> u64 {
+    (u64::from(i) << 33) | (u64::from(j) << 1) | u64::from(side)
+}
+
+/// Unpacks a grid key.
+#[allow(dead_code)] // used by tests and kept for readers of the CSV keys
+pub fn grid_key_parts(k: u64) -> (u32, u32, bool) {
+    (
+        (k >> 33) as u32,
+        ((k >> 1) & 0xffff_ffff) as u32,
+        k & 1 == 1,
+    )
+}
+
+/// Options of [`bipolar_grid`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridOptions {
+    /// Geodesic step between levels (`D / N` for N levels between the references).
+    pub step: f64,
+    /// Largest level index kept, for both fields (`M`; `M = N` keeps points within D of both).
+    pub max_level: u32,
+}
+
+/// Intersections of the level curves `U_r = i*step` and `U_q = j*step` (1 <= i, j <= M), one
+/// 2x2 solve per face and level pair, keyed `(i, j, side)` with side = sign of
+/// `<n, grad U_r x grad U_q>`. Faces with a masked-out vertex are skipped when `mask` is given.
+pub fn bipolar_grid(
+    mesh: &TriMesh,
+    ur: &[f64],
+    uq: &[f64],
+    opts: &GridOptions,
+    mask: Option<&[bool]>,
+) -> KeyedPoints {
+    let tol = 1e-9 * mesh.bbox().diagonal();
+    let mut pairs = Vec::new();
+    #[allow(clippy::reversed_empty_ranges)]
+    let levels = |a: f64, b: f64, c: f64| -> std::ops::RangeInclusive<u32> {
+        let lo = a.min(b).min(c);
+        let hi = a.max(b).max(c);
+        if !(lo.is_finite() && hi.is_finite()) {
+            return 1..=0; // empty: a face with an unreachable vertex has no level
+        }
+        let i0 = ((lo / opts.step).ceil().max(1.0)) as u32;
+        let i1 = ((hi / opts.step).floor().min(f64::from(opts.max_level))) as u32;
+        i0..=i1
+    };
+    for (f, t) in mesh.triangles().iter().enumerate() {
+        if let Some(m) = mask {
+            if t.iter().any(|&v| !m[v as usize]) {
+                continue;
+            }
+        }
+        let [v0, v1, v2] = t.map(|v| v as usize);
+        let (r0, r1, r2) = (ur[v0], ur[v1], ur[v2]);
+        let (q0, q1, q2) = (uq[v0], uq[v1], uq[v2]);
+        let det = (r1 - r0) * (q2 - q0) - (r2 - r0) * (q1 - q0);
+        let scale = ((r1 - r0).abs() + (r2 - r0).abs()) * ((q1 - q0).abs() + (q2 - q0).abs());
+        if det.abs().is_nan() || det.abs() <= 1e-12 * scale {
+            continue;
+        }
+        let side = det > 0.0;
+        let [p0, p1, p2] = mesh.face_corners(f as u32);
+        for i in levels(r0, r1, r2) {
+            let a = f64::from(i) * opts.step;
+            for j in levels(q0, q1, q2) {
+                let b = f64::from(j) * opts.step;
+                let b1 = ((a - r0) * (q2 - q0) - (r2 - r0) * (b - q0)) / det;
+                let b2 = ((r1 - r0) * (b - q0) - (a - r0) * (q1 - q0)) / det;
+                let b0 = 1.0 - b1 - b2;
+                if b0 >= -1e-10 && b1 >= -1e-10 && b2 >= -1e-10 {
+                    pairs.push((grid_key(i, j, side), b0 * p0 + b1 * p1 + b2 * p2));
+                }
+            }
+        }
+    }
+    KeyedPoints::from_pairs(pairs, tol)
+}
+
+/// Straight isoline pieces of the PL field `u` at each level (one segment per crossed face),
+/// for renders. A vertex counts as above a level when `u >= level`.
+pub fn isoline_segments(mesh: &TriMesh, u: &[f64], levels: &[f64]) -> Vec<Vec<[DVec3; 2]>> {
+    levels
+        .iter()
+        .map(|&c| {
+            let mut segs = Vec::new();
+            for t in mesh.triangles() {
+                let val = t.map(|v| u[v as usize]);
+                if val.iter().any(|x| !x.is_finite()) {
+                    continue;
+                }
+                let mut pts = Vec::with_capacity(2);
+                for k in 0..3 {
+                    let (a, b) = (k, (k + 1) % 3);
+                    if (val[a] >= c) != (val[b] >= c) {
+                        let s = (c - val[a]) / (val[b] - val[a]);
+                        let pa = mesh.position(t[a]);
+                        let pb = mesh.position(t[b]);
+                        pts.push(pa + s * (pb - pa));
+                    }
+                }
+                if pts.len() == 2 {
+                    segs.push([pts[0], pts[1]]);
+                }
+            }
+            segs
+        })
+        .collect()
+}
+
+/// Result of a keyed distance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KeyedDistance {
+    /// Normalised distance in [0, 1].
+    pub distance: f64,
+    /// Number of paired (shared, unambiguous) keys.
+    pub shared: usize,
+    /// Unambiguous points of the first set.
+    pub n_a: usize,
+    /// Unambiguous points of the second set.
+    pub n_b: usize,
+}
+
+/// Keyed closed-form distance (see the module doc); `None` with fewer than 3 shared keys.
+pub fn keyed_distance(a: &KeyedPoints, b: &KeyedPoints) -> Option<KeyedDistance> {
+    let (ka, pa) = a.unambiguous();
+    let (kb, pb) = b.unambiguous();
+    let mut xa = Vec::new();
+    let mut xb = Vec::new();
+    let (mut i, mut j) = (0, 0);
+    while i < ka.len() && j < kb.len() {
+        match ka[i].cmp(&kb[j]) {
+            std::cmp::Ordering::Less => i += 1,
+            std::cmp::Ordering::Greater => j += 1,
+            std::cmp::Ordering::Equal => {
+                xa.push(pa[i]);
+                xb.push(pb[j]);
+                i += 1;
+                j += 1;
+            }
+        }
+    }
+    let d = paired_distance(&xa, &xb)?;
+    Some(KeyedDistance {
+        distance: d,
+        shared: xa.len(),
+        n_a: ka.len(),
+        n_b: kb.len(),
+    })
+}
+
+/// Normalised L2 distance between paired point sets after centring and the optimal rotation.
+pub fn paired_distance(a: &[DVec3], b: &[DVec3]) -> Option<f64> {
+    if a.len() != b.len() || a.len() < 3 {
+        return None;
+    }
+    let n = a.len() as f64;
+    let ca = a.iter().copied().sum::<DVec3>() / n;
+    let cb = b.iter().copied().sum::<DVec3>() / n;
+    let mut s = [[0.0f64; 3]; 3];
+    let (mut na, mut nb) = (0.0, 0.0);
+    for (p, q) in a.iter().zip(b) {
+        let (x, y) = (*p - ca, *q - cb);
+        na += x.length_squared();
+        nb += y.length_squared();
+        for r in 0..3 {
+            for c in 0..3 {
+                s[r][c] += y[r] * x[c];
+            }
+        }
+    }
+    if na + nb <= 0.0 {
+        return Some(0.0);
+    }
+    let lmax = max_rotation_correlation(&s);
+    Some(((na + nb - 2.0 * lmax).max(0.0) / (na + nb)).sqrt())
+}
+
+#[allow(dead_code)] // used by `recognition` (wired once the face model lands)
+/// Optimal rotation aligning paired centred sets, `R` with `a ~ R b` (Horn's quaternion method).
+pub fn best_rotation(a: &[DVec3], b: &[DVec3]) -> meshcore::DMat3 {
+    let mut s = [[0.0f64; 3]; 3];
+    for (p, q) in a.iter().zip(b) {
+        for r in 0..3 {
+            for c in 0..3 {
+                s[r][c] += q[r] * p[c];
+            }
+        }
+    }
+    let (_, v) = horn_eigen(&s);
+    meshcore::DMat3::from_quat(meshcore::DQuat::from_xyzw(v[1], v[2], v[3], v[0]).normalize())
+}
+
+/// `max_R sum a_i . R b_i` from `S = sum b_i a_i^T` (largest eigenvalue of Horn's matrix).
+fn max_rotation_correlation(s: &[[f64; 3]; 3]) -> f64 {
+    horn_eigen(s).0
+}
+
+fn horn_eigen(s: &[[f64; 3]; 3]) -> (f64, [f64; 4]) {
+    let (sxx, sxy, sxz) = (s[0][0], s[0][1], s[0][2]);
+    let (syx, syy, syz) = (s[1][0], s[1][1], s[1][2]);
+    let (szx, szy, szz) = (s[2][0], s[2][1], s[2][2]);
+    let n = [
+        [sxx + syy + szz, syz - szy, szx - sxz, sxy - syx],
+        [syz - szy, sxx - syy - szz, sxy + syx, szx + sxz],
+        [szx - sxz, sxy + syx, -sxx + syy - szz, syz + szy],
+        [sxy - syx, szx + sxz, syz + szy, -sxx - syy + szz],
+    ];
+    let (vals, vecs) = jacobi4(n);
+    let mut best = 0;
+    for k in 1..4 {
+        if vals[k] > vals[best] {
+            best = k;
+        }
+    }
+    (
+        vals[best],
+        [vecs[0][best], vecs[1][best], vecs[2][best], vecs[3][best]],
+    )
+}
+
+#[allow(clippy::needless_range_loop)]
+/// Cyclic Jacobi eigen-decomposition of a symmetric 4x4 matrix: (eigenvalues, eigenvectors as
+/// columns).
+fn jacobi4(mut a: [[f64; 4]; 4]) -> ([f64; 4], [[f64; 4]; 4]) {
+    let mut v = [[0.0; 4]; 4];
+    for (i, row) in v.iter_mut().enumerate() {
+        row[i] = 1.0;
+    }
+    for _ in 0..100 {
+        let off: f64 = (0..4)
+            .flat_map(|i| (0..4).filter(move |&j| j != i).map(move |j| (i, j)))
+            .map(|(i, j)| a[i][j] * a[i][j])
+            .sum();
+        let diag: f64 = (0..4).map(|i| a[i][i] * a[i][i]).sum();
+        if off <= 1e-30 * diag.max(1e-300) {
+            break;
+        }
+        for p in 0..3 {
+            for q in p + 1..4 {
+                if a[p][q].abs() < 1e-300 {
+                    continue;
+                }
+                let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+                let t = if theta == 0.0 { 1.0 } else { t };
+                let c = 1.0 / (t * t + 1.0).sqrt();
+                let s = t * c;
+                for k in 0..4 {
+                    let (akp, akq) = (a[k][p], a[k][q]);
+                    a[k][p] = c * akp - s * akq;
+                    a[k][q] = s * akp + c * akq;
+                }
+                for k in 0..4 {
+                    let (apk, aqk) = (a[p][k], a[q][k]);
+                    a[p][k] = c * apk - s * aqk;
+                    a[q][k] = s * apk + c * aqk;
+                }
+                for row in v.iter_mut() {
+                    let (vkp, vkq) = (row[p], row[q]);
+                    row[p] = c * vkp - s * vkq;
+                    row[q] = s * vkp + c * vkq;
+                }
+            }
+        }
+    }
+    ([a[0][0], a[1][1], a[2][2], a[3][3]], v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiments::walk::tests::plane;
+    use meshcore::{DMat3, DQuat};
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn random_set(n: usize, seed: u64) -> Vec<DVec3> {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        (0..n)
+            .map(|_| DVec3::new(rng.random(), rng.random(), rng.random()) * 4.0 - 2.0)
+            .collect()
+    }
+
+    #[test]
+    fn rotated_copy_is_at_zero_and_reflection_is_not() {
+        let a = random_set(50, 1);
+        let r = DMat3::from_quat(DQuat::from_axis_angle(
+            DVec3::new(1.0, 2.0, -0.5).normalize(),
+            2.7,
+        ));
+        let b: Vec<DVec3> = a
+            .iter()
+            .map(|p| r * *p + DVec3::new(3.0, -1.0, 7.0))
+            .collect();
+        assert!(paired_distance(&a, &b).unwrap() < 1e-7);
+        let rot = best_rotation(
+            &a.iter()
+                .map(|p| *p - a.iter().copied().sum::<DVec3>() / 50.0)
+                .collect::<Vec<_>>(),
+            &b.iter()
+                .map(|p| *p - b.iter().copied().sum::<DVec3>() / 50.0)
+                .collect::<Vec<_>>(),
+        );
+        assert!((rot * r - DMat3::IDENTITY)
+            .to_cols_array()
+            .iter()
+            .all(|x| x.abs() < 1e-9));
+        let m: Vec<DVec3> = a.iter().map(|p| DVec3::new(-p.x, p.y, p.z)).collect();
+        assert!(paired_distance(&a, &m).unwrap() > 0.1);
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let noisy: Vec<DVec3> = a
+            .iter()
+            .map(|p| *p + 0.05 * DVec3::new(rng.random(), rng.random(), rng.random()))
+            .collect();
+        let d = paired_distance(&a, &noisy).unwrap();
+        assert!(d > 1e-4 && d < 0.05, "{d}");
+        let d2 = paired_distance(&noisy, &a).unwrap();
+        assert!((d - d2).abs() < 1e-12);
+    }
+
+    #[test]
+    fn keyed_distance_pairs_by_key_and_skips_ambiguous() {
+        let a = random_set(20, 2);
+        let mut pa: Vec<(u64, DVec3)> = a.iter().enumerate().map(|(i, p)| (i as u64, *p)).collect();
+        // Shuffle order and a duplicate far away for key 5 (ambiguous).
+        pa.reverse();
+        pa.push((5, DVec3::splat(100.0)));
+        let ka = KeyedPoints::from_pairs(pa, 1e-9);
+        assert!(ka.ambiguous[5]);
+        // b: same points for keys 0..15 only, plus a wild point at key 5 (ignored: ambiguous in a).
+        let pb: Vec<(u64, DVec3)> = a
+            .iter()
+            .enumerate()
+            .take(15)
+            .map(|(i, p)| (i as u64, if i == 5 { DVec3::splat(-50.0) } else { *p }))
+            .collect();
+        let kb = KeyedPoints::from_pairs(pb, 1e-9);
+        let d = keyed_distance(&ka, &kb).unwrap();
+        assert_eq!(d.shared, 14);
+        assert!(d.distance < 1e-7);
+        assert!(
+            keyed_distance(&ka, &KeyedPoints::from_pairs(vec![(0, DVec3::ZERO)], 1e-9)).is_none()
+        );
+    }
+
+    #[test]
+    fn grid_on_a_plane_follows_the_law_of_cosines() {
+        let m = plane(40, 0.3, 9);
+        let (r, q) = (DVec3::new(0.3, 0.5, 0.0), DVec3::new(0.7, 0.5, 0.0));
+        let ur: Vec<f64> = m.positions().iter().map(|p| (*p - r).length()).collect();
+        let uq: Vec<f64> = m.positions().iter().map(|p| (*p - q).length()).collect();
+        let g = bipolar_grid(
+            &m,
+            &ur,
+            &uq,
+            &GridOptions {
+                step: 0.1,
+                max_level: 4,
+            },
+            None,
+        );
+        assert!(!g.is_empty());
+        for k in 0..g.len() {
+            let (i, j, side) = grid_key_parts(g.keys[k]);
+            let p = g.points[k];
+            // Exact circle intersection of radii i/10 and j/10.
+            let (a, b, d) = (f64::from(i) * 0.1, f64::from(j) * 0.1, 0.4);
+            let x = (a * a - b * b + d * d) / (2.0 * d);
+            let y = (a * a - x * x).max(0.0).sqrt();
+            let expect_y = if side { 0.5 + y } else { 0.5 - y };
+            // PL interpolation of the distance: error O(h^2 / R).
+            assert!(
+                (p.x - (0.3 + x)).abs() < 0.01 && (p.y - expect_y).abs() < 0.01,
+                "{i} {j} {side} {p:?}"
+            );
+            assert!(!g.ambiguous[k]);
+        }
+        // Both sides present and symmetric in number.
+        let n_side = g.keys.iter().filter(|k| *k & 1 == 1).count();
+        assert_eq!(2 * n_side, g.len());
+    }
+
+    #[test]
+    fn isolines_cross_each_face_once() {
+        let m = plane(10, 0.2, 4);
+        let u: Vec<f64> = m.positions().iter().map(|p| p.x).collect();
+        let s = isoline_segments(&m, &u, &[0.55]);
+        assert_eq!(s[0].len(), 20);
+        for seg in &s[0] {
+            assert!((seg[0].x - 0.55).abs() < 1e-12 && (seg[1].x - 0.55).abs() < 1e-12);
+        }
+    }
+}
