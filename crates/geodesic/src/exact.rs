@@ -533,8 +533,7 @@ impl<'a> Solve<'a> {
                 let py = b[k2] * geo.cy;
                 self.emit_vertex_like(h, px, py, 0.0);
             }
-            for k in 0..3 {
-                let v = tf[k];
+            for &v in &tf {
                 let dv = (g.positions[v as usize] - pos).length();
                 self.relax(v, dv, Pred::Point(idx));
             }
@@ -770,9 +769,9 @@ impl<'a> Solve<'a> {
             tcs.push(tc);
             let t = tc.clamp(w.b0, w.b1);
             let dc = if t == tc {
-                w.sigma + (cx - w.sx).hypot(cy - w.sy)
+                w.sigma + ((cx - w.sx) * (cx - w.sx) + (cy - w.sy) * (cy - w.sy)).sqrt()
             } else {
-                w.dist(t) + (cx - t).hypot(cy)
+                w.dist(t) + ((cx - t) * (cx - t) + cy * cy).sqrt()
             };
             if dc < best || (dc == best && w.sigma < best_sigma) {
                 best = dc;

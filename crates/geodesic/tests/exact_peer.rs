@@ -38,14 +38,35 @@ fn compare_with_peer() {
             .filter(|l| !l.trim().is_empty())
             .map(|l| l.trim().parse::<f64>().unwrap())
             .collect();
-        let t0 = Instant::now();
-        let solver = ExactGeodesic::new(&m).unwrap();
-        let t1 = Instant::now();
-        let (d, props) = solver
-            .distances_with_stats(&[Source::Vertex(src)], &SolveOptions::default())
-            .unwrap();
-        let t2 = Instant::now();
-        let _ = solver.n_vertices();
+        let repeat: usize = std::env::var("EXACT_PEER_REPEAT")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(1);
+        let (mut setup, mut solve) = (Vec::new(), Vec::new());
+        let mut out = None;
+        for _ in 0..repeat {
+            let (t0, c0) = (Instant::now(), thread_cpu());
+            let solver = ExactGeodesic::new(&m).unwrap();
+            let (t1, c1) = (Instant::now(), thread_cpu());
+            let r = solver
+                .distances_with_stats(&[Source::Vertex(src)], &SolveOptions::default())
+                .unwrap();
+            let (t2, c2) = (Instant::now(), thread_cpu());
+            let _ = solver.n_vertices();
+            setup.push(((t1 - t0).as_secs_f64(), c1 - c0));
+            solve.push(((t2 - t1).as_secs_f64(), c2 - c1));
+            out = Some(r);
+        }
+        let (d, props) = out.unwrap();
+        let med = |v: &mut Vec<(f64, f64)>| {
+            let mut w: Vec<f64> = v.iter().map(|x| x.0).collect();
+            let mut c: Vec<f64> = v.iter().map(|x| x.1).collect();
+            w.sort_by(f64::total_cmp);
+            c.sort_by(f64::total_cmp);
+            (w[w.len() / 2], c[c.len() / 2])
+        };
+        let (sw, sc) = med(&mut setup);
+        let (vw, vc) = med(&mut solve);
         let floor = 1e-12 * m.bbox().diagonal();
         let rel = exact_util::max_rel_diff(&d, &reference, floor);
         let (mut imax, mut vmax) = (0, 0.0);
@@ -57,10 +78,9 @@ fn compare_with_peer() {
             }
         }
         println!(
-            "{mesh} src {src}: nV {} setup {:.4} s solve {:.4} s propagations {props} max rel diff {rel:.3e} (vertex {imax}: ours {} peer {})",
+            "{mesh} src {src}: nV {} setup wall {sw:.4} s cpu {sc:.4} s | solve wall {vw:.4} s cpu {vc:.4} s (median of {repeat}) | propagations {props} | peak RSS {} MB | max rel diff {rel:.3e} (vertex {imax}: ours {} peer {})",
             m.n_vertices(),
-            (t1 - t0).as_secs_f64(),
-            (t2 - t1).as_secs_f64(),
+            peak_rss_mb(),
             d[imax],
             reference[imax]
         );
@@ -70,4 +90,29 @@ fn compare_with_peer() {
         worst <= tol,
         "max relative difference {worst:.3e} > {tol:.0e}"
     );
+}
+
+/// CPU time of the calling thread in seconds (Linux `/proc/thread-self/schedstat`; NaN elsewhere).
+fn thread_cpu() -> f64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
+        .map(|ns| ns * 1e-9)
+        .unwrap_or(f64::NAN)
+}
+
+/// Peak resident set size of the process in MB (Linux `VmHWM`; 0 elsewhere).
+fn peak_rss_mb() -> u64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))?
+                .split_whitespace()
+                .nth(1)?
+                .parse::<u64>()
+                .ok()
+        })
+        .map(|kb| kb / 1024)
+        .unwrap_or(0)
 }

@@ -47,11 +47,15 @@ impl Window {
     /// True if the window was removed.
     #[inline]
     pub fn is_dead(&self) -> bool {
-        !(self.b0 <= self.b1)
+        // Dead when b0 > b1 or either end is NaN.
+        !matches!(
+            self.b0.partial_cmp(&self.b1),
+            Some(std::cmp::Ordering::Less | std::cmp::Ordering::Equal)
+        )
     }
 
     fn scale(&self) -> f64 {
-        self.sigma.abs() + self.sx.hypot(self.sy)
+        self.sigma.abs() + (self.sx * self.sx + self.sy * self.sy).sqrt()
     }
 }
 
@@ -124,6 +128,11 @@ fn equal_distance_roots(w1: &Window, w2: &Window, out: &mut [f64; 2]) -> usize {
 /// than [`TAU`] relative); windows are never split in the middle. Identical distance functions
 /// whose intervals overlap or touch are merged into `w1`.
 pub(crate) fn pair_trim(w1: &mut Window, w2: &mut Window) -> Trim {
+    let l = w1.b0.max(w2.b0);
+    let r = w1.b1.min(w2.b1);
+    if r < l {
+        return Trim::Both;
+    }
     let s = 1e-12 * w1.scale();
     if (w1.sigma - w2.sigma).abs() <= s
         && (w1.sx - w2.sx).abs() <= s
@@ -137,8 +146,6 @@ pub(crate) fn pair_trim(w1: &mut Window, w2: &mut Window) -> Trim {
         w2.kill();
         return Trim::SecondDead;
     }
-    let l = w1.b0.max(w2.b0);
-    let r = w1.b1.min(w2.b1);
     if r <= l {
         return Trim::Both;
     }
