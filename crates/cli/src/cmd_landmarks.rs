@@ -1,17 +1,73 @@
-//! `bipolar landmarks` (not implemented yet, issue 6).
+//! `bipolar landmarks`: automatic detection of the outer and inner eye corners and the nose tip.
+
+use anyhow::Context;
+use landmarks::{detect_with, io, DetectOptions, GenericModel, LandmarkName};
+use std::path::PathBuf;
 
 /// Arguments of `bipolar landmarks`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Remaining arguments (the command is not implemented yet).
-    #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
-    rest: Vec<String>,
+    /// Mesh file (obj, ply, stl, off, gltf, glb, bnt).
+    pub mesh: PathBuf,
+    /// Generic face model (JSON); default: the model shipped with the tool (trained on ICT
+    /// FaceKit faces, cm).
+    #[arg(long)]
+    pub model: Option<PathBuf>,
+    /// Output JSON file of the detected landmarks.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Also write the landmarks as a Bosphorus `.lm3` file.
+    #[arg(long)]
+    pub lm3: Option<PathBuf>,
+    /// Mesh units per model unit (10 for a scan in mm with the default model in cm).
+    #[arg(long, default_value_t = 1.0)]
+    pub scale: f64,
+    /// Overall confidence below which detection fails.
+    #[arg(long, default_value_t = 0.3)]
+    pub min_confidence: f64,
 }
 
 /// Runs the command.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    anyhow::bail!(
-        "`bipolar landmarks` is not implemented yet (issue 6); arguments: {:?}",
-        args.rest
-    )
+    let loaded = mesh_io::read_mesh(&args.mesh)
+        .with_context(|| format!("cannot load {}", args.mesh.display()))?;
+    let model = match &args.model {
+        Some(p) => GenericModel::load(p)?,
+        None => GenericModel::default_model()?,
+    };
+    let opts = DetectOptions {
+        mesh_units_per_model_unit: args.scale,
+        min_confidence: args.min_confidence,
+        ..DetectOptions::default()
+    };
+    let lm = detect_with(&loaded.mesh, &model, &opts)
+        .with_context(|| format!("landmark detection on {}", args.mesh.display()))?;
+    println!(
+        "{}: face found, confidence {:.2} (fit rms {:.4}, {:.0} % of the generic face matched)",
+        args.mesh.display(),
+        lm.confidence,
+        lm.fit_rms,
+        100.0 * lm.inlier_fraction
+    );
+    for n in LandmarkName::ALL {
+        let l = lm.get(n);
+        println!(
+            "  {:<16} vertex {:>7}  ({:.4}, {:.4}, {:.4})  confidence {:.2}",
+            n.key(),
+            l.vertex,
+            l.position.x,
+            l.position.y,
+            l.position.z,
+            l.confidence
+        );
+    }
+    if let Some(p) = &args.out {
+        io::write_landmarks_json(p, &lm)?;
+        println!("wrote {}", p.display());
+    }
+    if let Some(p) = &args.lm3 {
+        io::write_lm3(p, &lm)?;
+        println!("wrote {}", p.display());
+    }
+    Ok(())
 }

@@ -1,3 +1,198 @@
-//! Curvature and automatic face landmarks.
+//! Curvature and automatic face landmarks (nose tip, inner and outer eye corners).
 //!
-//! Not implemented yet (issue 6): this crate currently exports nothing.
+//! * [`curvature`]: per-vertex principal curvatures by quadric fitting at a chosen scale, shape
+//!   index (nose-tip cap `+1` with outward normals), curvedness, Taubin smoothing.
+//! * [`GenericModel`]: mean landmark configuration, mean face surface and per-landmark surface
+//!   templates learned from training faces ([`GenericModel::train`]); JSON serialisable; a
+//!   default model trained on ICT FaceKit faces (cm) ships with the crate
+//!   ([`GenericModel::default_model`]).
+//! * [`detect`]: rotation- and translation-invariant detection. Curvature gives nose-tip (convex
+//!   cap) and inner-eye-corner (concave) candidates; their configurations give pose hypotheses;
+//!   the generic face surface is fitted (point-to-plane ICP) to choose and refine the pose;
+//!   each landmark is then refined by a local template search. Inputs that do not fit a face
+//!   (not a face, inverted normals) end with [`LandmarkError::NotFound`].
+//! * [`io`]: `.lm3` reader and writer, the ICT `landmarks.json` layout, JSON output.
+
+pub mod curvature;
+mod detect;
+pub mod geom;
+pub mod io;
+mod model;
+
+pub use curvature::{curvedness, shape_index, Curvature, CurvatureOptions};
+pub use detect::{detect, detect_with, DetectOptions};
+pub use model::{DetectParams, GenericModel, Template, TrainOptions};
+
+use meshcore::{DAffine3, DVec3, MeshError};
+
+/// The five landmarks; "right" and "left" are the subject's.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum LandmarkName {
+    /// Outer corner of the right eye (exocanthion).
+    OuterEyeRight = 0,
+    /// Inner corner of the right eye (endocanthion).
+    InnerEyeRight = 1,
+    /// Inner corner of the left eye.
+    InnerEyeLeft = 2,
+    /// Outer corner of the left eye.
+    OuterEyeLeft = 3,
+    /// Nose tip (pronasale).
+    NoseTip = 4,
+}
+
+impl LandmarkName {
+    /// All names in index order.
+    pub const ALL: [LandmarkName; 5] = [
+        LandmarkName::OuterEyeRight,
+        LandmarkName::InnerEyeRight,
+        LandmarkName::InnerEyeLeft,
+        LandmarkName::OuterEyeLeft,
+        LandmarkName::NoseTip,
+    ];
+
+    /// Snake-case key used in JSON files (`outer_eye_right`, ...).
+    pub fn key(self) -> &'static str {
+        match self {
+            Self::OuterEyeRight => "outer_eye_right",
+            Self::InnerEyeRight => "inner_eye_right",
+            Self::InnerEyeLeft => "inner_eye_left",
+            Self::OuterEyeLeft => "outer_eye_left",
+            Self::NoseTip => "nose_tip",
+        }
+    }
+
+    /// Key of the ICT FaceKit `landmarks.json` (`right_eye_outer`, ...).
+    pub fn ict_key(self) -> &'static str {
+        match self {
+            Self::OuterEyeRight => "right_eye_outer",
+            Self::InnerEyeRight => "right_eye_inner",
+            Self::InnerEyeLeft => "left_eye_inner",
+            Self::OuterEyeLeft => "left_eye_outer",
+            Self::NoseTip => "nose_tip",
+        }
+    }
+
+    /// Bosphorus `.lm3` label (`Outer right eye corner`, ...).
+    pub fn lm3_label(self) -> &'static str {
+        match self {
+            Self::OuterEyeRight => "Outer right eye corner",
+            Self::InnerEyeRight => "Inner right eye corner",
+            Self::InnerEyeLeft => "Inner left eye corner",
+            Self::OuterEyeLeft => "Outer left eye corner",
+            Self::NoseTip => "Nose tip",
+        }
+    }
+
+    /// Parses any of the spellings above, or the kebab-case CLI form (`outer-eye-right`).
+    pub fn parse(s: &str) -> Option<Self> {
+        let t = s.trim();
+        Self::ALL.into_iter().find(|n| {
+            t == n.key()
+                || t == n.ict_key()
+                || t.eq_ignore_ascii_case(n.lm3_label())
+                || t == n.key().replace('_', "-")
+        })
+    }
+}
+
+impl std::fmt::Display for LandmarkName {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.key())
+    }
+}
+
+/// One detected landmark.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Landmark {
+    /// Vertex of the input mesh.
+    pub vertex: u32,
+    /// Its position (input units).
+    pub position: DVec3,
+    /// Confidence in `[0, 1]` (face fit quality times local template agreement).
+    pub confidence: f64,
+}
+
+/// The five detected landmarks and the quality of the face fit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Landmarks {
+    /// Subject's right outer eye corner.
+    pub outer_eye_right: Landmark,
+    /// Subject's left outer eye corner.
+    pub outer_eye_left: Landmark,
+    /// Subject's right inner eye corner.
+    pub inner_eye_right: Landmark,
+    /// Subject's left inner eye corner.
+    pub inner_eye_left: Landmark,
+    /// Nose tip.
+    pub nose_tip: Landmark,
+    /// Overall confidence in `[0, 1]` of the generic face fit.
+    pub confidence: f64,
+    /// RMS distance of the fitted generic face surface (inliers), input units.
+    pub fit_rms: f64,
+    /// Share of the generic face surface that found the input surface.
+    pub inlier_fraction: f64,
+    /// Rigid motion from the model's canonical frame to the input (model units scaled to input
+    /// units only in the translation).
+    pub model_to_mesh: DAffine3,
+}
+
+impl Landmarks {
+    /// The landmark of a given name.
+    pub fn get(&self, name: LandmarkName) -> &Landmark {
+        match name {
+            LandmarkName::OuterEyeRight => &self.outer_eye_right,
+            LandmarkName::InnerEyeRight => &self.inner_eye_right,
+            LandmarkName::InnerEyeLeft => &self.inner_eye_left,
+            LandmarkName::OuterEyeLeft => &self.outer_eye_left,
+            LandmarkName::NoseTip => &self.nose_tip,
+        }
+    }
+
+    /// Positions in [`LandmarkName::ALL`] order.
+    pub fn positions(&self) -> [DVec3; 5] {
+        LandmarkName::ALL.map(|n| self.get(n).position)
+    }
+}
+
+/// Errors of the landmarks crate.
+#[derive(Debug, thiserror::Error)]
+pub enum LandmarkError {
+    /// No face-like configuration was found.
+    #[error("landmarks not found: {reason} (best candidate score {best_score:.3}, needs a face with outward normals in the model's units)")]
+    NotFound {
+        /// What failed.
+        reason: String,
+        /// Confidence of the best candidate configuration in `[0, 1]`.
+        best_score: f64,
+    },
+    /// The generic model is malformed.
+    #[error("invalid generic model: {0}")]
+    InvalidModel(String),
+    /// Training data unusable.
+    #[error("invalid training data: {0}")]
+    InvalidTraining(String),
+    /// Bad option value.
+    #[error("invalid option: {0}")]
+    InvalidOption(String),
+    /// Mesh error.
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+    /// File could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// Landmark file content error.
+    #[error("{path}:{line}: {message}")]
+    Parse {
+        /// The file.
+        path: String,
+        /// 1-based line (0 when not applicable).
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+}

@@ -1,0 +1,436 @@
+//! Per-vertex principal curvatures by local quadric fitting at a chosen scale, shape index,
+//! curvedness and Taubin smoothing (for curvature only).
+//!
+//! Sign convention: curvatures are positive where the surface bends away from its normal, so a
+//! sphere with outward normals has `k1 = k2 = +1/R` and a shape index of `+1` (a cap, like the
+//! nose tip); the same sphere with inward normals (reversed winding) has `-1/R` and `-1` (a cup).
+
+use meshcore::{DVec3, TriMesh};
+
+/// Principal curvatures and directions at one vertex.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Curvature {
+    /// Maximum principal curvature (`k1 >= k2`), in 1 / mesh units.
+    pub k1: f64,
+    /// Minimum principal curvature.
+    pub k2: f64,
+    /// Unit tangent direction of `k1`.
+    pub d1: DVec3,
+    /// Unit tangent direction of `k2`.
+    pub d2: DVec3,
+    /// Unit normal used for the fit (area-weighted vertex normal).
+    pub normal: DVec3,
+}
+
+impl Curvature {
+    /// Mean curvature `(k1 + k2) / 2`.
+    pub fn mean(&self) -> f64 {
+        0.5 * (self.k1 + self.k2)
+    }
+
+    /// Gaussian curvature `k1 k2`.
+    pub fn gaussian(&self) -> f64 {
+        self.k1 * self.k2
+    }
+
+    /// Shape index in `[-1, 1]` (see [`shape_index`]).
+    pub fn shape_index(&self) -> f64 {
+        shape_index(self.k1, self.k2)
+    }
+
+    /// Curvedness (see [`curvedness`]).
+    pub fn curvedness(&self) -> f64 {
+        curvedness(self.k1, self.k2)
+    }
+}
+
+/// Koenderink's shape index `S = (2/pi) atan((k1 + k2) / (k1 - k2))` with `k1 >= k2` (the order
+/// of the arguments does not matter): `+1` cap, `+0.5` ridge, `0` saddle, `-0.5` rut, `-1` cup.
+/// Umbilic points get `+-1` by the sign of the mean curvature, and `0` when both are zero.
+pub fn shape_index(k1: f64, k2: f64) -> f64 {
+    let (a, b) = if k1 >= k2 { (k1, k2) } else { (k2, k1) };
+    let s = a + b;
+    let d = a - b;
+    if d <= 1e-12 * (a.abs() + b.abs()) {
+        return if s > 0.0 {
+            1.0
+        } else if s < 0.0 {
+            -1.0
+        } else {
+            0.0
+        };
+    }
+    std::f64::consts::FRAC_2_PI * (s / d).atan()
+}
+
+/// Curvedness `sqrt((k1^2 + k2^2) / 2)`.
+pub fn curvedness(k1: f64, k2: f64) -> f64 {
+    (0.5 * (k1 * k1 + k2 * k2)).sqrt()
+}
+
+/// Options of [`vertex_curvatures`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CurvatureOptions {
+    /// Fitting radius (Euclidean, over the vertices reachable through edges within the ball), in
+    /// mesh units.
+    pub radius: f64,
+    /// Minimum number of neighbours of a fit; the neighbourhood grows by edge rings beyond the
+    /// radius until it has that many (at least 5).
+    pub min_neighbours: usize,
+}
+
+impl CurvatureOptions {
+    /// Fitting at `radius` with at least 12 neighbours.
+    pub fn with_radius(radius: f64) -> Self {
+        Self {
+            radius,
+            min_neighbours: 12,
+        }
+    }
+}
+
+/// Vertex adjacency in CSR form (neighbours sorted, unique).
+#[derive(Debug, Clone)]
+pub struct VertexAdjacency {
+    offsets: Vec<u32>,
+    neighbours: Vec<u32>,
+}
+
+impl VertexAdjacency {
+    /// Builds the adjacency of the triangle edges of `mesh`.
+    pub fn new(mesh: &TriMesh) -> Self {
+        let n = mesh.n_vertices();
+        let mut lists: Vec<Vec<u32>> = vec![Vec::new(); n];
+        for t in mesh.triangles() {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                if a != b {
+                    lists[a as usize].push(b);
+                    lists[b as usize].push(a);
+                }
+            }
+        }
+        let mut offsets = Vec::with_capacity(n + 1);
+        let mut neighbours = Vec::new();
+        offsets.push(0);
+        for mut l in lists {
+            l.sort_unstable();
+            l.dedup();
+            neighbours.extend_from_slice(&l);
+            offsets.push(neighbours.len() as u32);
+        }
+        Self {
+            offsets,
+            neighbours,
+        }
+    }
+
+    /// Neighbours of vertex `v`.
+    pub fn neighbours(&self, v: u32) -> &[u32] {
+        let a = self.offsets[v as usize] as usize;
+        let b = self.offsets[v as usize + 1] as usize;
+        &self.neighbours[a..b]
+    }
+
+    /// Number of vertices.
+    pub fn n_vertices(&self) -> usize {
+        self.offsets.len() - 1
+    }
+}
+
+/// Reusable breadth-first collector of the vertices within a Euclidean ball reachable through
+/// edges inside the ball.
+#[derive(Debug, Clone)]
+pub(crate) struct BallCollector {
+    stamp: Vec<u32>,
+    generation: u32,
+    queue: Vec<u32>,
+}
+
+impl BallCollector {
+    pub(crate) fn new(n: usize) -> Self {
+        Self {
+            stamp: vec![0; n],
+            generation: 0,
+            queue: Vec::new(),
+        }
+    }
+
+    /// Vertices (including `v`) connected to `v` through vertices within `radius` of `center`;
+    /// if fewer than `min_count`, whole edge rings are added until there are enough (or the
+    /// component is exhausted).
+    pub(crate) fn collect(
+        &mut self,
+        adj: &VertexAdjacency,
+        pos: &[DVec3],
+        v: u32,
+        center: DVec3,
+        radius: f64,
+        min_count: usize,
+        out: &mut Vec<u32>,
+    ) {
+        out.clear();
+        self.generation = self.generation.wrapping_add(1);
+        if self.generation == 0 {
+            self.stamp.iter_mut().for_each(|s| *s = 0);
+            self.generation = 1;
+        }
+        let g = self.generation;
+        let r2 = radius * radius;
+        self.queue.clear();
+        self.queue.push(v);
+        self.stamp[v as usize] = g;
+        let mut head = 0;
+        // Vertices reached but outside the ball, kept for ring growth.
+        let mut outside: Vec<u32> = Vec::new();
+        while head < self.queue.len() {
+            let u = self.queue[head];
+            head += 1;
+            out.push(u);
+            for &w in adj.neighbours(u) {
+                if self.stamp[w as usize] == g {
+                    continue;
+                }
+                self.stamp[w as usize] = g;
+                if (pos[w as usize] - center).length_squared() <= r2 {
+                    self.queue.push(w);
+                } else {
+                    outside.push(w);
+                }
+            }
+        }
+        // Ring growth when the ball is too small for a stable fit.
+        while out.len() < min_count && !outside.is_empty() {
+            let ring = std::mem::take(&mut outside);
+            for &u in &ring {
+                out.push(u);
+            }
+            for &u in &ring {
+                for &w in adj.neighbours(u) {
+                    if self.stamp[w as usize] != g {
+                        self.stamp[w as usize] = g;
+                        outside.push(w);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A right-handed orthonormal tangent basis `(u, w)` of the plane orthogonal to unit `n`.
+pub(crate) fn tangent_basis(n: DVec3) -> (DVec3, DVec3) {
+    let a = if n.x.abs() < 0.6 {
+        DVec3::X
+    } else if n.y.abs() < 0.6 {
+        DVec3::Y
+    } else {
+        DVec3::Z
+    };
+    let u = (a - n * n.dot(a)).normalize();
+    let w = n.cross(u);
+    (u, w)
+}
+
+/// Solves the symmetric positive (semi-)definite system `a x = b` by Gaussian elimination with
+/// partial pivoting; `None` when singular.
+pub(crate) fn solve_dense<const N: usize>(
+    mut a: [[f64; N]; N],
+    mut b: [f64; N],
+) -> Option<[f64; N]> {
+    let scale = (0..N)
+        .map(|i| a[i][i].abs())
+        .fold(0.0, f64::max)
+        .max(1e-300);
+    for col in 0..N {
+        let piv = (col..N).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
+        if a[piv][col].abs() <= 1e-13 * scale {
+            return None;
+        }
+        a.swap(col, piv);
+        b.swap(col, piv);
+        for r in col + 1..N {
+            let f = a[r][col] / a[col][col];
+            if f != 0.0 {
+                for c in col..N {
+                    a[r][c] -= f * a[col][c];
+                }
+                b[r] -= f * b[col];
+            }
+        }
+    }
+    let mut x = [0.0; N];
+    for r in (0..N).rev() {
+        let mut s = b[r];
+        for c in r + 1..N {
+            s -= a[r][c] * x[c];
+        }
+        x[r] = s / a[r][r];
+    }
+    Some(x)
+}
+
+/// Principal curvatures of every vertex by weighted least-squares fitting of
+/// `h = a x^2 + b xy + c y^2 + d x + e y + f` in the local frame of the vertex normal, over the
+/// vertices within `options.radius` (reached through edges). Weights `(1 - r^2/R^2)^2`.
+///
+/// Vertices whose neighbourhood cannot support a fit (isolated vertices, fewer than 5
+/// neighbours, degenerate layouts) get zero curvatures with arbitrary orthonormal directions.
+pub fn vertex_curvatures(mesh: &TriMesh, options: &CurvatureOptions) -> Vec<Curvature> {
+    let normals = mesh.vertex_normals();
+    let adj = VertexAdjacency::new(mesh);
+    vertex_curvatures_with(mesh, &normals, &adj, options)
+}
+
+/// [`vertex_curvatures`] with precomputed unit normals and adjacency.
+pub fn vertex_curvatures_with(
+    mesh: &TriMesh,
+    normals: &[DVec3],
+    adj: &VertexAdjacency,
+    options: &CurvatureOptions,
+) -> Vec<Curvature> {
+    let pos = mesh.positions();
+    let n = pos.len();
+    let mut ball = BallCollector::new(n);
+    let mut nb = Vec::new();
+    let radius = options.radius.max(0.0);
+    let min_count = options.min_neighbours.max(5) + 1;
+    (0..n as u32)
+        .map(|v| {
+            let p = pos[v as usize];
+            let nrm = normals[v as usize];
+            if nrm == DVec3::ZERO {
+                return flat(DVec3::Z);
+            }
+            ball.collect(adj, pos, v, p, radius, min_count, &mut nb);
+            fit_vertex(pos, p, nrm, &nb, radius).unwrap_or_else(|| flat(nrm))
+        })
+        .collect()
+}
+
+fn flat(n: DVec3) -> Curvature {
+    let (u, w) = tangent_basis(n);
+    Curvature {
+        k1: 0.0,
+        k2: 0.0,
+        d1: u,
+        d2: w,
+        normal: n,
+    }
+}
+
+/// Quadric fit at one vertex; heights measured along `-n` so that convex (outward-normal) caps
+/// have positive curvature.
+fn fit_vertex(pos: &[DVec3], p: DVec3, n: DVec3, nb: &[u32], radius: f64) -> Option<Curvature> {
+    if nb.len() < 6 {
+        return None;
+    }
+    let (u, w) = tangent_basis(n);
+    // Effective radius: at least the farthest neighbour (ring growth may exceed `radius`).
+    let mut r2max: f64 = radius * radius;
+    for &q in nb {
+        let d = pos[q as usize] - p;
+        r2max = r2max.max((d - n * d.dot(n)).length_squared());
+    }
+    let r2max = r2max * 1.0001 + 1e-300;
+    let mut ata = [[0.0; 6]; 6];
+    let mut atb = [0.0; 6];
+    let scale = r2max.sqrt();
+    for &q in nb {
+        let d = pos[q as usize] - p;
+        // Normalised coordinates for conditioning.
+        let x = d.dot(u) / scale;
+        let y = d.dot(w) / scale;
+        let h = -d.dot(n) / scale;
+        let r2 = x * x + y * y;
+        let wt = (1.0 - r2 * scale * scale / r2max).max(0.0).powi(2) + 1e-3;
+        let row = [x * x, x * y, y * y, x, y, 1.0];
+        for i in 0..6 {
+            for j in 0..6 {
+                ata[i][j] += wt * row[i] * row[j];
+            }
+            atb[i] += wt * row[i] * h;
+        }
+    }
+    let c = solve_dense(ata, atb)?;
+    // Back to mesh units: h = s * H(x/s, y/s): second derivatives divide by s, first unchanged.
+    let fxx = 2.0 * c[0] / scale;
+    let fxy = c[1] / scale;
+    let fyy = 2.0 * c[2] / scale;
+    let fx = c[3];
+    let fy = c[4];
+    let g = 1.0 + fx * fx + fy * fy;
+    let sg = g.sqrt();
+    // First and second fundamental forms of the graph (x, y, h(x, y)).
+    let (e1, f1, g1) = (1.0 + fx * fx, fx * fy, 1.0 + fy * fy);
+    let (l2, m2, n2) = (fxx / sg, fxy / sg, fyy / sg);
+    // Shape operator W = I^{-1} II.
+    let det = e1 * g1 - f1 * f1;
+    let w11 = (g1 * l2 - f1 * m2) / det;
+    let w12 = (g1 * m2 - f1 * n2) / det;
+    let w21 = (e1 * m2 - f1 * l2) / det;
+    let w22 = (e1 * n2 - f1 * m2) / det;
+    let tr = w11 + w22;
+    let dt = w11 * w22 - w12 * w21;
+    let disc = (0.25 * tr * tr - dt).max(0.0).sqrt();
+    let k1 = 0.5 * tr + disc;
+    let k2 = 0.5 * tr - disc;
+    // Eigenvector of W for k1 in parameter space.
+    let ev = |k: f64| -> (f64, f64) {
+        let a = (w12, k - w11);
+        let b = (k - w22, w21);
+        if a.0 * a.0 + a.1 * a.1 >= b.0 * b.0 + b.1 * b.1 {
+            a
+        } else {
+            b
+        }
+    };
+    let (a, b) = ev(k1);
+    // Tangent of the graph: X_x = u - fx n, X_y = w - fy n (heights along -n).
+    let t1 = (u - n * fx) * a + (w - n * fy) * b;
+    let nn = n;
+    let d1 = if t1.length_squared() > 1e-24 && disc > 1e-12 * (k1.abs() + k2.abs() + 1e-300) {
+        (t1 - nn * t1.dot(nn)).normalize_or_zero()
+    } else {
+        DVec3::ZERO
+    };
+    let d1 = if d1 == DVec3::ZERO { u } else { d1 };
+    let d2 = nn.cross(d1);
+    Some(Curvature {
+        k1,
+        k2,
+        d1,
+        d2,
+        normal: nn,
+    })
+}
+
+/// Taubin lambda/mu smoothing (umbrella operator with uniform weights), returning a smoothed
+/// copy; meant for curvature estimation only, the descriptor uses the original positions.
+/// Typical values: `lambda = 0.5`, `mu = -0.53`, 5-10 iterations. Boundary vertices are moved
+/// too (along their one-sided umbrella), which shrinks open borders slightly.
+pub fn taubin_smooth(mesh: &TriMesh, iterations: usize, lambda: f64, mu: f64) -> TriMesh {
+    let adj = VertexAdjacency::new(mesh);
+    let mut pos = mesh.positions().to_vec();
+    let mut next = pos.clone();
+    for _ in 0..iterations {
+        for factor in [lambda, mu] {
+            for v in 0..pos.len() {
+                let nb = adj.neighbours(v as u32);
+                if nb.is_empty() {
+                    next[v] = pos[v];
+                    continue;
+                }
+                let mut c = DVec3::ZERO;
+                for &q in nb {
+                    c += pos[q as usize];
+                }
+                c /= nb.len() as f64;
+                next[v] = pos[v] + factor * (c - pos[v]);
+            }
+            std::mem::swap(&mut pos, &mut next);
+        }
+    }
+    // Positions stay finite (convex combinations with bounded factors), so this cannot fail; keep
+    // the original mesh if it ever did.
+    TriMesh::new(pos, mesh.triangles().to_vec()).unwrap_or_else(|_| mesh.clone())
+}

@@ -1,0 +1,388 @@
+//! Landmark detection: curvature candidates, pose hypotheses from (nose tip, inner eye corner)
+//! configurations, verification and refinement of the pose by fitting the generic face surface,
+//! then local template search around each predicted landmark.
+
+use crate::curvature::{vertex_curvatures_with, CurvatureOptions, VertexAdjacency};
+use crate::geom::{icp, kabsch, score, FitScore, Rigid, SurfaceIndex};
+use crate::model::GenericModel;
+use crate::{Landmark, LandmarkError, LandmarkName, Landmarks};
+use meshcore::{DAffine3, DMat3, DVec3, TriMesh};
+
+/// Options of [`detect_with`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DetectOptions {
+    /// Mesh units per model unit (e.g. `10.0` for a scan in mm with the default model in cm).
+    pub mesh_units_per_model_unit: f64,
+    /// Overall confidence below which detection fails with [`LandmarkError::NotFound`].
+    pub min_confidence: f64,
+    /// Maximum number of nose-tip candidates.
+    pub max_nose_candidates: usize,
+    /// Maximum number of eye-corner candidates.
+    pub max_eye_candidates: usize,
+}
+
+impl Default for DetectOptions {
+    fn default() -> Self {
+        Self {
+            mesh_units_per_model_unit: 1.0,
+            min_confidence: 0.3,
+            max_nose_candidates: 6,
+            max_eye_candidates: 10,
+        }
+    }
+}
+
+/// Vertex normals, per-vertex reach and the k-d tree of a mesh.
+pub(crate) fn surface_index(mesh: &TriMesh) -> SurfaceIndex {
+    let pos = mesh.positions().to_vec();
+    let nrm = mesh.vertex_normals();
+    let mut sum = vec![0.0; pos.len()];
+    let mut cnt = vec![0u32; pos.len()];
+    for t in mesh.triangles() {
+        for k in 0..3 {
+            let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+            let l = (pos[a] - pos[b]).length();
+            sum[a] += l;
+            sum[b] += l;
+            cnt[a] += 1;
+            cnt[b] += 1;
+        }
+    }
+    let reach = sum
+        .iter()
+        .zip(&cnt)
+        .map(|(s, &c)| if c > 0 { 0.5 * s / c as f64 } else { 0.0 })
+        .collect();
+    SurfaceIndex::new(pos, nrm, reach)
+}
+
+/// Greedy non-maximum suppression: vertices sorted by decreasing score (ties by index), kept
+/// when no kept vertex lies within `radius`.
+fn nms(idx: &SurfaceIndex, mut cand: Vec<(f64, u32)>, radius: f64, max: usize) -> Vec<u32> {
+    cand.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    let mut kept: Vec<u32> = Vec::new();
+    for (_, v) in cand {
+        let p = idx.pos[v as usize];
+        if kept
+            .iter()
+            .all(|&k| (idx.pos[k as usize] - p).length() > radius)
+        {
+            kept.push(v);
+            if kept.len() >= max {
+                break;
+            }
+        }
+    }
+    kept
+}
+
+/// A pose hypothesis (model -> mesh) with its fit.
+#[derive(Debug, Clone, Copy)]
+struct Hypothesis {
+    t: Rigid,
+    fit: FitScore,
+}
+
+/// Detects the five landmarks with the default options (mesh in the model's units).
+pub fn detect(mesh: &TriMesh, model: &GenericModel) -> Result<Landmarks, LandmarkError> {
+    detect_with(mesh, model, &DetectOptions::default())
+}
+
+/// Detects the five landmarks.
+///
+/// Invariant to rigid motions of the input. Fails with [`LandmarkError::NotFound`] (naming the
+/// best score) when no configuration of candidates fits the generic face well enough: meshes
+/// that are not faces, faces with inverted normals (seen from behind), or faces in other units
+/// than `options.mesh_units_per_model_unit` says.
+pub fn detect_with(
+    mesh: &TriMesh,
+    model: &GenericModel,
+    options: &DetectOptions,
+) -> Result<Landmarks, LandmarkError> {
+    model.validate()?;
+    let s = options.mesh_units_per_model_unit;
+    if !(s.is_finite() && s > 0.0) {
+        return Err(LandmarkError::InvalidOption(format!(
+            "mesh_units_per_model_unit must be positive and finite, got {s}"
+        )));
+    }
+    // Work in model units.
+    let work;
+    let mesh_m = if s == 1.0 {
+        mesh
+    } else {
+        work = TriMesh::new(
+            mesh.positions().iter().map(|p| *p / s).collect(),
+            mesh.triangles().to_vec(),
+        )?;
+        &work
+    };
+    let p = &model.params;
+    let debug = std::env::var_os("LANDMARKS_DEBUG").is_some();
+    let clock = std::time::Instant::now();
+    let idx = surface_index(mesh_m);
+    let adj = VertexAdjacency::new(mesh_m);
+    let curv = vertex_curvatures_with(
+        mesh_m,
+        &idx.nrm,
+        &adj,
+        &CurvatureOptions::with_radius(p.curvature_radius),
+    );
+    // Candidates.
+    let mut nose_c = Vec::new();
+    let mut eye_c = Vec::new();
+    for (v, c) in curv.iter().enumerate() {
+        let (si, cv) = (c.shape_index(), c.curvedness());
+        if si >= p.nose_min_shape_index && cv >= p.nose_min_curvedness {
+            nose_c.push((cv * (1.0 + si), v as u32));
+        }
+        if si <= p.eye_max_shape_index && cv >= p.eye_min_curvedness {
+            eye_c.push((cv * (1.0 - si), v as u32));
+        }
+    }
+    let noses = nms(
+        &idx,
+        nose_c,
+        p.candidate_radius,
+        options.max_nose_candidates,
+    );
+    let eyes = nms(&idx, eye_c, p.candidate_radius, options.max_eye_candidates);
+    if debug {
+        eprintln!(
+            "[{:.1} ms] candidates: noses {noses:?} eyes {eyes:?}",
+            clock.elapsed().as_secs_f64() * 1e3
+        );
+    }
+    if noses.is_empty() {
+        return Err(LandmarkError::NotFound {
+            reason: "no convex cap (nose-tip candidate) on the surface".into(),
+            best_score: 0.0,
+        });
+    }
+    // Pose hypotheses.
+    use LandmarkName as L;
+    let d = model.eye_distance();
+    let m_nose = model.landmark(L::NoseTip);
+    let m_nn = DVec3::from_array(model.nose_normal);
+    let m_ir = model.landmark(L::InnerEyeRight);
+    let m_il = model.landmark(L::InnerEyeLeft);
+    let d_nr = (m_ir - m_nose).length();
+    let d_nl = (m_il - m_nose).length();
+    let mut hyps: Vec<Rigid> = Vec::new();
+    for &n in &noses {
+        let pn = idx.pos[n as usize];
+        let nn = curv[n as usize].normal;
+        let src_base = [m_nose, m_nose + m_nn * d];
+        let dst_base = [pn, pn + nn * d];
+        for (i, &ei) in eyes.iter().enumerate() {
+            let pi = idx.pos[ei as usize];
+            let di = (pi - pn).length();
+            // Pairs: nose, its normal and one inner corner (either side).
+            for (m_e, dm) in [(m_ir, d_nr), (m_il, d_nl)] {
+                if (di - dm).abs() > 0.35 * dm {
+                    continue;
+                }
+                let src = [src_base[0], src_base[1], m_e];
+                let dst = [dst_base[0], dst_base[1], pi];
+                if let Some(t) = kabsch(&src, &dst, Some(&[1.0, 0.5, 1.0])) {
+                    hyps.push(t);
+                }
+            }
+            // Triplets: both inner corners.
+            for &ej in &eyes[i + 1..] {
+                let pj = idx.pos[ej as usize];
+                let dj = (pj - pn).length();
+                let dij = (pj - pi).length();
+                if (dij - d).abs() > 0.35 * d {
+                    continue;
+                }
+                for (a, b, da, db) in [(pi, pj, di, dj), (pj, pi, dj, di)] {
+                    if (da - d_nr).abs() > 0.35 * d_nr || (db - d_nl).abs() > 0.35 * d_nl {
+                        continue;
+                    }
+                    let src = [src_base[0], src_base[1], m_ir, m_il];
+                    let dst = [dst_base[0], dst_base[1], a, b];
+                    if let Some(t) = kabsch(&src, &dst, Some(&[1.0, 0.5, 1.0, 1.0])) {
+                        hyps.push(t);
+                    }
+                }
+            }
+        }
+        // Without eye candidates: rotations about the nose normal.
+        if eyes.len() < 2 {
+            let base = kabsch(&src_base, &dst_base, None);
+            if let Some(b) = base {
+                for k in 0..12 {
+                    let ang = k as f64 * std::f64::consts::TAU / 12.0;
+                    let r = DMat3::from_axis_angle(nn, ang);
+                    let spin = Rigid { r, t: pn - r * pn };
+                    hyps.push(spin.compose(&b));
+                }
+            }
+        }
+    }
+    let face = model.face.pairs();
+    let tau = p.inlier_distance;
+    let coarse: Vec<(DVec3, DVec3)> = face.iter().step_by(4).copied().collect();
+    let mut scored: Vec<Hypothesis> = hyps
+        .iter()
+        .map(|t| Hypothesis {
+            t: *t,
+            fit: score(&idx, &coarse, t, 3.0 * tau, 0.3),
+        })
+        .collect();
+    scored.sort_by(|a, b| a.fit.cost.total_cmp(&b.fit.cost));
+    if debug {
+        eprintln!(
+            "[{:.1} ms] {} hypotheses, best coarse costs {:?}",
+            clock.elapsed().as_secs_f64() * 1e3,
+            scored.len(),
+            scored
+                .iter()
+                .take(6)
+                .map(|h| h.fit.cost)
+                .collect::<Vec<_>>()
+        );
+    }
+    scored.truncate(6);
+    let mut best: Option<Hypothesis> = None;
+    for h in &scored {
+        // Coarse to fine: wide inlier band first, then the nominal one.
+        let t1 = icp(&idx, &coarse, &h.t, 10, 3.0 * tau, 0.3);
+        let t2 = icp(&idx, &face, &t1, 15, tau, 0.5);
+        let fit = score(&idx, &face, &t2, tau, 0.5);
+        if best.as_ref().is_none_or(|b| fit.cost < b.fit.cost) {
+            best = Some(Hypothesis { t: t2, fit });
+        }
+    }
+    let Some(best) = best else {
+        return Err(LandmarkError::NotFound {
+            reason: format!(
+                "{} nose-tip and {} eye-corner candidates form no face-like configuration",
+                noses.len(),
+                eyes.len()
+            ),
+            best_score: 0.0,
+        });
+    };
+    if debug {
+        eprintln!(
+            "[{:.1} ms] best fit {:?}",
+            clock.elapsed().as_secs_f64() * 1e3,
+            best.fit
+        );
+    }
+    let conf_fit = fit_confidence(&best.fit, p.typical_rms, p.typical_inliers);
+    if conf_fit < options.min_confidence {
+        return Err(LandmarkError::NotFound {
+            reason: format!(
+                "the best fit of the generic face covers {:.0} % of it (rms {:.3} model units)",
+                100.0 * best.fit.inlier_fraction,
+                best.fit.rms
+            ),
+            best_score: conf_fit,
+        });
+    }
+    // Local refinement of each landmark.
+    let mut out = [Landmark {
+        vertex: 0,
+        position: DVec3::ZERO,
+        confidence: 0.0,
+    }; 5];
+    for name in L::ALL {
+        let pred = best.t.apply(model.landmark(name));
+        let tpl = model.patches[name as usize].pairs();
+        let (v, cost) = refine(&idx, &tpl, &best.t, pred, p.search_radius, tau);
+        if debug {
+            eprintln!(
+                "{name}: predicted at {:?} (vertex {}), refined to vertex {v} (cost {cost:.2e})",
+                pred,
+                idx.query(pred).vertex
+            );
+        }
+        let c_local = (-(cost / (p.typical_rms * p.typical_rms)) * 0.1).exp();
+        out[name as usize] = Landmark {
+            vertex: v,
+            position: mesh.position(v),
+            confidence: (conf_fit * c_local).clamp(0.0, 1.0),
+        };
+    }
+    let pose = DAffine3::from_mat3_translation(best.t.r, best.t.t * s);
+    Ok(Landmarks {
+        outer_eye_right: out[L::OuterEyeRight as usize],
+        inner_eye_right: out[L::InnerEyeRight as usize],
+        inner_eye_left: out[L::InnerEyeLeft as usize],
+        outer_eye_left: out[L::OuterEyeLeft as usize],
+        nose_tip: out[L::NoseTip as usize],
+        confidence: conf_fit,
+        fit_rms: best.fit.rms * s,
+        inlier_fraction: best.fit.inlier_fraction,
+        model_to_mesh: pose,
+    })
+}
+
+/// Confidence in `[0, 1]` of a face fit from its inlier share and inlier RMS, relative to the
+/// typical values on training faces.
+fn fit_confidence(f: &FitScore, typical_rms: f64, typical_inliers: f64) -> f64 {
+    if !f.rms.is_finite() {
+        return 0.0;
+    }
+    let a = (f.inlier_fraction / typical_inliers.max(1e-6)).min(1.0);
+    let r = f.rms / typical_rms;
+    let b = if r <= 1.5 {
+        1.0
+    } else {
+        (-(r - 1.5).powi(2) / 2.0).exp()
+    };
+    (a * a * b).clamp(0.0, 1.0)
+}
+
+/// Template search around `pred`: the vertex minimising the truncated mean squared distance of
+/// the template (rotated by the face pose) placed at the vertex, plus a weak prior on the
+/// distance to the prediction. Returns the vertex and its cost.
+fn refine(
+    idx: &SurfaceIndex,
+    tpl: &[(DVec3, DVec3)],
+    pose: &Rigid,
+    pred: DVec3,
+    radius: f64,
+    tau: f64,
+) -> (u32, f64) {
+    let tau2 = tau * tau;
+    let rotated: Vec<DVec3> = tpl.iter().map(|(q, _)| pose.rotate(*q)).collect();
+    let eval = |c: DVec3, pts: &mut dyn Iterator<Item = &DVec3>| -> f64 {
+        let mut s = 0.0;
+        let mut n = 0usize;
+        for q in pts {
+            let h = idx.query(c + *q);
+            s += h.d2.min(tau2);
+            n += 1;
+        }
+        s / n.max(1) as f64
+    };
+    let prior = |c: DVec3| 0.02 * tau2 * (c - pred).length_squared() / (radius * radius);
+    let mut cands = idx.within(pred, radius);
+    let pv = idx.query(pred).vertex;
+    if !cands.contains(&pv) {
+        cands.push(pv);
+    }
+    // Coarse pass on a subsample, then the full template on the best few.
+    let mut coarse: Vec<(f64, u32)> = cands
+        .iter()
+        .map(|&v| {
+            let c = idx.pos[v as usize];
+            (eval(c, &mut rotated.iter().step_by(5)) + prior(c), v)
+        })
+        .collect();
+    coarse.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    coarse.truncate(8);
+    let mut best = (f64::INFINITY, pv);
+    for &(_, v) in &coarse {
+        let c = idx.pos[v as usize];
+        let cost = eval(c, &mut rotated.iter()) + prior(c);
+        if cost < best.0 || (cost == best.0 && v < best.1) {
+            best = (cost, v);
+        }
+    }
+    (best.1, best.0)
+}

@@ -1,0 +1,196 @@
+//! Curvature against analytic values on spheres, cylinders and saddles.
+
+use landmarks::curvature::{taubin_smooth, vertex_curvatures, CurvatureOptions};
+use landmarks::{curvedness, shape_index};
+use meshcore::{DVec3, TriMesh};
+
+/// UV sphere of radius `r` with outward-facing triangles.
+fn sphere(r: f64, n_lat: usize, n_lon: usize) -> TriMesh {
+    let mut p = vec![DVec3::new(0.0, 0.0, r)];
+    for i in 1..n_lat {
+        let th = std::f64::consts::PI * i as f64 / n_lat as f64;
+        for j in 0..n_lon {
+            let ph = std::f64::consts::TAU * j as f64 / n_lon as f64;
+            p.push(r * DVec3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()));
+        }
+    }
+    p.push(DVec3::new(0.0, 0.0, -r));
+    let s = p.len() as u32 - 1;
+    let idx = |i: usize, j: usize| (1 + (i - 1) * n_lon + j % n_lon) as u32;
+    let mut t = Vec::new();
+    for j in 0..n_lon {
+        t.push([0, idx(1, j), idx(1, j + 1)]);
+        t.push([s, idx(n_lat - 1, j + 1), idx(n_lat - 1, j)]);
+    }
+    for i in 1..n_lat - 1 {
+        for j in 0..n_lon {
+            t.push([idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)]);
+            t.push([idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)]);
+        }
+    }
+    TriMesh::new(p, t).unwrap()
+}
+
+/// Open cylinder of radius `r` around z, outward normals.
+fn cylinder(r: f64, len: f64, n_a: usize, n_z: usize) -> TriMesh {
+    let mut p = Vec::new();
+    for i in 0..=n_z {
+        let z = len * (i as f64 / n_z as f64 - 0.5);
+        for j in 0..n_a {
+            let a = std::f64::consts::TAU * j as f64 / n_a as f64;
+            p.push(DVec3::new(r * a.cos(), r * a.sin(), z));
+        }
+    }
+    let idx = |i: usize, j: usize| (i * n_a + j % n_a) as u32;
+    let mut t = Vec::new();
+    for i in 0..n_z {
+        for j in 0..n_a {
+            t.push([idx(i, j), idx(i, j + 1), idx(i + 1, j + 1)]);
+            t.push([idx(i, j), idx(i + 1, j + 1), idx(i + 1, j)]);
+        }
+    }
+    TriMesh::new(p, t).unwrap()
+}
+
+/// Height field `z = f(x, y)` on a jittered-free grid over `[-1, 1]^2`, normals up.
+fn height_field(n: usize, f: impl Fn(f64, f64) -> f64) -> TriMesh {
+    let mut p = Vec::new();
+    for i in 0..=n {
+        for j in 0..=n {
+            let x = -1.0 + 2.0 * j as f64 / n as f64;
+            let y = -1.0 + 2.0 * i as f64 / n as f64;
+            p.push(DVec3::new(x, y, f(x, y)));
+        }
+    }
+    let idx = |i: usize, j: usize| (i * (n + 1) + j) as u32;
+    let mut t = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            t.push([idx(i, j), idx(i, j + 1), idx(i + 1, j + 1)]);
+            t.push([idx(i, j), idx(i + 1, j + 1), idx(i + 1, j)]);
+        }
+    }
+    TriMesh::new(p, t).unwrap()
+}
+
+fn flipped(m: &TriMesh) -> TriMesh {
+    TriMesh::new(
+        m.positions().to_vec(),
+        m.triangles().iter().map(|t| [t[0], t[2], t[1]]).collect(),
+    )
+    .unwrap()
+}
+
+#[test]
+fn sphere_has_positive_umbilic_curvature_and_cap_shape_index() {
+    for r in [0.5, 2.0, 30.0] {
+        let m = sphere(r, 40, 80);
+        let c = vertex_curvatures(&m, &CurvatureOptions::with_radius(0.25 * r));
+        let mut worst: f64 = 0.0;
+        for (v, k) in c.iter().enumerate() {
+            // Skip the poles (fan vertices with skewed neighbourhoods are still fine, but keep
+            // the test about the regular part).
+            if v == 0 || v == c.len() - 1 {
+                continue;
+            }
+            worst = worst
+                .max((k.k1 * r - 1.0).abs())
+                .max((k.k2 * r - 1.0).abs());
+            assert!(k.shape_index() > 0.95, "S = {}", k.shape_index());
+            assert!((k.curvedness() * r - 1.0).abs() < 0.02);
+        }
+        assert!(worst < 0.02, "radius {r}: worst relative error {worst}");
+        // Reversed orientation (normals inwards): a cup.
+        let c = vertex_curvatures(&flipped(&m), &CurvatureOptions::with_radius(0.25 * r));
+        for k in &c[1..c.len() - 1] {
+            assert!((k.k1 * r + 1.0).abs() < 0.02 && (k.k2 * r + 1.0).abs() < 0.02);
+            assert!(k.shape_index() < -0.95);
+        }
+    }
+}
+
+#[test]
+fn cylinder_principal_values_and_directions() {
+    let r = 1.5;
+    let m = cylinder(r, 6.0, 96, 60);
+    let c = vertex_curvatures(&m, &CurvatureOptions::with_radius(0.4));
+    let mut checked = 0;
+    for (v, k) in c.iter().enumerate() {
+        let p = m.position(v as u32);
+        if p.z.abs() > 2.0 {
+            continue; // Away from the open ends.
+        }
+        assert!((k.k1 * r - 1.0).abs() < 0.02, "k1 = {}", k.k1);
+        assert!(k.k2.abs() < 0.02, "k2 = {}", k.k2);
+        // d1 is circumferential, d2 axial.
+        assert!(k.d1.z.abs() < 0.02, "d1 = {}", k.d1);
+        assert!(k.d2.z.abs() > 0.999, "d2 = {}", k.d2);
+        assert!((k.shape_index() - 0.5).abs() < 0.02);
+        checked += 1;
+    }
+    assert!(checked > 1000);
+}
+
+#[test]
+fn saddle_and_bowl_at_center() {
+    // z = (x^2 - y^2)/2 with upward normals: curvatures -1 along x (surface bends towards the
+    // normal) and +1 along y at the origin; shape index 0.
+    let m = height_field(60, |x, y| 0.5 * (x * x - y * y));
+    let c = vertex_curvatures(&m, &CurvatureOptions::with_radius(0.12));
+    let center = 30 * 61 + 30;
+    let k = c[center];
+    assert!(
+        (k.k1 - 1.0).abs() < 0.03 && (k.k2 + 1.0).abs() < 0.03,
+        "{k:?}"
+    );
+    assert!(k.shape_index().abs() < 0.02);
+    assert!(k.d1.y.abs() > 0.99, "d1 along y: {}", k.d1);
+    // Bowl z = (x^2 + y^2)/2 seen from above (normals up): a cup, S = -1, like an eye corner.
+    let m = height_field(60, |x, y| 0.5 * (x * x + y * y));
+    let c = vertex_curvatures(&m, &CurvatureOptions::with_radius(0.12));
+    let k = c[center];
+    assert!(
+        (k.k1 + 1.0).abs() < 0.03 && (k.k2 + 1.0).abs() < 0.03,
+        "{k:?}"
+    );
+    assert!(k.shape_index() < -0.97);
+}
+
+#[test]
+fn noisy_sphere_is_robust_at_a_larger_scale_and_with_smoothing() {
+    use rand::{Rng, SeedableRng};
+    let r = 5.0;
+    let m = sphere(r, 50, 100);
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+    let h = m.mean_edge_length();
+    let noisy = TriMesh::new(
+        m.positions()
+            .iter()
+            .map(|p| *p * (1.0 + 0.05 * h / r * (rng.random::<f64>() - 0.5) * 2.0))
+            .collect(),
+        m.triangles().to_vec(),
+    )
+    .unwrap();
+    let smooth = taubin_smooth(&noisy, 5, 0.5, -0.53);
+    for mesh in [&noisy, &smooth] {
+        let c = vertex_curvatures(mesh, &CurvatureOptions::with_radius(0.3 * r));
+        let mean_err: f64 = c[1..c.len() - 1]
+            .iter()
+            .map(|k| (k.mean() * r - 1.0).abs())
+            .sum::<f64>()
+            / (c.len() - 2) as f64;
+        assert!(mean_err < 0.03, "mean relative error {mean_err}");
+    }
+}
+
+#[test]
+fn shape_index_convention() {
+    assert_eq!(shape_index(1.0, 1.0), 1.0);
+    assert_eq!(shape_index(-1.0, -1.0), -1.0);
+    assert_eq!(shape_index(0.0, 0.0), 0.0);
+    assert!((shape_index(1.0, 0.0) - 0.5).abs() < 1e-12);
+    assert!((shape_index(0.0, -1.0) + 0.5).abs() < 1e-12);
+    assert!(shape_index(1.0, -1.0).abs() < 1e-12);
+    assert_eq!(shape_index(0.3, 0.7), shape_index(0.7, 0.3));
+    assert!((curvedness(3.0, 4.0) - (12.5f64).sqrt()).abs() < 1e-12);
+}

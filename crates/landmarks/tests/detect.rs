@@ -1,0 +1,235 @@
+//! Detection: rigid-motion invariance, a small evaluation on the shared paper set (skipped when
+//! the data is absent), and clear failures on non-faces and faces seen from behind.
+
+use landmarks::{detect, io, GenericModel, LandmarkError, LandmarkName};
+use meshcore::{DAffine3, DQuat, DVec3, TriMesh};
+use std::path::PathBuf;
+
+fn shared() -> PathBuf {
+    std::env::var_os("BIPOLAR_SHARED")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"))
+}
+
+fn paper_set() -> Option<PathBuf> {
+    let d = shared().join("faces/ict-facekit/paper-set");
+    if d.join("landmarks.json").is_file() {
+        Some(d)
+    } else {
+        eprintln!("skipped: shared face data not found at {}", d.display());
+        None
+    }
+}
+
+/// Minimal OBJ reader (v / f lines) for the tests.
+fn read_obj(path: &std::path::Path) -> TriMesh {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut v = Vec::new();
+    let mut f = Vec::new();
+    for line in text.lines() {
+        let mut it = line.split_whitespace();
+        match it.next() {
+            Some("v") => {
+                let c: Vec<f64> = it.take(3).map(|s| s.parse().unwrap()).collect();
+                v.push(DVec3::new(c[0], c[1], c[2]));
+            }
+            Some("f") => {
+                let i: Vec<u32> = it
+                    .map(|s| s.split('/').next().unwrap().parse::<u32>().unwrap() - 1)
+                    .collect();
+                for k in 1..i.len() - 1 {
+                    f.push([i[0], i[k], i[k + 1]]);
+                }
+            }
+            _ => {}
+        }
+    }
+    TriMesh::new(v, f).unwrap()
+}
+
+fn flipped(m: &TriMesh) -> TriMesh {
+    TriMesh::new(
+        m.positions().to_vec(),
+        m.triangles().iter().map(|t| [t[0], t[2], t[1]]).collect(),
+    )
+    .unwrap()
+}
+
+fn motions() -> Vec<DAffine3> {
+    vec![
+        DAffine3::IDENTITY,
+        DAffine3::from_rotation_translation(
+            DQuat::from_axis_angle(DVec3::new(1.0, 2.0, -0.5).normalize(), 2.4),
+            DVec3::new(30.0, -12.0, 7.0),
+        ),
+        DAffine3::from_rotation_translation(
+            DQuat::from_axis_angle(DVec3::Y, std::f64::consts::PI),
+            DVec3::new(-5.0, 0.0, 100.0),
+        ),
+        DAffine3::from_rotation_translation(
+            DQuat::from_axis_angle(DVec3::new(0.3, -1.0, 0.2).normalize(), -1.1),
+            DVec3::ZERO,
+        ),
+    ]
+}
+
+#[test]
+fn default_model_loads_and_round_trips() {
+    let m = GenericModel::default_model().unwrap();
+    assert_eq!(m.patches.len(), 5);
+    let back = GenericModel::from_json(&m.to_json()).unwrap();
+    assert_eq!(back.landmarks, m.landmarks);
+    // Canonical frame: nose tip at the origin, left outer corner at +x, eyes above the nose.
+    let n = m.landmark(LandmarkName::NoseTip);
+    assert!(n.length() < 1e-9);
+    assert!(m.landmark(LandmarkName::OuterEyeLeft).x > 0.0);
+    assert!(m.landmark(LandmarkName::InnerEyeRight).y > 0.0);
+    assert!(GenericModel::from_json("{\"version\": 1}").is_err());
+}
+
+#[test]
+fn detections_follow_rigid_motions_and_match_the_truth() {
+    let Some(dir) = paper_set() else { return };
+    let truth = io::read_ict_landmarks(&dir.join("landmarks.json")).unwrap();
+    let model = GenericModel::default_model().unwrap();
+    for name in ["id2_neutral", "id1_happiness"] {
+        let mesh = read_obj(&dir.join(format!("{name}.obj")));
+        let gt = truth[name];
+        let base = detect(&mesh, &model).unwrap();
+        for (k, t) in motions().iter().enumerate() {
+            let moved = mesh.transformed(t);
+            let lm = detect(&moved, &model).unwrap();
+            for n in LandmarkName::ALL {
+                let p = lm.get(n).position;
+                let back = t.inverse().transform_point3(p);
+                let err = (back - gt[n as usize]).length();
+                assert!(err < 0.5, "{name} motion {k} {n}: {err} cm from the truth");
+                // Same vertex (or a neighbour at worst) as without motion.
+                let d = (back - base.get(n).position).length();
+                assert!(d < 0.35, "{name} motion {k} {n}: moved by {d} cm");
+            }
+            assert!(lm.confidence > 0.5, "confidence {}", lm.confidence);
+        }
+    }
+}
+
+#[test]
+fn small_evaluation_on_the_paper_set() {
+    let Some(dir) = paper_set() else { return };
+    let truth = io::read_ict_landmarks(&dir.join("landmarks.json")).unwrap();
+    // Train on five neutral identities, test on the sixth with its expressions.
+    let train: Vec<(TriMesh, [DVec3; 5])> = (2..=6)
+        .map(|i| {
+            let n = format!("id{i}_neutral");
+            (read_obj(&dir.join(format!("{n}.obj"))), truth[&n])
+        })
+        .collect();
+    let model = GenericModel::train(&train).unwrap();
+    let mut errs = Vec::new();
+    for (k, name) in ["id1_neutral", "id1_anger", "id1_surprise", "id1_mouth_open"]
+        .iter()
+        .enumerate()
+    {
+        let mesh = read_obj(&dir.join(format!("{name}.obj")));
+        let t = motions()[k];
+        let lm = detect(&mesh.transformed(&t), &model).unwrap();
+        for n in LandmarkName::ALL {
+            let back = t.inverse().transform_point3(lm.get(n).position);
+            errs.push((back - truth[*name][n as usize]).length());
+        }
+    }
+    errs.sort_by(f64::total_cmp);
+    let median = errs[errs.len() / 2];
+    let max = errs[errs.len() - 1];
+    eprintln!(
+        "paper set: median {:.2} mm, max {:.2} mm",
+        10.0 * median,
+        10.0 * max
+    );
+    assert!(median < 0.2, "median error {median} cm");
+    assert!(max < 0.6, "max error {max} cm");
+}
+
+#[test]
+fn face_seen_from_behind_is_not_found() {
+    let Some(dir) = paper_set() else { return };
+    let model = GenericModel::default_model().unwrap();
+    let mesh = flipped(&read_obj(&dir.join("id3_neutral.obj")));
+    for t in motions() {
+        match detect(&mesh.transformed(&t), &model) {
+            Err(LandmarkError::NotFound { best_score, .. }) => assert!(best_score < 0.3),
+            other => panic!("expected NotFound, got {other:?}"),
+        }
+    }
+}
+
+/// Icosphere-like UV sphere.
+fn sphere(r: f64, n_lat: usize, n_lon: usize) -> TriMesh {
+    let mut p = vec![DVec3::new(0.0, 0.0, r)];
+    for i in 1..n_lat {
+        let th = std::f64::consts::PI * i as f64 / n_lat as f64;
+        for j in 0..n_lon {
+            let ph = std::f64::consts::TAU * j as f64 / n_lon as f64;
+            p.push(r * DVec3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()));
+        }
+    }
+    p.push(DVec3::new(0.0, 0.0, -r));
+    let s = p.len() as u32 - 1;
+    let idx = |i: usize, j: usize| (1 + (i - 1) * n_lon + j % n_lon) as u32;
+    let mut t = Vec::new();
+    for j in 0..n_lon {
+        t.push([0, idx(1, j), idx(1, j + 1)]);
+        t.push([s, idx(n_lat - 1, j + 1), idx(n_lat - 1, j)]);
+    }
+    for i in 1..n_lat - 1 {
+        for j in 0..n_lon {
+            t.push([idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)]);
+            t.push([idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)]);
+        }
+    }
+    TriMesh::new(p, t).unwrap()
+}
+
+/// A bumpy height field (Gaussian bumps and dimples), not a face.
+fn bumpy(n: usize) -> TriMesh {
+    let f = |x: f64, y: f64| {
+        2.0 * (-((x - 1.0).powi(2) + y * y) / 2.0).exp()
+            - 1.5 * (-((x + 3.0).powi(2) + (y - 3.0).powi(2))).exp()
+            + 1.0 * (-((x - 3.0).powi(2) + (y + 3.0).powi(2)) / 0.5).exp()
+    };
+    let mut p = Vec::new();
+    for i in 0..=n {
+        for j in 0..=n {
+            let x = -8.0 + 16.0 * j as f64 / n as f64;
+            let y = -8.0 + 16.0 * i as f64 / n as f64;
+            p.push(DVec3::new(x, y, f(x, y)));
+        }
+    }
+    let idx = |i: usize, j: usize| (i * (n + 1) + j) as u32;
+    let mut t = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            t.push([idx(i, j), idx(i, j + 1), idx(i + 1, j + 1)]);
+            t.push([idx(i, j), idx(i + 1, j + 1), idx(i + 1, j)]);
+        }
+    }
+    TriMesh::new(p, t).unwrap()
+}
+
+#[test]
+fn non_faces_are_not_found() {
+    let model = GenericModel::default_model().unwrap();
+    for (what, mesh) in [
+        ("sphere r=8", sphere(8.0, 40, 80)),
+        ("sphere r=1", sphere(1.0, 30, 60)),
+        ("bumpy plane", bumpy(80)),
+    ] {
+        match detect(&mesh, &model) {
+            Err(e @ LandmarkError::NotFound { .. }) => {
+                let msg = e.to_string();
+                assert!(msg.contains("not found") && msg.contains("score"), "{msg}");
+            }
+            other => panic!("{what}: expected NotFound, got {other:?}"),
+        }
+    }
+}

@@ -1,0 +1,328 @@
+//! `cargo xtask landmarks-eval`: accuracy of the automatic landmarker on faces sampled from the
+//! ICT face model (random identities, expressions and rigid motions), against the model's
+//! landmark vertices.
+
+use crate::facemodel::{self, FaceModel, LANDMARK_NAMES};
+use anyhow::{Context, Result};
+use indicatif::{ProgressBar, ProgressStyle};
+use landmarks::{detect, GenericModel, LandmarkName, TrainOptions};
+use meshcore::{DVec3, TriMesh};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Options of `cargo xtask landmarks-eval`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Number of test faces.
+    #[arg(long, default_value_t = 100)]
+    pub faces: usize,
+    /// Number of training faces of the generic model.
+    #[arg(long, default_value_t = 60)]
+    pub train: usize,
+    /// Seed (training and test faces use different streams derived from it).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Output folder (default `target/landmarks-eval/` in the workspace).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// ICT model folder (default `<shared>/faces/ict-facekit/model`).
+    #[arg(long)]
+    pub model_dir: Option<PathBuf>,
+    /// Test neutral faces only (no expressions).
+    #[arg(long)]
+    pub neutral: bool,
+    /// Evaluate this generic model file instead of training one.
+    #[arg(long)]
+    pub generic_model: Option<PathBuf>,
+    /// Also write the trained generic model to this file (how the crate's default model is made).
+    #[arg(long)]
+    pub write_model: Option<PathBuf>,
+}
+
+/// Sampled face with the positions of its landmark vertices.
+type Sample = (TriMesh, [DVec3; 5]);
+
+fn sample_faces(model: &FaceModel, n: usize, seed: u64, expressions: bool) -> Result<Vec<Sample>> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut out = Vec::with_capacity(n);
+    for _ in 0..n {
+        let id = model.random_identity(&mut rng);
+        let ex = if expressions {
+            model.random_expression(&mut rng)
+        } else {
+            vec![]
+        };
+        let pose = facemodel::random_rigid_motion(&mut rng, 10.0);
+        let face = model.sample(&id, &ex)?.transformed(&pose);
+        let lm = model.landmark_positions(&face)?;
+        out.push((face, lm));
+    }
+    Ok(out)
+}
+
+/// Statistics of one landmark's errors (mm).
+#[derive(Debug, serde::Serialize)]
+struct Stats {
+    landmark: String,
+    n: usize,
+    failures: usize,
+    mean_mm: f64,
+    median_mm: f64,
+    p95_mm: f64,
+    max_mm: f64,
+    within_2_5mm: f64,
+    within_5mm: f64,
+    within_10mm: f64,
+}
+
+fn stats(name: &str, errs: &[f64]) -> Stats {
+    let mut v = errs.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    let q = |p: f64| v[((n - 1) as f64 * p).round() as usize];
+    let finite: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    let share = |t: f64| v.iter().filter(|&&x| x <= t).count() as f64 / n as f64;
+    Stats {
+        landmark: name.to_owned(),
+        n,
+        failures: n - finite.len(),
+        mean_mm: finite.iter().sum::<f64>() / finite.len().max(1) as f64,
+        median_mm: q(0.5),
+        p95_mm: q(0.95),
+        max_mm: v[n - 1],
+        within_2_5mm: share(2.5),
+        within_5mm: share(5.0),
+        within_10mm: share(10.0),
+    }
+}
+
+/// Runs the evaluation.
+pub fn run(args: Args) -> Result<()> {
+    let model_dir = args.model_dir.unwrap_or_else(facemodel::default_model_dir);
+    let ict = FaceModel::load(&model_dir)
+        .with_context(|| format!("loading the ICT face model from {}", model_dir.display()))?;
+    anyhow::ensure!(args.faces > 0, "--faces must be positive");
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    let out = args
+        .out
+        .unwrap_or_else(|| root.join("target").join("landmarks-eval"));
+    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    // Different streams for training and test faces.
+    let train_seed = args.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0x7472_6169_6e00;
+    let test_seed = args.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0x7465_7374_0000;
+    let generic = if let Some(p) = &args.generic_model {
+        GenericModel::load(p)?
+    } else {
+        let t0 = Instant::now();
+        let train = sample_faces(&ict, args.train, train_seed, true)?;
+        let g = GenericModel::train_with(&train, &TrainOptions::default(), ict.units())?;
+        eprintln!(
+            "trained the generic model on {} faces in {:.1} s",
+            args.train,
+            t0.elapsed().as_secs_f64()
+        );
+        g
+    };
+    if let Some(p) = &args.write_model {
+        std::fs::write(p, generic.to_json() + "\n")
+            .with_context(|| format!("writing {}", p.display()))?;
+        eprintln!("wrote the generic model to {}", p.display());
+    }
+    std::fs::write(out.join("generic-model.json"), generic.to_json() + "\n")?;
+    let test = sample_faces(&ict, args.faces, test_seed, !args.neutral)?;
+    let pb = ProgressBar::new(test.len() as u64);
+    pb.set_style(
+        ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} ({eta})")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    pb.set_message("detecting");
+    let unit_mm = if ict.units() == "cm" { 10.0 } else { 1.0 };
+    let results: Vec<(Vec<f64>, f64, Option<String>, f64)> = test
+        .par_iter()
+        .map(|(mesh, gt)| {
+            let t0 = Instant::now();
+            let r = detect(mesh, &generic);
+            let ms = t0.elapsed().as_secs_f64() * 1e3;
+            pb.inc(1);
+            match r {
+                Ok(lm) => {
+                    let e = LandmarkName::ALL
+                        .iter()
+                        .map(|&n| (lm.get(n).position - gt[n as usize]).length() * unit_mm)
+                        .collect();
+                    (e, ms, None, lm.confidence)
+                }
+                Err(e) => (vec![f64::INFINITY; 5], ms, Some(e.to_string()), 0.0),
+            }
+        })
+        .collect();
+    pb.finish_and_clear();
+    let mut per: Vec<Vec<f64>> = vec![Vec::new(); 5];
+    for (e, _, _, _) in &results {
+        for k in 0..5 {
+            per[k].push(e[k]);
+        }
+    }
+    let names: Vec<&str> = LandmarkName::ALL.iter().map(|n| n.key()).collect();
+    let st: Vec<Stats> = names.iter().zip(&per).map(|(n, e)| stats(n, e)).collect();
+    let mut times: Vec<f64> = results.iter().map(|r| r.1).collect();
+    times.sort_by(f64::total_cmp);
+    let failures: Vec<(usize, String)> = results
+        .iter()
+        .enumerate()
+        .filter_map(|(i, r)| r.2.clone().map(|e| (i, e)))
+        .collect();
+    println!(
+        "{} test faces ({}), generic model from {} training faces; errors in mm",
+        test.len(),
+        if args.neutral {
+            "neutral"
+        } else {
+            "random expressions"
+        },
+        generic.n_training
+    );
+    println!(
+        "{:<16} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7}",
+        "landmark", "mean", "median", "p95", "max", "<2.5", "<5", "<10"
+    );
+    for s in &st {
+        println!(
+            "{:<16} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>6.1}% {:>6.1}% {:>6.1}%",
+            s.landmark,
+            s.mean_mm,
+            s.median_mm,
+            s.p95_mm,
+            s.max_mm,
+            100.0 * s.within_2_5mm,
+            100.0 * s.within_5mm,
+            100.0 * s.within_10mm
+        );
+    }
+    let tmed = times[times.len() / 2];
+    let tp95 = times[((times.len() - 1) as f64 * 0.95) as usize];
+    println!(
+        "time per face: median {tmed:.1} ms, p95 {tp95:.1} ms ({} threads, release)",
+        rayon::current_num_threads()
+    );
+    for (i, e) in failures.iter().take(5) {
+        println!("face {i}: {e}");
+    }
+    println!("failures: {}", failures.len());
+    let summary = serde_json::json!({
+        "faces": test.len(),
+        "training_faces": generic.n_training,
+        "seed": args.seed,
+        "expressions": !args.neutral,
+        "units_of_errors": "mm",
+        "landmark_vertices": LANDMARK_NAMES,
+        "per_landmark": st,
+        "time_ms": {"median": tmed, "p95": tp95, "threads": rayon::current_num_threads()},
+        "failures": failures.iter().map(|(i, e)| serde_json::json!({"face": i, "error": e})).collect::<Vec<_>>(),
+    });
+    std::fs::write(
+        out.join("summary.json"),
+        serde_json::to_string_pretty(&summary)? + "\n",
+    )?;
+    let series: Vec<(String, Vec<f64>)> = names
+        .iter()
+        .zip(&per)
+        .map(|(n, e)| (n.to_string(), e.iter().map(|x| x.min(15.0)).collect()))
+        .collect();
+    write_histogram_svg(
+        &out.join("errors-histogram.svg"),
+        "Landmark errors on sampled ICT faces",
+        "error (mm, clipped at 15)",
+        &series,
+        30,
+    )?;
+    println!("{}", out.display());
+    Ok(())
+}
+
+/// A minimal SVG histogram (one outlined series per landmark) used until the viz crate lands.
+fn write_histogram_svg(
+    path: &std::path::Path,
+    title: &str,
+    x_label: &str,
+    series: &[(String, Vec<f64>)],
+    bins: usize,
+) -> Result<()> {
+    let (w, h, ml, mb, mt, mr) = (760.0, 420.0, 60.0, 50.0, 40.0, 170.0);
+    let xmax = series
+        .iter()
+        .flat_map(|s| s.1.iter())
+        .copied()
+        .filter(|x| x.is_finite())
+        .fold(1e-9_f64, f64::max);
+    let counts: Vec<Vec<usize>> = series
+        .iter()
+        .map(|(_, v)| {
+            let mut c = vec![0; bins];
+            for &x in v {
+                let b = ((x / xmax * bins as f64) as usize).min(bins - 1);
+                c[b] += 1;
+            }
+            c
+        })
+        .collect();
+    let cmax = counts.iter().flatten().copied().max().unwrap_or(1).max(1) as f64;
+    let colors = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd"];
+    let pw = w - ml - mr;
+    let ph = h - mt - mb;
+    let mut s = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n<text x=\"{}\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">{title}</text>\n",
+        ml + pw / 2.0
+    );
+    s += &format!(
+        "<line x1=\"{ml}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" stroke=\"black\"/>\n<line x1=\"{ml}\" y1=\"{mt}\" x2=\"{ml}\" y2=\"{}\" stroke=\"black\"/>\n",
+        mt + ph, ml + pw, mt + ph, mt + ph
+    );
+    for k in 0..=5 {
+        let x = xmax * k as f64 / 5.0;
+        let px = ml + pw * k as f64 / 5.0;
+        s += &format!(
+            "<text x=\"{px}\" y=\"{}\" text-anchor=\"middle\">{x:.1}</text>\n",
+            mt + ph + 16.0
+        );
+        let c = cmax * k as f64 / 5.0;
+        let py = mt + ph - ph * k as f64 / 5.0;
+        s += &format!(
+            "<text x=\"{}\" y=\"{}\" text-anchor=\"end\">{c:.0}</text>\n",
+            ml - 6.0,
+            py + 4.0
+        );
+    }
+    s += &format!(
+        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{x_label}</text>\n<text x=\"16\" y=\"{}\" transform=\"rotate(-90 16 {})\" text-anchor=\"middle\">faces</text>\n",
+        ml + pw / 2.0,
+        h - 10.0,
+        mt + ph / 2.0,
+        mt + ph / 2.0
+    );
+    for (k, ((name, _), c)) in series.iter().zip(&counts).enumerate() {
+        let col = colors[k % colors.len()];
+        let mut d = format!("M {ml} {}", mt + ph);
+        for (b, &n) in c.iter().enumerate() {
+            let x0 = ml + pw * b as f64 / bins as f64;
+            let x1 = ml + pw * (b + 1) as f64 / bins as f64;
+            let y = mt + ph - ph * n as f64 / cmax;
+            d += &format!(" L {x0:.1} {y:.1} L {x1:.1} {y:.1}");
+        }
+        d += &format!(" L {} {}", ml + pw, mt + ph);
+        s += &format!("<path d=\"{d}\" fill=\"none\" stroke=\"{col}\" stroke-width=\"1.5\"/>\n");
+        let ly = mt + 14.0 + 18.0 * k as f64;
+        s += &format!(
+            "<rect x=\"{}\" y=\"{}\" width=\"12\" height=\"12\" fill=\"{col}\"/><text x=\"{}\" y=\"{}\">{name}</text>\n",
+            ml + pw + 15.0,
+            ly - 10.0,
+            ml + pw + 32.0,
+            ly
+        );
+    }
+    s += "</svg>\n";
+    std::fs::write(path, s).with_context(|| format!("writing {}", path.display()))
+}
