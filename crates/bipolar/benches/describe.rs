@@ -1,1 +1,129 @@
-fn main() {}
+//! Descriptor construction time (geodesics excluded) on a paper-set face (6,706 vertices,
+//! 30 levels) and on an icosphere. The face is read from `$BIPOLAR_SHARED` (default
+//! `../shared` relative to the workspace root); without it only the sphere is measured.
+
+// criterion_group! generates an undocumented function.
+#![allow(missing_docs)]
+
+use bipolar::{
+    describe_fields_with_refs, DescriptorOptions, LevelSpec, SelectionRule, Source, TangentMethod,
+};
+use criterion::{criterion_group, criterion_main, Criterion};
+use meshcore::{Topology, TriMesh};
+use std::path::PathBuf;
+
+fn shared_dir() -> PathBuf {
+    std::env::var_os("BIPOLAR_SHARED")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"))
+}
+
+fn face() -> Option<(TriMesh, [Source; 2])> {
+    let dir = shared_dir().join("faces/ict-facekit/paper-set");
+    let path = dir.join("id1_neutral.obj");
+    let mesh = mesh_io::read_mesh(&path).ok()?.mesh;
+    // Outer eye corners of the ICT FaceKit topology.
+    Some((mesh, [Source::Vertex(1507), Source::Vertex(3721)]))
+}
+
+fn fields(mesh: &TriMesh, refs: &[Source]) -> (Vec<Vec<f64>>, &'static str) {
+    let (solver, name) = match geodesic::new_solver(mesh, geodesic::Method::Exact) {
+        Ok(s) => (s, "exact"),
+        Err(_) => (
+            geodesic::new_solver(mesh, geodesic::Method::Dijkstra).unwrap(),
+            "dijkstra",
+        ),
+    };
+    let f = refs
+        .iter()
+        .map(|r| {
+            solver
+                .distances(&[*r], &geodesic::SolveOptions::default())
+                .unwrap()
+        })
+        .collect();
+    (f, name)
+}
+
+fn bench(c: &mut Criterion) {
+    let mut cases: Vec<(String, TriMesh, [Source; 2], u32)> = Vec::new();
+    match face() {
+        Some((m, r)) => cases.push(("face".into(), m, r, 30)),
+        None => eprintln!(
+            "paper-set face not found under {}; benchmarking the sphere only",
+            shared_dir().display()
+        ),
+    }
+    let ico = bipolar::synthetic::icosphere(5);
+    cases.push((
+        "ico5".into(),
+        ico,
+        [Source::Vertex(0), Source::Vertex(5000)],
+        30,
+    ));
+    for (name, mesh, refs, n) in &cases {
+        let topo = Topology::new(mesh);
+        let (f, solver) = fields(mesh, refs);
+        eprintln!(
+            "{name}: {} vertices, fields from the {solver} solver",
+            mesh.n_vertices()
+        );
+        let mut g = c.benchmark_group(format!("describe_{name}"));
+        g.sample_size(20);
+        for (label, rule, tangent) in [
+            (
+                "gradient_isoangle",
+                SelectionRule::IsoAngle,
+                TangentMethod::Gradient,
+            ),
+            (
+                "gradient_filter",
+                SelectionRule::Filter {
+                    tolerance: 0.95 / 32.0,
+                },
+                TangentMethod::Gradient,
+            ),
+            ("gradient_all", SelectionRule::All, TangentMethod::Gradient),
+            (
+                "strip_filter",
+                SelectionRule::Filter {
+                    tolerance: 0.95 / 32.0,
+                },
+                TangentMethod::Strip,
+            ),
+            (
+                "spline_filter",
+                SelectionRule::Filter {
+                    tolerance: 0.95 / 32.0,
+                },
+                TangentMethod::Spline,
+            ),
+            (
+                "spline_isoangle",
+                SelectionRule::IsoAngle,
+                TangentMethod::Spline,
+            ),
+        ] {
+            let opts = DescriptorOptions {
+                levels: LevelSpec::Count(*n),
+                max_level: Some(*n),
+                rule,
+                tangent,
+                ..DescriptorOptions::default()
+            };
+            let d = describe_fields_with_refs(mesh, &topo, &f, Some(refs), &opts).unwrap();
+            eprintln!(
+                "  {label}: {} points from {} intersections",
+                d.len(),
+                d.stats.intersections
+            );
+            g.bench_function(label, |b| {
+                b.iter(|| describe_fields_with_refs(mesh, &topo, &f, Some(refs), &opts).unwrap())
+            });
+        }
+        g.finish();
+    }
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

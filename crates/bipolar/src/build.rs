@@ -457,22 +457,8 @@ impl<'a> Ctx<'a> {
         out: &mut Vec<DescriptorPoint>,
     ) -> Result<usize, BipolarError> {
         let raws = self.grid_intersections(pair, stats);
-        let n = raws.len();
-        if n == 0 {
+        if raws.is_empty() {
             return Ok(0);
-        }
-        // Ambiguity on all intersections (before any filtering).
-        let mut amb = vec![false; n];
-        let mut s = 0;
-        while s < n {
-            let mut e = s + 1;
-            while e < n && same_key(&raws[e], &raws[s]) {
-                e += 1;
-            }
-            if e - s > 1 {
-                amb[s..e].iter_mut().for_each(|x| *x = true);
-            }
-            s = e;
         }
         // Tangents.
         let cos: Vec<f64> = match self.opts.tangent {
@@ -540,6 +526,24 @@ impl<'a> Ctx<'a> {
                     .collect()
             }
         };
+        // Merge duplicates (a point on an edge or at a vertex is found in every face around
+        // it): average position and cos over the group (order-independent, so invariant to
+        // motions and renumbering), keep the face of smallest index.
+        let (raws, cos) = merge_duplicates(&raws, &cos, 1e-9 * self.diag);
+        let n = raws.len();
+        // Ambiguity on all intersections (before any filtering).
+        let mut amb = vec![false; n];
+        let mut s = 0;
+        while s < n {
+            let mut e = s + 1;
+            while e < n && same_key(&raws[e], &raws[s]) {
+                e += 1;
+            }
+            if e - s > 1 {
+                amb[s..e].iter_mut().for_each(|x| *x = true);
+            }
+            s = e;
+        }
         let k_max = self.opts.angles as f64;
         let alpha = self.opts.alpha;
         for (idx, r) in raws.iter().enumerate() {
@@ -649,23 +653,7 @@ impl<'a> Ctx<'a> {
                 .then(x.pos.z.total_cmp(&y.pos.z))
                 .then(x.face.cmp(&y.face))
         });
-        // Merge duplicates (points on shared edges / vertices found in several faces).
-        let tol = 1e-9 * self.diag;
-        let mut merged: Vec<Raw> = Vec::with_capacity(raws.len());
-        let mut run_start = 0;
-        for r in raws {
-            if merged.last().is_some_and(|l| !same_key(l, &r)) {
-                run_start = merged.len();
-            }
-            if merged[run_start..]
-                .iter()
-                .any(|k| (k.pos - r.pos).length() <= tol)
-            {
-                continue;
-            }
-            merged.push(r);
-        }
-        merged
+        raws
     }
 
     /// Iso-angle points along the level curves of the first field (rule B, §2.5-B).
@@ -759,6 +747,16 @@ impl<'a> Ctx<'a> {
                     }
                     let side: i8 = if det_sign > 0.0 { 1 } else { -1 };
                     for &(k, target, sign) in &targets {
+                        // Samples within 1e-12 of the target count as on it ("above"), so a
+                        // rounding-level change cannot create or move a crossing.
+                        let snap = |c: f64| {
+                            if (c - target).abs() <= 1e-12 {
+                                target
+                            } else {
+                                c
+                            }
+                        };
+                        let (c0, c1) = (snap(c0), snap(c1));
                         if (c0 >= target) == (c1 >= target) {
                             continue;
                         }
@@ -810,6 +808,7 @@ impl<'a> Ctx<'a> {
     fn vertex_gradients(&self, f: &[f64], g: &[DVec3], vn: &[DVec3]) -> Vec<DVec3> {
         let mut acc = vec![DVec3::ZERO; self.mesh.n_vertices()];
         let mut w = vec![0.0; self.mesh.n_vertices()];
+        let mut mag = vec![0.0; self.mesh.n_vertices()];
         for (face, t) in self.mesh.triangles().iter().enumerate() {
             if self.face_values(f, face).is_none() {
                 continue;
@@ -817,14 +816,18 @@ impl<'a> Ctx<'a> {
             let area = self.mesh.face_area(face as u32);
             for &v in t {
                 acc[v as usize] += area * g[face];
+                mag[v as usize] += area * g[face].length();
                 w[v as usize] += area;
             }
         }
         acc.iter()
             .zip(&w)
             .zip(vn)
-            .map(|((a, &w), n)| {
-                if w > 0.0 {
+            .zip(&mag)
+            .map(|(((a, &w), n), &mag)| {
+                // Where the face gradients around a vertex cancel (the source of a distance
+                // field, a ridge), the direction is undefined: return zero (no tangent).
+                if w > 0.0 && a.length() > 0.1 * mag {
                     let m = *a / w;
                     m - m.dot(*n) * *n
                 } else {
@@ -839,6 +842,70 @@ impl<'a> Ctx<'a> {
         let [a, b, c] = self.mesh.face_corners(face);
         meshcore::closest_point_on_triangle(p, a, b, c)
     }
+}
+
+/// Groups raw intersections (sorted by key, then position) of equal key lying within `tol`
+/// of each other; returns one point per group (mean position and cos, smallest face),
+/// sorted by key then position.
+fn merge_duplicates(raws: &[Raw], cos: &[f64], tol: f64) -> (Vec<Raw>, Vec<f64>) {
+    let mut out: Vec<Raw> = Vec::with_capacity(raws.len());
+    let mut out_cos = Vec::with_capacity(raws.len());
+    let mut s = 0;
+    while s < raws.len() {
+        let mut e = s + 1;
+        while e < raws.len() && same_key(&raws[e], &raws[s]) {
+            e += 1;
+        }
+        // Greedy clustering within the key run.
+        let mut group_of = vec![usize::MAX; e - s];
+        let mut n_groups = 0;
+        for a in 0..e - s {
+            if group_of[a] != usize::MAX {
+                continue;
+            }
+            group_of[a] = n_groups;
+            let mut members = vec![a];
+            let mut k = 0;
+            while k < members.len() {
+                let m = members[k];
+                for b in 0..e - s {
+                    if group_of[b] == usize::MAX
+                        && (raws[s + b].pos - raws[s + m].pos).length() <= tol
+                    {
+                        group_of[b] = n_groups;
+                        members.push(b);
+                    }
+                }
+                k += 1;
+            }
+            let cnt = members.len() as f64;
+            let pos = members.iter().map(|&m| raws[s + m].pos).sum::<DVec3>() / cnt;
+            let mean_cos = members.iter().map(|&m| cos[s + m]).sum::<f64>() / cnt;
+            let keep = members
+                .iter()
+                .map(|&m| raws[s + m])
+                .min_by_key(|r| r.face)
+                .unwrap_or(raws[s + a]);
+            out.push(Raw { pos, ..keep });
+            out_cos.push(mean_cos);
+            n_groups += 1;
+        }
+        s = e;
+    }
+    // Re-sort by key then position (the means moved).
+    let mut idx: Vec<usize> = (0..out.len()).collect();
+    idx.sort_by(|&x, &y| {
+        let (a, b) = (&out[x], &out[y]);
+        (a.i, a.j, a.side)
+            .cmp(&(b.i, b.j, b.side))
+            .then(a.pos.x.total_cmp(&b.pos.x))
+            .then(a.pos.y.total_cmp(&b.pos.y))
+            .then(a.pos.z.total_cmp(&b.pos.z))
+    });
+    (
+        idx.iter().map(|&i| out[i]).collect(),
+        idx.iter().map(|&i| out_cos[i]).collect(),
+    )
 }
 
 fn same_key(a: &Raw, b: &Raw) -> bool {
