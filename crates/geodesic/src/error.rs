@@ -23,6 +23,9 @@ pub enum GeodesicError {
     /// The method is not available yet.
     #[error("geodesic method {0} is not implemented yet")]
     NotImplemented(&'static str),
+    /// A numerical step failed (e.g. a sparse factorisation of a mesh with degenerate faces).
+    #[error("numerical failure: {0}")]
+    Numerical(String),
     /// A negative or NaN cut-off.
     #[error("invalid max_distance {0}: must be positive")]
     InvalidCutoff(f64),

@@ -6,7 +6,12 @@
 //!
 //! | method | type | what it computes |
 //! |---|---|---|
+//! | [`Method::Exact`] | [`ExactGeodesic`] | exact polyhedral distance (window propagation) |
+//! | [`Method::Fmm`] | [`FastMarching`] | fast marching (Kimmel-Sethian) with obtuse-angle unfolding; first order |
+//! | [`Method::Heat`] | [`HeatMethod`] | heat method with reused sparse Cholesky factorisations; smooth, approximate |
 //! | [`Method::Dijkstra`] | [`Dijkstra`] | shortest paths along mesh edges (the paper's baseline; overestimates) |
+//!
+//! Many sources at once (one field each) run in parallel with [`distances_many`].
 //!
 //! Unreachable vertices (other components, or beyond the cut-off) get `f64::INFINITY`.
 
@@ -19,7 +24,7 @@ mod heat;
 pub use dijkstra::Dijkstra;
 pub use error::GeodesicError;
 pub use exact::ExactGeodesic;
-pub use fmm::FastMarching;
+pub use fmm::{FastMarching, FmmUpdate};
 pub use heat::HeatMethod;
 pub use meshcore::{SurfacePoint, TriMesh};
 
@@ -100,4 +105,19 @@ pub fn new_solver(
         Method::Heat => Box::new(HeatMethod::new(mesh)?),
         Method::Dijkstra => Box::new(Dijkstra::new(mesh)?),
     })
+}
+
+/// One distance field per entry of `sources`, computed in parallel (rayon) with the same solver
+/// and options. Equivalent to calling [`GeodesicSolver::distances`] for each entry in turn; the
+/// first error (in input order) is returned.
+pub fn distances_many(
+    solver: &dyn GeodesicSolver,
+    sources: &[Vec<Source>],
+    opts: &SolveOptions,
+) -> Result<Vec<Vec<f64>>, GeodesicError> {
+    use rayon::prelude::*;
+    sources
+        .par_iter()
+        .map(|s| solver.distances(s, opts))
+        .collect()
 }

@@ -1,0 +1,282 @@
+//! Side-by-side accuracy and timing of the approximate methods on the peer sphere meshes.
+//!
+//! Needs the meshes written by `make_meshes.py` of `../shared/peers/geodesic` (and, for the
+//! "vs exact" and peer columns, the outputs of its `bench.py`) in the folder named by
+//! `GEODESIC_PEERS_DIR` (default `/tmp/peers-geo`); skips when they are absent. Slow (release
+//! build recommended), hence ignored:
+//!
+//! `cargo test --release -p geodesic --test approx_peers -- --ignored --nocapture`
+
+use geodesic::{
+    Dijkstra, FastMarching, FmmUpdate, GeodesicSolver, HeatMethod, SolveOptions, Source, TriMesh,
+};
+use glam::DVec3;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+fn load_obj(path: &Path) -> TriMesh {
+    let text = std::fs::read_to_string(path).unwrap();
+    let (mut p, mut t) = (Vec::new(), Vec::new());
+    for line in text.lines() {
+        let mut it = line.split_whitespace();
+        match it.next() {
+            Some("v") => {
+                let c: Vec<f64> = it.take(3).map(|s| s.parse().unwrap()).collect();
+                p.push(DVec3::new(c[0], c[1], c[2]));
+            }
+            Some("f") => {
+                let c: Vec<u32> = it
+                    .map(|s| s.split('/').next().unwrap().parse::<u32>().unwrap() - 1)
+                    .collect();
+                for k in 1..c.len() - 1 {
+                    t.push([c[0], c[k], c[k + 1]]);
+                }
+            }
+            _ => {}
+        }
+    }
+    TriMesh::new(p, t).unwrap()
+}
+
+fn load_txt(path: &Path) -> Option<Vec<f64>> {
+    let text = std::fs::read_to_string(path).ok()?;
+    Some(text.lines().map(|l| l.trim().parse().unwrap()).collect())
+}
+
+struct Err3 {
+    mae: f64,
+    max: f64,
+    rel: f64,
+    /// Analytic distance where the max error occurs.
+    at: f64,
+}
+
+fn errors(d: &[f64], g: &[f64]) -> Err3 {
+    let (mut s, mut m, mut r, mut nr, mut at) = (0.0, 0.0f64, 0.0, 0usize, 0.0);
+    for (a, b) in d.iter().zip(g) {
+        let e = (a - b).abs();
+        s += e;
+        if e > m {
+            m = e;
+            at = *b;
+        }
+        if *b > 0.05 {
+            r += e / b;
+            nr += 1;
+        }
+    }
+    Err3 {
+        mae: s / d.len() as f64,
+        max: m,
+        rel: r / nr as f64,
+        at,
+    }
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn fmt_t(s: f64) -> String {
+    if s < 1e-3 {
+        format!("{:.0} µs", s * 1e6)
+    } else if s < 1.0 {
+        format!("{:.1} ms", s * 1e3)
+    } else {
+        format!("{:.2} s", s)
+    }
+}
+
+#[test]
+#[ignore = "slow: needs the peer meshes in /tmp/peers-geo and a release build"]
+fn peer_comparison() {
+    faer::set_global_parallelism(faer::Par::Seq);
+    let dir = PathBuf::from(
+        std::env::var("GEODESIC_PEERS_DIR").unwrap_or_else(|_| "/tmp/peers-geo".to_string()),
+    );
+    if !dir.join("meshes").is_dir() {
+        println!("skipping: no peer meshes in {}", dir.display());
+        return;
+    }
+    let cases = std::env::var("GEODESIC_CASES")
+        .unwrap_or_else(|_| "ico4:0,ico5:0,ico6:0,ico7:0,uv10k:0,uv10k:4901,jitter5:0".to_string());
+    let methods = std::env::var("GEODESIC_METHODS")
+        .unwrap_or_else(|_| "fmm,fmm_point,fmm_blend,heat,dijkstra".to_string());
+    let repeat: usize = std::env::var("GEODESIC_REPEAT")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(3);
+    println!("| mesh:source | nV | method | setup | solve | total | MAE | max err | mean rel err | max vs exact |");
+    println!("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|");
+    for case in cases.split(',') {
+        let (name, src) = case.split_once(':').unwrap();
+        let src: u32 = src.parse().unwrap();
+        let path = dir.join("meshes").join(format!("{name}.obj"));
+        if !path.exists() {
+            println!("| {case} | missing mesh |");
+            continue;
+        }
+        let mesh = load_obj(&path);
+        let p = mesh.position(src).normalize();
+        let g: Vec<f64> = mesh
+            .positions()
+            .iter()
+            .map(|v| v.normalize().dot(p).clamp(-1.0, 1.0).acos())
+            .collect();
+        let exact = load_txt(
+            &dir.join("out")
+                .join(format!("{name}_s{src}_exact_gdist.txt")),
+        );
+        let vs_exact = |d: &[f64]| {
+            exact
+                .as_ref()
+                .map(|x| {
+                    d.iter()
+                        .zip(x)
+                        .map(|(a, b)| (a - b).abs())
+                        .fold(0.0, f64::max)
+                })
+                .unwrap_or(f64::NAN)
+        };
+        for peer in ["fmm_pp3d", "heat_igl"] {
+            if let Some(d) = load_txt(&dir.join("out").join(format!("{name}_s{src}_{peer}.txt"))) {
+                let e = errors(&d, &g);
+                println!(
+                    "| {case} | {} | {peer} (peer, errors only) | | | | {:.2e} | {:.2e} | {:.2e} | {:.1e} |",
+                    g.len(),
+                    e.mae,
+                    e.max,
+                    e.rel,
+                    vs_exact(&d)
+                );
+            }
+        }
+        for m in methods.split(',') {
+            let (mut setups, mut solves) = (Vec::new(), Vec::new());
+            let mut d = Vec::new();
+            for _ in 0..repeat {
+                let t0 = Instant::now();
+                let solver: Box<dyn GeodesicSolver> = match m {
+                    "fmm" => Box::new(FastMarching::new(&mesh).unwrap()),
+                    "fmm_point" => {
+                        Box::new(FastMarching::with_update(&mesh, FmmUpdate::PointSource).unwrap())
+                    }
+                    "fmm_blend" => {
+                        Box::new(FastMarching::with_update(&mesh, FmmUpdate::Blend).unwrap())
+                    }
+                    "heat" => Box::new(HeatMethod::new(&mesh).unwrap()),
+                    "dijkstra" => Box::new(Dijkstra::new(&mesh).unwrap()),
+                    other => panic!("unknown method {other}"),
+                };
+                let t1 = Instant::now();
+                d = solver
+                    .distances(&[Source::Vertex(src)], &SolveOptions::default())
+                    .unwrap();
+                let t2 = Instant::now();
+                setups.push((t1 - t0).as_secs_f64());
+                solves.push((t2 - t1).as_secs_f64());
+            }
+            let (su, so) = (median(setups), median(solves));
+            let e = errors(&d, &g);
+            if std::env::var("GEODESIC_BINS").is_ok() {
+                let mut bins = vec![(0.0f64, 0.0f64, 0usize, 0.0f64); 16];
+                let ex = exact.as_ref().unwrap();
+                for ((a, b), x) in d.iter().zip(&g).zip(ex) {
+                    let k = ((b / std::f64::consts::PI * 16.0) as usize).min(15);
+                    bins[k].0 += a - b;
+                    bins[k].1 += a - x;
+                    bins[k].2 += 1;
+                    bins[k].3 = bins[k].3.max((a - x).abs());
+                }
+                for (k, bn) in bins.iter().enumerate() {
+                    println!(
+                        "  bin {k:2}: mean signed err vs sphere {:+.2e}, vs exact {:+.2e}, max |vs exact| {:.2e}",
+                        bn.0 / bn.2 as f64,
+                        bn.1 / bn.2 as f64,
+                        bn.3
+                    );
+                }
+            }
+            if std::env::var("GEODESIC_WHERE").is_ok() {
+                println!("max error of {m} at analytic distance {:.3}", e.at);
+            }
+            println!(
+                "| {case} | {} | {m} (ours) | {} | {} | {} | {:.2e} | {:.2e} | {:.2e} | {:.1e} |",
+                g.len(),
+                fmt_t(su),
+                fmt_t(so),
+                fmt_t(su + so),
+                e.mae,
+                e.max,
+                e.rel,
+                vs_exact(&d)
+            );
+        }
+    }
+}
+
+#[test]
+#[ignore = "slow: needs the paper-set faces and a release build"]
+fn face_comparison_against_exact() {
+    faer::set_global_parallelism(faer::Par::Seq);
+    let shared = std::env::var("BIPOLAR_SHARED")
+        .map(PathBuf::from)
+        .unwrap_or_else(|_| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"));
+    let dir = shared.join("faces/ict-facekit/paper-set");
+    if !dir.is_dir() {
+        println!("skipping: no paper-set faces in {}", dir.display());
+        return;
+    }
+    println!(
+        "| face | method | setup | solve | MAE vs exact | max vs exact | max rel (d > 1 cm) |"
+    );
+    println!("|---|---|---:|---:|---:|---:|---:|");
+    for face in ["id1_neutral", "id2_neutral"] {
+        let mesh = load_obj(&dir.join(format!("{face}.obj")));
+        let src = [Source::Vertex(3721)];
+        let exact = geodesic::ExactGeodesic::new(&mesh)
+            .unwrap()
+            .distances(&src, &SolveOptions::default())
+            .unwrap();
+        for m in ["fmm", "fmm_point", "fmm_blend", "heat", "dijkstra"] {
+            let t0 = Instant::now();
+            let solver: Box<dyn GeodesicSolver> = match m {
+                "fmm" => Box::new(FastMarching::new(&mesh).unwrap()),
+                "fmm_point" => {
+                    Box::new(FastMarching::with_update(&mesh, FmmUpdate::PointSource).unwrap())
+                }
+                "fmm_blend" => {
+                    Box::new(FastMarching::with_update(&mesh, FmmUpdate::Blend).unwrap())
+                }
+                "heat" => Box::new(HeatMethod::new(&mesh).unwrap()),
+                _ => Box::new(Dijkstra::new(&mesh).unwrap()),
+            };
+            let t1 = Instant::now();
+            let d = solver.distances(&src, &SolveOptions::default()).unwrap();
+            let t2 = Instant::now();
+            let n_inf = d.iter().filter(|x| !x.is_finite()).count();
+            let n_inf_exact = exact.iter().filter(|x| !x.is_finite()).count();
+            if n_inf + n_inf_exact > 0 {
+                println!("{m}: {n_inf} non-finite values (exact: {n_inf_exact})");
+            }
+            let (mut s, mut mx, mut rel) = (0.0, 0.0f64, 0.0f64);
+            for (a, b) in d.iter().zip(&exact) {
+                let e = (a - b).abs();
+                s += e;
+                mx = mx.max(e);
+                if *b > 1.0 {
+                    rel = rel.max(e / b);
+                }
+            }
+            println!(
+                "| {face} | {m} | {} | {} | {:.2e} | {:.2e} | {:.2e} |",
+                fmt_t((t1 - t0).as_secs_f64()),
+                fmt_t((t2 - t1).as_secs_f64()),
+                s / d.len() as f64,
+                mx,
+                rel
+            );
+        }
+    }
+}
