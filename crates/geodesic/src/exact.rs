@@ -332,6 +332,21 @@ impl ExactGeodesic {
         Ok((s.finish(), props))
     }
 
+    /// One distance field per source set, solved in parallel with rayon (one independent
+    /// propagation per set; results in input order, identical to calling
+    /// [`GeodesicSolver::distances`] for each set).
+    pub fn distances_many(
+        &self,
+        source_sets: &[Vec<Source>],
+        opts: &SolveOptions,
+    ) -> Result<Vec<Vec<f64>>, GeodesicError> {
+        use rayon::prelude::*;
+        source_sets
+            .par_iter()
+            .map(|s| self.distances(s, opts))
+            .collect()
+    }
+
     #[inline]
     fn tail(&self, h: u32) -> u32 {
         self.tris[(h / 3) as usize][(h % 3) as usize]

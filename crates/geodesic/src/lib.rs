@@ -23,7 +23,7 @@ mod heat;
 
 pub use dijkstra::Dijkstra;
 pub use error::GeodesicError;
-pub use exact::ExactGeodesic;
+pub use exact::{ExactGeodesic, ExactMeshReport};
 pub use fmm::{FastMarching, FmmUpdate};
 pub use heat::HeatMethod;
 pub use meshcore::{SurfacePoint, TriMesh};

@@ -433,6 +433,12 @@ fn face_point_source_distances_and_multi_source_minimum() {
         assert!((all[u] - mn).abs() <= 1e-12 * mn.max(1.0), "vertex {u}");
     }
     assert_eq!(all, solve(&s, &srcs));
+    // Parallel batch = sequential calls, bit for bit.
+    let sets: Vec<Vec<Source>> = srcs.iter().map(|x| vec![*x]).collect();
+    assert_eq!(
+        s.distances_many(&sets, &SolveOptions::default()).unwrap(),
+        singles
+    );
     // An edge point gives the same field from either adjacent face.
     let t = m.triangles()[37];
     let sp1 = SurfacePoint::new(37, DVec3::new(0.3, 0.7, 0.0));
