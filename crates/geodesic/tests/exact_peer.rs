@@ -7,7 +7,8 @@
 //!
 //! `EXACT_PEER_REF` holds one distance per line in vertex order. Several comparisons can be
 //! given at once, separated by `;` in each variable. A source `F<face>` is the centroid of
-//! that face (compare with libigl's `exact_geodesic` face sources).
+//! that face (compare with libigl's `exact_geodesic` face sources); `0,17,40` are several
+//! sources at once.
 
 mod exact_util;
 
@@ -32,15 +33,19 @@ fn compare_with_peer() {
     let mut worst = 0.0f64;
     for ((mesh, rf), src) in meshes.split(';').zip(refs.split(';')).zip(srcs.split(';')) {
         let m = exact_util::read_obj(std::path::Path::new(mesh)).unwrap();
-        // "F<face>" means the centroid of that face (libigl's `FS` face source).
+        // "F<face>" means the centroid of that face (libigl's `FS` face source); several
+        // sources are separated by commas.
         let src_str = src.trim().to_string();
-        let source = match src_str.strip_prefix('F') {
-            Some(f) => Source::Point(geodesic::SurfacePoint::new(
-                f.parse().unwrap(),
-                glam::DVec3::splat(1.0 / 3.0),
-            )),
-            None => Source::Vertex(src_str.parse().unwrap()),
-        };
+        let sources: Vec<Source> = src_str
+            .split(',')
+            .map(|one| match one.strip_prefix('F') {
+                Some(f) => Source::Point(geodesic::SurfacePoint::new(
+                    f.parse().unwrap(),
+                    glam::DVec3::splat(1.0 / 3.0),
+                )),
+                None => Source::Vertex(one.parse().unwrap()),
+            })
+            .collect();
         let src = src_str;
         let reference: Vec<f64> = std::fs::read_to_string(rf)
             .unwrap()
@@ -59,7 +64,7 @@ fn compare_with_peer() {
             let solver = ExactGeodesic::new(&m).unwrap();
             let (t1, c1) = (Instant::now(), thread_cpu());
             let r = solver
-                .distances_with_stats(&[source], &SolveOptions::default())
+                .distances_with_stats(&sources, &SolveOptions::default())
                 .unwrap();
             let (t2, c2) = (Instant::now(), thread_cpu());
             let _ = solver.n_vertices();
