@@ -6,6 +6,11 @@
 //! the lower envelope). Vertices are ordered by `(distance, vertex id)`; see
 //! `shared/docs/exact-geodesics.md` for the algorithm and the soundness argument.
 //!
+//! Besides the [`GeodesicSolver`] trait: [`ExactGeodesic::distances_with_stats`] (also returns
+//! the number of window propagations), [`ExactGeodesic::distances_many`] (several source sets
+//! in parallel with rayon) and [`ExactGeodesic::trace_path`] (the shortest path itself, unfolded
+//! back through the windows).
+//!
 //! Mesh handling (done once in [`ExactGeodesic::new`], reported by [`ExactGeodesic::report`]):
 //! * faces repeating a vertex or having an edge shorter than `1e-12` x bbox diagonal are dropped
 //!   (weld coincident vertices first with `meshcore::repair` if that matters);
@@ -424,6 +429,9 @@ pub(crate) struct Solve<'a> {
     pending_emit: Vec<u32>,
     tc_buf: Vec<f64>,
     draining: bool,
+    /// Pairwise trim and apex split enabled (off only in the differential tests' oracle mode,
+    /// which keeps just the vertex filter).
+    prune: bool,
     propagations: u64,
     /// Path-tracing mode: every emitted window, and how each vertex got its distance.
     pub(crate) records: Option<Vec<Record>>,
@@ -452,6 +460,7 @@ impl<'a> Solve<'a> {
             pending_emit: Vec::new(),
             tc_buf: Vec::new(),
             draining: false,
+            prune: true,
             propagations: 0,
             records: if record { Some(Vec::new()) } else { None },
             pred: if record {
@@ -750,7 +759,7 @@ impl<'a> Solve<'a> {
                 || db + (l - w.b0) < w.dist(w.b0) * (1.0 - TAU))
         });
         // P1: sorted lower-envelope trim.
-        if ws.len() > 1 {
+        if self.prune && ws.len() > 1 {
             ws.sort_by(|x, y| x.b0.total_cmp(&y.b0));
             let mut cur = 0;
             for j in 1..ws.len() {
@@ -799,18 +808,22 @@ impl<'a> Solve<'a> {
             self.relax(c, best, Pred::Window(best_id, p_star));
         }
         // P3: split rule and propagation.
+        if !self.prune {
+            // Oracle mode: every ray goes to the side it actually exits through.
+            p_star = f64::NAN;
+        }
         let tl_tw = g.twin[prev(h) as usize];
         let tr_tw = g.twin[next(h) as usize];
         for (i, w) in ws.iter().enumerate() {
             let tc = tcs[i];
             if tl_tw != NONE {
-                let tl = w.b1.min(p_star).min(tc);
+                let tl = w.b1.min(tc).min(if p_star.is_nan() { tc } else { p_star });
                 if tl > w.b0 {
                     self.emit_left(&geo, tl_tw, w, w.b0, tl, tl == tc);
                 }
             }
             if tr_tw != NONE {
-                let tr = w.b0.max(p_star).max(tc);
+                let tr = w.b0.max(tc).max(if p_star.is_nan() { tc } else { p_star });
                 if tr < w.b1 {
                     self.emit_right(&geo, tr_tw, w, tr, w.b1, tr == tc);
                 }
@@ -978,5 +991,119 @@ impl GeodesicSolver for ExactGeodesic {
         opts: &SolveOptions,
     ) -> Result<Vec<f64>, GeodesicError> {
         self.distances_with_stats(sources, opts).map(|(d, _)| d)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+
+    /// Icosphere of `level` with radial jitter `amp` (relative).
+    fn jittered_sphere(level: u32, amp: f64, seed: u64) -> TriMesh {
+        let t = (1.0 + 5f64.sqrt()) / 2.0;
+        let mut v: Vec<DVec3> = [
+            [-1.0, t, 0.0],
+            [1.0, t, 0.0],
+            [-1.0, -t, 0.0],
+            [1.0, -t, 0.0],
+            [0.0, -1.0, t],
+            [0.0, 1.0, t],
+            [0.0, -1.0, -t],
+            [0.0, 1.0, -t],
+            [t, 0.0, -1.0],
+            [t, 0.0, 1.0],
+            [-t, 0.0, -1.0],
+            [-t, 0.0, 1.0],
+        ]
+        .iter()
+        .map(|p| DVec3::from_array(*p).normalize())
+        .collect();
+        let mut f: Vec<[u32; 3]> = vec![
+            [0, 11, 5],
+            [0, 5, 1],
+            [0, 1, 7],
+            [0, 7, 10],
+            [0, 10, 11],
+            [1, 5, 9],
+            [5, 11, 4],
+            [11, 10, 2],
+            [10, 7, 6],
+            [7, 1, 8],
+            [3, 9, 4],
+            [3, 4, 2],
+            [3, 2, 6],
+            [3, 6, 8],
+            [3, 8, 9],
+            [4, 9, 5],
+            [2, 4, 11],
+            [6, 2, 10],
+            [8, 6, 7],
+            [9, 8, 1],
+        ];
+        for _ in 0..level {
+            let mut mid = std::collections::HashMap::new();
+            let mut nf = Vec::new();
+            let mut m = |a: u32, b: u32, v: &mut Vec<DVec3>| -> u32 {
+                *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                    v.push((v[a as usize] + v[b as usize]).normalize());
+                    (v.len() - 1) as u32
+                })
+            };
+            for &[a, b, c] in &f {
+                let (ab, bc, ca) = (m(a, b, &mut v), m(b, c, &mut v), m(c, a, &mut v));
+                nf.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+            }
+            f = nf;
+        }
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        for p in &mut v {
+            *p *= 1.0 + rng.random_range(-amp..=amp);
+        }
+        TriMesh::new(v, f).unwrap()
+    }
+
+    /// The pruned propagation equals the oracle mode (vertex filter only, no pairwise trim,
+    /// no apex split) on small jittered spheres: the spec's most effective bug finders.
+    #[test]
+    fn pruning_is_sound_on_jittered_spheres() {
+        let (mut total_pruned, mut total_oracle) = (0u64, 0u64);
+        for (level, amp, seed) in [
+            (2, 0.0, 0),
+            (2, 0.005, 1),
+            (2, 0.01, 2),
+            (2, 0.03, 3),
+            (3, 0.01, 4),
+        ] {
+            let m = jittered_sphere(level, amp, seed);
+            let g = ExactGeodesic::new(&m).unwrap();
+            for src in [0u32, 7, 100] {
+                let run = |prune: bool| {
+                    let mut s = Solve::new(&g, f64::INFINITY, false);
+                    s.prune = prune;
+                    s.seed(&[Source::Vertex(src)]).unwrap();
+                    s.run();
+                    (s.propagations, s.finish())
+                };
+                let (np, fast) = run(true);
+                let (no, slow) = run(false);
+                assert!(np <= no, "pruning should not add work: {np} > {no}");
+                total_pruned += np;
+                total_oracle += no;
+                for v in 0..fast.len() {
+                    assert!(
+                        (fast[v] - slow[v]).abs() <= 1e-12 * slow[v].max(1.0),
+                        "level {level} amp {amp} src {src} vertex {v}: {} vs {}",
+                        fast[v],
+                        slow[v]
+                    );
+                }
+            }
+        }
+        // The oracle mode really propagates more (the rules under test were active).
+        assert!(
+            2 * total_pruned < total_oracle,
+            "{total_pruned} vs {total_oracle}"
+        );
     }
 }
