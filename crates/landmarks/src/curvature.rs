@@ -5,6 +5,8 @@
 //! sphere with outward normals has `k1 = k2 = +1/R` and a shape index of `+1` (a cap, like the
 //! nose tip); the same sphere with inward normals (reversed winding) has `-1/R` and `-1` (a cup).
 
+#![allow(clippy::needless_range_loop)] // Dense small linear algebra reads best with indices.
+
 use meshcore::{DVec3, TriMesh};
 
 /// Principal curvatures and directions at one vertex.
@@ -159,6 +161,7 @@ impl BallCollector {
     /// Vertices (including `v`) connected to `v` through vertices within `radius` of `center`;
     /// if fewer than `min_count`, whole edge rings are added until there are enough (or the
     /// component is exhausted).
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn collect(
         &mut self,
         adj: &VertexAdjacency,

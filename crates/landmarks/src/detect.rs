@@ -2,6 +2,8 @@
 //! configurations, verification and refinement of the pose by fitting the generic face surface,
 //! then local template search around each predicted landmark.
 
+#![allow(clippy::needless_range_loop)] // Dense small linear algebra reads best with indices.
+
 use crate::curvature::{vertex_curvatures_with, CurvatureOptions, VertexAdjacency};
 use crate::geom::{icp, kabsch, score, FitScore, Rigid, SurfaceIndex};
 use crate::model::GenericModel;
@@ -26,7 +28,7 @@ impl Default for DetectOptions {
         Self {
             mesh_units_per_model_unit: 1.0,
             min_confidence: 0.3,
-            max_nose_candidates: 6,
+            max_nose_candidates: 8,
             max_eye_candidates: 10,
         }
     }
@@ -128,150 +130,165 @@ pub fn detect_with(
         &adj,
         &CurvatureOptions::with_radius(p.curvature_radius),
     );
-    // Candidates.
-    let mut nose_c = Vec::new();
-    let mut eye_c = Vec::new();
-    for (v, c) in curv.iter().enumerate() {
-        let (si, cv) = (c.shape_index(), c.curvedness());
-        if si >= p.nose_min_shape_index && cv >= p.nose_min_curvedness {
-            nose_c.push((cv * (1.0 + si), v as u32));
-        }
-        if si <= p.eye_max_shape_index && cv >= p.eye_min_curvedness {
-            eye_c.push((cv * (1.0 - si), v as u32));
-        }
-    }
-    let noses = nms(
-        &idx,
-        nose_c,
-        p.candidate_radius,
-        options.max_nose_candidates,
-    );
-    let eyes = nms(&idx, eye_c, p.candidate_radius, options.max_eye_candidates);
-    if debug {
-        eprintln!(
-            "[{:.1} ms] candidates: noses {noses:?} eyes {eyes:?}",
-            clock.elapsed().as_secs_f64() * 1e3
-        );
-    }
-    if noses.is_empty() {
-        return Err(LandmarkError::NotFound {
-            reason: "no convex cap (nose-tip candidate) on the surface".into(),
-            best_score: 0.0,
-        });
-    }
-    // Pose hypotheses.
     use LandmarkName as L;
-    let d = model.eye_distance();
-    let m_nose = model.landmark(L::NoseTip);
-    let m_nn = DVec3::from_array(model.nose_normal);
-    let m_ir = model.landmark(L::InnerEyeRight);
-    let m_il = model.landmark(L::InnerEyeLeft);
-    let d_nr = (m_ir - m_nose).length();
-    let d_nl = (m_il - m_nose).length();
-    let mut hyps: Vec<Rigid> = Vec::new();
-    for &n in &noses {
-        let pn = idx.pos[n as usize];
-        let nn = curv[n as usize].normal;
-        let src_base = [m_nose, m_nose + m_nn * d];
-        let dst_base = [pn, pn + nn * d];
-        for (i, &ei) in eyes.iter().enumerate() {
-            let pi = idx.pos[ei as usize];
-            let di = (pi - pn).length();
-            // Pairs: nose, its normal and one inner corner (either side).
-            for (m_e, dm) in [(m_ir, d_nr), (m_il, d_nl)] {
-                if (di - dm).abs() > 0.35 * dm {
-                    continue;
-                }
-                let src = [src_base[0], src_base[1], m_e];
-                let dst = [dst_base[0], dst_base[1], pi];
-                if let Some(t) = kabsch(&src, &dst, Some(&[1.0, 0.5, 1.0])) {
-                    hyps.push(t);
-                }
+    let mut n_noses = 0;
+    let mut n_eyes = 0;
+    let mut overall: Option<Hypothesis> = None;
+    // Round 0 with the nominal candidates; round 1, only when round 0 found no convincing face
+    // (expressions can blur the curvature signatures), with three times more nose candidates
+    // and a looser signature gate.
+    for round in 0..2 {
+        let (max_noses, gate) = if round == 0 {
+            (options.max_nose_candidates, 9.0)
+        } else {
+            (3 * options.max_nose_candidates, 16.0)
+        };
+        // Candidates.
+        let mut nose_c = Vec::new();
+        let mut eye_c = Vec::new();
+        for (v, c) in curv.iter().enumerate() {
+            let (si, cv) = (c.shape_index(), c.curvedness());
+            // Candidates resemble the learned curvature signatures (within 3 sd on each axis).
+            let dn = p.nose.distance2(si, cv);
+            if dn < gate && si > 0.0 {
+                nose_c.push((-dn, v as u32));
             }
-            // Triplets: both inner corners.
-            for &ej in &eyes[i + 1..] {
-                let pj = idx.pos[ej as usize];
-                let dj = (pj - pn).length();
-                let dij = (pj - pi).length();
-                if (dij - d).abs() > 0.35 * d {
-                    continue;
-                }
-                for (a, b, da, db) in [(pi, pj, di, dj), (pj, pi, dj, di)] {
-                    if (da - d_nr).abs() > 0.35 * d_nr || (db - d_nl).abs() > 0.35 * d_nl {
+            let de = p.eye.distance2(si, cv);
+            if de < gate && si < 0.0 {
+                eye_c.push((-de, v as u32));
+            }
+        }
+        let noses = nms(&idx, nose_c, p.candidate_radius, max_noses);
+        let eyes = nms(&idx, eye_c, p.candidate_radius, options.max_eye_candidates);
+        n_noses = n_noses.max(noses.len());
+        n_eyes = n_eyes.max(eyes.len());
+        if debug {
+            eprintln!(
+                "[{:.1} ms] candidates: noses {noses:?} eyes {eyes:?}",
+                clock.elapsed().as_secs_f64() * 1e3
+            );
+        }
+        if noses.is_empty() {
+            continue;
+        }
+        // Pose hypotheses.
+        let d = model.eye_distance();
+        let m_nose = model.landmark(L::NoseTip);
+        let m_nn = DVec3::from_array(model.nose_normal);
+        let m_ir = model.landmark(L::InnerEyeRight);
+        let m_il = model.landmark(L::InnerEyeLeft);
+        let d_nr = (m_ir - m_nose).length();
+        let d_nl = (m_il - m_nose).length();
+        let mut hyps: Vec<Rigid> = Vec::new();
+        for &n in &noses {
+            let pn = idx.pos[n as usize];
+            let nn = curv[n as usize].normal;
+            let src_base = [m_nose, m_nose + m_nn * d];
+            let dst_base = [pn, pn + nn * d];
+            for (i, &ei) in eyes.iter().enumerate() {
+                let pi = idx.pos[ei as usize];
+                let di = (pi - pn).length();
+                let _ = di;
+                // Triplets: both inner corners.
+                for &ej in &eyes[i + 1..] {
+                    let pj = idx.pos[ej as usize];
+                    let dj = (pj - pn).length();
+                    let dij = (pj - pi).length();
+                    if (dij - d).abs() > 0.35 * d {
                         continue;
                     }
-                    let src = [src_base[0], src_base[1], m_ir, m_il];
-                    let dst = [dst_base[0], dst_base[1], a, b];
-                    if let Some(t) = kabsch(&src, &dst, Some(&[1.0, 0.5, 1.0, 1.0])) {
-                        hyps.push(t);
+                    for (a, b, da, db) in [(pi, pj, di, dj), (pj, pi, dj, di)] {
+                        if (da - d_nr).abs() > 0.35 * d_nr || (db - d_nl).abs() > 0.35 * d_nl {
+                            continue;
+                        }
+                        let src = [src_base[0], src_base[1], m_ir, m_il];
+                        let dst = [dst_base[0], dst_base[1], a, b];
+                        if let Some(t) = kabsch(&src, &dst, Some(&[1.0, 0.5, 1.0, 1.0])) {
+                            hyps.push(t);
+                        }
                     }
                 }
             }
-        }
-        // Without eye candidates: rotations about the nose normal.
-        if eyes.len() < 2 {
-            let base = kabsch(&src_base, &dst_base, None);
-            if let Some(b) = base {
-                for k in 0..12 {
-                    let ang = k as f64 * std::f64::consts::TAU / 12.0;
+            // Rotations about the nose normal: pose hypotheses that need no eye candidate (eye
+            // corners are weak features under expressions).
+            if let Some(b) = kabsch(&src_base, &dst_base, None) {
+                for k in 0..16 {
+                    let ang = k as f64 * std::f64::consts::TAU / 16.0;
                     let r = DMat3::from_axis_angle(nn, ang);
                     let spin = Rigid { r, t: pn - r * pn };
                     hyps.push(spin.compose(&b));
                 }
             }
         }
-    }
-    let face = model.face.pairs();
-    let tau = p.inlier_distance;
-    let coarse: Vec<(DVec3, DVec3)> = face.iter().step_by(4).copied().collect();
-    let mut scored: Vec<Hypothesis> = hyps
-        .iter()
-        .map(|t| Hypothesis {
-            t: *t,
-            fit: score(&idx, &coarse, t, 3.0 * tau, 0.3),
-        })
-        .collect();
-    scored.sort_by(|a, b| a.fit.cost.total_cmp(&b.fit.cost));
-    if debug {
-        eprintln!(
-            "[{:.1} ms] {} hypotheses, best coarse costs {:?}",
-            clock.elapsed().as_secs_f64() * 1e3,
-            scored.len(),
-            scored
-                .iter()
-                .take(6)
-                .map(|h| h.fit.cost)
-                .collect::<Vec<_>>()
-        );
-    }
-    scored.truncate(6);
-    let mut best: Option<Hypothesis> = None;
-    for h in &scored {
-        // Coarse to fine: wide inlier band first, then the nominal one.
-        let t1 = icp(&idx, &coarse, &h.t, 10, 3.0 * tau, 0.3);
-        let t2 = icp(&idx, &face, &t1, 15, tau, 0.5);
-        let fit = score(&idx, &face, &t2, tau, 0.5);
-        if best.as_ref().is_none_or(|b| fit.cost < b.fit.cost) {
-            best = Some(Hypothesis { t: t2, fit });
+        let face = model.face.pairs();
+        let tau = p.inlier_distance;
+        let coarse: Vec<(DVec3, DVec3)> = face.iter().step_by(3).copied().collect();
+        let mut scored: Vec<Hypothesis> = hyps
+            .iter()
+            .map(|t| Hypothesis {
+                t: *t,
+                fit: score(&idx, &coarse, t, 3.0 * tau, 0.3),
+            })
+            .collect();
+        scored.sort_by(|a, b| a.fit.cost.total_cmp(&b.fit.cost));
+        if debug {
+            eprintln!(
+                "[{:.1} ms] {} hypotheses, best coarse costs {:?}",
+                clock.elapsed().as_secs_f64() * 1e3,
+                scored.len(),
+                scored
+                    .iter()
+                    .take(6)
+                    .map(|h| h.fit.cost)
+                    .collect::<Vec<_>>()
+            );
+        }
+        scored.truncate(12);
+        // Coarse ICP of the best hypotheses with a wide inlier band, then the nominal band on the
+        // best three.
+        let mut coarse_fits: Vec<Hypothesis> = scored
+            .iter()
+            .map(|h| {
+                let t = icp(&idx, &coarse, &h.t, 8, 3.0 * tau, 0.3);
+                Hypothesis {
+                    t,
+                    fit: score(&idx, &coarse, &t, tau, 0.5),
+                }
+            })
+            .collect();
+        coarse_fits.sort_by(|a, b| a.fit.cost.total_cmp(&b.fit.cost));
+        coarse_fits.truncate(3);
+        let mut best: Option<Hypothesis> = None;
+        for h in &coarse_fits {
+            let t2 = icp(&idx, &face, &h.t, 12, tau, 0.5);
+            let fit = score(&idx, &face, &t2, tau, 0.5);
+            if best.as_ref().is_none_or(|b| fit.cost < b.fit.cost) {
+                best = Some(Hypothesis { t: t2, fit });
+            }
+        }
+        if let Some(b) = best {
+            if overall.as_ref().is_none_or(|o| b.fit.cost < o.fit.cost) {
+                overall = Some(b);
+            }
+        }
+        if let Some(o) = &overall {
+            if fit_confidence(&o.fit, p.typical_rms, p.typical_inliers) >= 0.85 {
+                break;
+            }
         }
     }
-    let Some(best) = best else {
+    let Some(best) = overall else {
         return Err(LandmarkError::NotFound {
-            reason: format!(
-                "{} nose-tip and {} eye-corner candidates form no face-like configuration",
-                noses.len(),
-                eyes.len()
-            ),
+            reason: if n_noses == 0 {
+                "no convex cap (nose-tip candidate) on the surface".into()
+            } else {
+                format!(
+                    "{n_noses} nose-tip and {n_eyes} eye-corner candidates form no face-like configuration"
+                )
+            },
             best_score: 0.0,
         });
     };
-    if debug {
-        eprintln!(
-            "[{:.1} ms] best fit {:?}",
-            clock.elapsed().as_secs_f64() * 1e3,
-            best.fit
-        );
-    }
     let conf_fit = fit_confidence(&best.fit, p.typical_rms, p.typical_inliers);
     if conf_fit < options.min_confidence {
         return Err(LandmarkError::NotFound {
@@ -292,7 +309,14 @@ pub fn detect_with(
     for name in L::ALL {
         let pred = best.t.apply(model.landmark(name));
         let tpl = model.patches[name as usize].pairs();
-        let (v, cost) = refine(&idx, &tpl, &best.t, pred, p.search_radius, tau);
+        // The nose tip is a strong feature but far from the eyes that dominate the pose: wider
+        // search.
+        let radius = if name == L::NoseTip {
+            2.0 * p.search_radius
+        } else {
+            p.search_radius
+        };
+        let (v, cost) = refine(&idx, &tpl, &best.t, pred, radius, p.inlier_distance);
         if debug {
             eprintln!(
                 "{name}: predicted at {:?} (vertex {}), refined to vertex {v} (cost {cost:.2e})",

@@ -1,6 +1,8 @@
 //! Small geometric helpers: symmetric eigen-decomposition, weighted Kabsch/Horn fit, nearest
 //! vertex queries with a point-to-surface approximation, point-to-plane ICP.
 
+#![allow(clippy::needless_range_loop)] // Dense small linear algebra reads best with indices.
+
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use meshcore::{DMat3, DQuat, DVec3};
 

@@ -1,6 +1,8 @@
 //! The generic face model: mean landmark configuration, a mean face surface sample and local
 //! surface templates around each landmark, in a canonical frame; learned from training faces.
 
+#![allow(clippy::needless_range_loop)] // Dense small linear algebra reads best with indices.
+
 use crate::curvature::{vertex_curvatures, CurvatureOptions};
 use crate::geom::{kabsch, Rigid};
 use crate::{LandmarkError, LandmarkName};
@@ -21,6 +23,8 @@ pub struct TrainOptions {
     pub face_spacing: f64,
     /// Radius of the mean face sample around the nose tip / d.
     pub face_radius: f64,
+    /// How far below the nose tip the face template reaches / d.
+    pub face_below: f64,
     /// Radius of the landmark templates / d.
     pub patch_radius: f64,
     /// Grid spacing of the landmark templates / d.
@@ -35,6 +39,7 @@ impl Default for TrainOptions {
             curvature_radius: 0.3,
             face_spacing: 0.17,
             face_radius: 2.2,
+            face_below: 0.4,
             patch_radius: 0.3,
             patch_spacing: 0.05,
             min_coverage: 0.6,
@@ -47,14 +52,10 @@ impl Default for TrainOptions {
 pub struct DetectParams {
     /// Curvature fitting radius.
     pub curvature_radius: f64,
-    /// Minimum shape index of nose-tip candidates.
-    pub nose_min_shape_index: f64,
-    /// Minimum curvedness of nose-tip candidates.
-    pub nose_min_curvedness: f64,
-    /// Maximum shape index of inner-eye-corner candidates.
-    pub eye_max_shape_index: f64,
-    /// Minimum curvedness of inner-eye-corner candidates.
-    pub eye_min_curvedness: f64,
+    /// Curvature signature of the nose tip on training faces.
+    pub nose: Signature,
+    /// Curvature signature of the inner eye corners on training faces.
+    pub eye: Signature,
     /// Non-maximum suppression radius of candidates.
     pub candidate_radius: f64,
     /// Inlier distance of the surface fits.
@@ -65,6 +66,45 @@ pub struct DetectParams {
     pub typical_rms: f64,
     /// Typical inlier share of the face fit on training faces.
     pub typical_inliers: f64,
+}
+
+/// Mean and spread of the shape index and of the log-curvedness of a landmark on training faces.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Signature {
+    /// Mean shape index.
+    pub shape_index: f64,
+    /// Its standard deviation (floored at 0.08).
+    pub shape_index_sd: f64,
+    /// Mean of `ln(curvedness)`.
+    pub log_curvedness: f64,
+    /// Its standard deviation (floored at 0.25).
+    pub log_curvedness_sd: f64,
+}
+
+impl Signature {
+    fn learn(s: &[f64], c: &[f64]) -> Self {
+        let ms = |v: &[f64]| {
+            let m = v.iter().sum::<f64>() / v.len().max(1) as f64;
+            let var = v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / v.len().max(1) as f64;
+            (m, var.sqrt())
+        };
+        let lc: Vec<f64> = c.iter().map(|x| x.max(1e-12).ln()).collect();
+        let (a, b) = ms(s);
+        let (e, f) = ms(&lc);
+        Self {
+            shape_index: a,
+            shape_index_sd: b.max(0.08),
+            log_curvedness: e,
+            log_curvedness_sd: f.max(0.25),
+        }
+    }
+
+    /// Squared normalised distance of a (shape index, curvedness) pair to the signature.
+    pub fn distance2(&self, shape_index: f64, curvedness: f64) -> f64 {
+        let a = (shape_index - self.shape_index) / self.shape_index_sd;
+        let b = (curvedness.max(1e-12).ln() - self.log_curvedness) / self.log_curvedness_sd;
+        a * a + b * b
+    }
 }
 
 /// Surface template: points and unit normals in the canonical frame.
@@ -410,26 +450,41 @@ impl GenericModel {
             }
             mean = acc.iter().map(|a| *a / faces.len() as f64).collect();
         }
-        // Canonical frame of the mean.
+        // Canonical frame of the mean: x from right to left outer eye corner, z forward (mean
+        // area-weighted surface normal around the nose in the aligned faces), y = z × x.
         use LandmarkName as L;
         let nose = mean[L::NoseTip as usize];
         let x = (mean[L::OuterEyeLeft as usize] - mean[L::OuterEyeRight as usize]).normalize();
-        let eyes_mid = mean[..4].iter().copied().sum::<DVec3>() / 4.0;
-        let up = eyes_mid - nose;
-        let y = (up - x * up.dot(x)).normalize();
-        let z = x.cross(y);
+        let d0 = (mean[L::InnerEyeLeft as usize] - mean[L::InnerEyeRight as usize]).length();
+        let mut fwd = DVec3::ZERO;
+        for (k, (mesh, _)) in faces.iter().enumerate() {
+            for f in 0..mesh.n_faces() as u32 {
+                let [a, b, c] = mesh.face_corners(f);
+                let g = aligns[k].apply((a + b + c) / 3.0);
+                if (g - nose).length() < 2.0 * d0 {
+                    fwd += aligns[k].rotate(mesh.face_cross(f));
+                }
+            }
+        }
+        let z = (fwd - x * fwd.dot(x)).normalize();
+        let y = z.cross(x);
         if !(x.is_finite() && y.is_finite() && z.is_finite()) {
             return Err(LandmarkError::InvalidTraining(
-                "degenerate mean landmark configuration".into(),
+                "degenerate mean landmark configuration or no surface around the nose".into(),
             ));
         }
+        // Eyes above the nose (y up); if not, the surface normals point into the head.
+        let eyes_mid = mean[..4].iter().copied().sum::<DVec3>() / 4.0;
+        if (eyes_mid - nose).dot(y) <= 0.0 {
+            return Err(LandmarkError::InvalidTraining(
+                "eyes below the nose in the normal-based frame: training meshes need outward normals"
+                    .into(),
+            ));
+        }
+        let rot = meshcore::DMat3::from_cols(x, y, z).transpose();
         let to_canon = Rigid {
-            r: meshcore::DMat3::from_cols(x, y, z).transpose(),
-            t: DVec3::ZERO,
-        };
-        let to_canon = Rigid {
-            r: to_canon.r,
-            t: -(to_canon.r * nose),
+            r: rot,
+            t: -(rot * nose),
         };
         let canon: Vec<DVec3> = mean.iter().map(|p| to_canon.apply(*p)).collect();
         let aligns: Vec<Rigid> = aligns.iter().map(|a| to_canon.compose(a)).collect();
@@ -470,7 +525,10 @@ impl GenericModel {
                 eye_c.push(curv[ve].curvedness());
             }
         }
-        let face = face_acc.template(opt.min_coverage, DVec3::ZERO);
+        // The face template keeps the upper face (above the upper lip: nose, eyes, cheeks,
+        // forehead), which moves little with expressions.
+        let mut face = face_acc.template(opt.min_coverage, DVec3::ZERO);
+        face.points.retain(|p| p[1] > -opt.face_below * d);
         let patches: Vec<Template> = patch_acc
             .iter()
             .zip(&canon)
@@ -481,12 +539,10 @@ impl GenericModel {
             .collect();
         let params = DetectParams {
             curvature_radius: rho,
-            nose_min_shape_index: (quantile(&mut nose_s, 0.0) - 0.15).max(0.0),
-            nose_min_curvedness: 0.5 * quantile(&mut nose_c, 0.0),
-            eye_max_shape_index: (quantile(&mut eye_s, 1.0) + 0.15).min(0.5),
-            eye_min_curvedness: 0.5 * quantile(&mut eye_c, 0.0),
+            nose: Signature::learn(&nose_s, &nose_c),
+            eye: Signature::learn(&eye_s, &eye_c),
             candidate_radius: 0.25 * d,
-            inlier_distance: 0.06 * d,
+            inlier_distance: 0.1 * d,
             search_radius: 0.25 * d,
             typical_rms: 0.02 * d,
             typical_inliers: 0.9,

@@ -103,7 +103,7 @@ fn detections_follow_rigid_motions_and_match_the_truth() {
                 let p = lm.get(n).position;
                 let back = t.inverse().transform_point3(p);
                 let err = (back - gt[n as usize]).length();
-                assert!(err < 0.5, "{name} motion {k} {n}: {err} cm from the truth");
+                assert!(err < 0.8, "{name} motion {k} {n}: {err} cm from the truth");
                 // Same vertex (or a neighbour at worst) as without motion.
                 let d = (back - base.get(n).position).length();
                 assert!(d < 0.35, "{name} motion {k} {n}: moved by {d} cm");
