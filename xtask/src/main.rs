@@ -3,6 +3,8 @@
 use clap::{Parser, Subcommand};
 
 mod experiments;
+mod facemodel;
+mod landmarks_eval;
 mod robustness;
 
 /// Experiments and evaluations of the bipolar workspace.
@@ -22,7 +24,7 @@ enum Task {
     /// Identification/verification benchmark on sampled faces (issue 7).
     Recognition,
     /// Landmark detection accuracy on sampled faces (issue 6).
-    LandmarksEval,
+    LandmarksEval(landmarks_eval::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -31,6 +33,6 @@ fn main() -> anyhow::Result<()> {
         Task::SphereValidate => anyhow::bail!("sphere-validate is not implemented yet (issue 4)"),
         Task::Robustness(args) => robustness::run(args),
         Task::Recognition => anyhow::bail!("recognition is not implemented yet (issue 7)"),
-        Task::LandmarksEval => anyhow::bail!("landmarks-eval is not implemented yet (issue 6)"),
+        Task::LandmarksEval(args) => landmarks_eval::run(args),
     }
 }
