@@ -249,11 +249,7 @@ impl Topology {
             }
             let mut lp = vec![s];
             let mut cur = s;
-            loop {
-                let Some(list) = next.get_mut(&cur) else {
-                    break;
-                };
-                let Some(n) = list.pop() else { break };
+            while let Some(n) = next.get_mut(&cur).and_then(|list| list.pop()) {
                 if n == s {
                     break;
                 }
