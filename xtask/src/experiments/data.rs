@@ -83,13 +83,14 @@ pub struct Face {
     pub landmarks: FaceLandmarks,
 }
 
-/// Reads a triangle mesh from a file (`mesh-io` once it lands; now a minimal OBJ reader).
+/// Reads a triangle mesh from a file with `mesh-io` (warnings are ignored here).
 pub fn read_mesh(path: &Path) -> Result<TriMesh> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    parse_obj(&text).with_context(|| format!("parsing {}", path.display()))
+    Ok(mesh_io::read_mesh(path)
+        .with_context(|| format!("reading {}", path.display()))?
+        .mesh)
 }
 
+#[allow(dead_code)] // kept as the reference reader of the tests
 /// Minimal OBJ parser: `v x y z` and `f a b c ...` (1-based or negative indices, `a/b/c`
 /// tokens, polygons fan-triangulated). Everything else is ignored.
 pub fn parse_obj(text: &str) -> Result<TriMesh> {

@@ -51,36 +51,127 @@ pub fn field_at(mesh: &TriMesh, u: &[f64], sp: &SurfacePoint) -> f64 {
     sp.bary.x * u[t[0] as usize] + sp.bary.y * u[t[1] as usize] + sp.bary.z * u[t[2] as usize]
 }
 
-/// The bipolar descriptor of a configuration at `n` levels between the references.
-pub fn bipolar(mesh: &TriMesh, refs: &Refs, n: u32, region: Region) -> KeyedPoints {
-    let step = refs.d / f64::from(n);
-    match region {
-        Region::Static => {
-            let mask = static_mask(mesh, &refs.ur, &refs.uq, refs.d, &refs.frame, refs.nose);
-            bipolar_grid(
-                mesh,
-                &refs.ur,
-                &refs.uq,
-                &GridOptions { step, max_level: n },
-                Some(&mask),
-            )
-        }
-        Region::Whole => bipolar_grid(
-            mesh,
-            &refs.ur,
-            &refs.uq,
-            &GridOptions {
-                step,
-                max_level: 2 * n,
-            },
-            None,
-        ),
+/// Which implementation builds the bipolar descriptor.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum DescriptorImpl {
+    /// The `bipolar` crate, every intersection of the two level families (rule `All`, keys
+    /// `(i, j, side)`): the grid reading of the paper.
+    CrateAll,
+    /// The `bipolar` crate, exact iso-angle points (rule B, keys `(i, k, side, sign)`), K = 8,
+    /// alpha = 0.95, gradient tangents.
+    CrateIsoAngle,
+    /// The local grid implementation of `experiments::descriptor` (cross-check).
+    Local,
+}
+
+static DESCRIPTOR_IMPL: std::sync::atomic::AtomicU8 = std::sync::atomic::AtomicU8::new(0);
+static CRATE_FAILURES: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+/// Selects the descriptor implementation for the whole process.
+pub fn set_descriptor_impl(d: DescriptorImpl) {
+    DESCRIPTOR_IMPL.store(d as u8, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// The selected descriptor implementation.
+pub fn descriptor_impl() -> DescriptorImpl {
+    match DESCRIPTOR_IMPL.load(std::sync::atomic::Ordering::Relaxed) {
+        0 => DescriptorImpl::CrateAll,
+        1 => DescriptorImpl::CrateIsoAngle,
+        _ => DescriptorImpl::Local,
     }
 }
 
-/// Keyed distance (NaN when fewer than 3 keys are shared).
+/// Number of descriptors the crate could not build (they count as empty descriptors).
+pub fn crate_failures() -> usize {
+    CRATE_FAILURES.load(std::sync::atomic::Ordering::Relaxed)
+}
+
+/// Converts a crate descriptor to a keyed set (sorted by packed key; a key found twice is
+/// ambiguous).
+pub fn from_crate(d: &bipolar::Descriptor) -> KeyedPoints {
+    let mut v: Vec<(u64, DVec3, bool)> = d
+        .points
+        .iter()
+        .map(|p| (p.key.pack(), p.position, p.ambiguous))
+        .collect();
+    v.sort_by(|a, b| {
+        a.0.cmp(&b.0)
+            .then(a.1.x.total_cmp(&b.1.x))
+            .then(a.1.y.total_cmp(&b.1.y))
+    });
+    let mut out = KeyedPoints::default();
+    for (k, p, amb) in v {
+        if out.keys.last() == Some(&k) {
+            if let Some(last) = out.ambiguous.last_mut() {
+                *last = true;
+            }
+            continue;
+        }
+        out.keys.push(k);
+        out.points.push(p);
+        out.ambiguous.push(amb);
+    }
+    out
+}
+
+/// The bipolar descriptor of a configuration at `n` levels between the references (step
+/// `D / n`; static region: levels up to n with the static mask; whole: levels up to 2n).
+pub fn bipolar(mesh: &TriMesh, refs: &Refs, n: u32, region: Region) -> KeyedPoints {
+    let step = refs.d / f64::from(n);
+    let (max_level, mask) = match region {
+        Region::Static => (
+            n,
+            Some(static_mask(
+                mesh,
+                &refs.ur,
+                &refs.uq,
+                refs.d,
+                &refs.frame,
+                refs.nose,
+            )),
+        ),
+        Region::Whole => (2 * n, None),
+    };
+    let imp = descriptor_impl();
+    if imp == DescriptorImpl::Local {
+        return bipolar_grid(
+            mesh,
+            &refs.ur,
+            &refs.uq,
+            &GridOptions { step, max_level },
+            mask.as_deref(),
+        );
+    }
+    let opts = bipolar::DescriptorOptions {
+        levels: bipolar::LevelSpec::Step(step),
+        max_level: Some(max_level),
+        vertex_mask: mask,
+        rule: if imp == DescriptorImpl::CrateAll {
+            bipolar::SelectionRule::All
+        } else {
+            bipolar::SelectionRule::IsoAngle
+        },
+        ..Default::default()
+    };
+    let topo = meshcore::Topology::new(mesh);
+    match bipolar::describe_fields(mesh, &topo, &[refs.ur.clone(), refs.uq.clone()], &opts) {
+        Ok(d) => from_crate(&d),
+        Err(_) => {
+            CRATE_FAILURES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            KeyedPoints::default()
+        }
+    }
+}
+
+/// Keyed distance (NaN when fewer than 3 keys are shared): `shapedist::keyed_distance`
+/// (Kabsch closed form, no gate) on the unambiguous points.
 pub fn dist(a: &KeyedPoints, b: &KeyedPoints) -> f64 {
-    keyed_distance(a, b).map_or(f64::NAN, |k| k.distance)
+    let (ka, pa) = a.unambiguous();
+    let (kb, pb) = b.unambiguous();
+    match shapedist::keyed_distance(&ka, &pa, &kb, &pb, &shapedist::KeyedOptions::default()) {
+        Ok(k) => k.distance,
+        Err(_) => keyed_distance(a, b).map_or(f64::NAN, |k| k.distance),
+    }
 }
 
 /// Symmetric pairwise distance matrix (rayon over pairs).

@@ -58,6 +58,27 @@ impl Report {
         write_csv(&self.path(name), header, rows)
     }
 
+    /// Writes a PNG twin of every SVG of the folder (rasterised by `viz::svg_to_png`, in
+    /// parallel); returns how many were written.
+    pub fn png_twins(&self) -> Result<usize> {
+        use rayon::prelude::*;
+        let mut svgs: Vec<PathBuf> = std::fs::read_dir(&self.dir)?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x == "svg"))
+            .collect();
+        svgs.sort();
+        svgs.par_iter()
+            .map(|p| -> Result<()> {
+                let svg = std::fs::read_to_string(p)?;
+                let png = viz::svg_to_png(&svg)
+                    .with_context(|| format!("rasterising {}", p.display()))?;
+                std::fs::write(p.with_extension("png"), png)?;
+                Ok(())
+            })
+            .collect::<Result<Vec<()>>>()?;
+        Ok(svgs.len())
+    }
+
     /// Writes `report.md` and returns its path.
     pub fn finish(&self) -> Result<PathBuf> {
         let p = self.path("report.md");
