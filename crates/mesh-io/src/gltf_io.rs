@@ -116,6 +116,7 @@ struct Collect {
     colors: Vec<[u8; 4]>,
     all_colored: bool,
     skipped: usize,
+    visits: usize,
 }
 
 fn add_primitive(
@@ -250,10 +251,11 @@ fn visit(
     file: &str,
     c: &mut Collect,
 ) -> Result<(), IoError> {
-    if depth > 64 {
+    c.visits += 1;
+    if depth > 64 || c.visits > 100_000 {
         return Err(IoError::whole(
             file,
-            "node hierarchy deeper than 64 levels (cycle?)",
+            "node hierarchy deeper than 64 levels or with more than 100000 node visits (cycle or shared nodes?)",
         ));
     }
     let local = node.transform().matrix();
@@ -287,6 +289,7 @@ pub(crate) fn read_gltf(
         colors: Vec::new(),
         all_colored: true,
         skipped: 0,
+        visits: 0,
     };
     match doc.default_scene().or_else(|| doc.scenes().next()) {
         Some(scene) => {

@@ -475,7 +475,45 @@ fn read_binary(
             "face" => {
                 let li = face_list_index(el, file)?;
                 sink.tris.reserve(el.count);
+                sink.tri_at.reserve(el.count);
+                // Fast path for the common layout `list uchar int|uint vertex_indices` alone:
+                // triangles are 13-byte records.
+                let fast = el.props.len() == 1
+                    && matches!(el.props[0], Prop::List(Ty::U8, Ty::I32 | Ty::U32, _));
                 for _ in 0..el.count {
+                    if fast && off + 13 <= bytes.len() && bytes[off] == 3 {
+                        let rd = |o: usize| {
+                            let a = [bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]];
+                            if be {
+                                u32::from_be_bytes(a)
+                            } else {
+                                u32::from_le_bytes(a)
+                            }
+                        };
+                        let t = [rd(off + 1), rd(off + 5), rd(off + 9)];
+                        let signed = matches!(el.props[0], Prop::List(_, Ty::I32, _));
+                        if let Some(k) = t
+                            .iter()
+                            .position(|&v| (signed && (v as i32) < 0) || v >= u32::MAX - 1)
+                        {
+                            return Err(IoError::byte(
+                                file,
+                                off + 1 + 4 * k,
+                                format!(
+                                    "invalid vertex index {}",
+                                    if signed {
+                                        t[k] as i64 as i32 as i64
+                                    } else {
+                                        t[k] as i64
+                                    }
+                                ),
+                            ));
+                        }
+                        sink.tris.push(t);
+                        sink.tri_at.push(off);
+                        off += 13;
+                        continue;
+                    }
                     for (k, prop) in el.props.iter().enumerate() {
                         match prop {
                             Prop::Scalar(ty, _) => {
@@ -520,6 +558,7 @@ fn read_binary(
                     }
                 }
             }
+            _ if el.props.is_empty() => {}
             _ => {
                 for _ in 0..el.count {
                     for prop in &el.props {

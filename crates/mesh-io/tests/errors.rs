@@ -248,3 +248,17 @@ fn npy_synthetic_f4_and_f8() {
     let e = mesh_io::parse_npy_f32(&f, "a.npy").unwrap_err();
     assert!(e.to_string().contains("Fortran"), "{e}");
 }
+
+#[test]
+fn ply_element_without_properties_and_huge_count_does_not_hang() {
+    let mut b = b"ply\nformat binary_little_endian 1.0\nelement nothing 18446744073709551615\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n".to_vec();
+    for v in [0f32, 0., 0., 1., 0., 0., 0., 1., 0.] {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    b.push(3);
+    for i in [0i32, 1, 2] {
+        b.extend_from_slice(&i.to_le_bytes());
+    }
+    let m = read_mesh_from_bytes(&b, Format::Ply).unwrap();
+    assert_eq!(m.mesh.n_faces(), 1);
+}
