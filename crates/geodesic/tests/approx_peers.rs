@@ -124,10 +124,8 @@ fn peer_comparison() {
             .iter()
             .map(|v| v.normalize().dot(p).clamp(-1.0, 1.0).acos())
             .collect();
-        let exact = load_txt(
-            &dir.join("out")
-                .join(format!("{name}_s{src}_exact_gdist.txt")),
-        );
+        let out = dir.join(std::env::var("GEODESIC_PEERS_OUT").unwrap_or_else(|_| "out".into()));
+        let exact = load_txt(&out.join(format!("{name}_s{src}_exact_gdist.txt")));
         let vs_exact = |d: &[f64]| {
             exact
                 .as_ref()
@@ -140,7 +138,7 @@ fn peer_comparison() {
                 .unwrap_or(f64::NAN)
         };
         for peer in ["fmm_pp3d", "heat_igl"] {
-            if let Some(d) = load_txt(&dir.join("out").join(format!("{name}_s{src}_{peer}.txt"))) {
+            if let Some(d) = load_txt(&out.join(format!("{name}_s{src}_{peer}.txt"))) {
                 let e = errors(&d, &g);
                 println!(
                     "| {case} | {} | {peer} (peer, errors only) | | | | {:.2e} | {:.2e} | {:.2e} | {:.1e} |",
