@@ -6,6 +6,7 @@ mod experiments;
 mod facemodel;
 mod landmarks_eval;
 mod robustness;
+mod sphere_validate;
 
 /// Experiments and evaluations of the bipolar workspace.
 #[derive(Debug, Parser)]
@@ -18,7 +19,7 @@ struct Cli {
 #[derive(Debug, Subcommand)]
 enum Task {
     /// The paper's section 3: the descriptor on a sphere against analytic curves (issue 4).
-    SphereValidate,
+    SphereValidate(sphere_validate::Args),
     /// The paper's sections 4-6 on the face set (issue 7).
     Robustness(robustness::Args),
     /// Identification/verification benchmark on sampled faces (issue 7).
@@ -30,7 +31,7 @@ enum Task {
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
     match cli.task {
-        Task::SphereValidate => anyhow::bail!("sphere-validate is not implemented yet (issue 4)"),
+        Task::SphereValidate(args) => sphere_validate::run(args),
         Task::Robustness(args) => robustness::run(args),
         Task::Recognition => anyhow::bail!("recognition is not implemented yet (issue 7)"),
         Task::LandmarksEval(args) => landmarks_eval::run(args),
