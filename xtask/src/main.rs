@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand};
 mod experiments;
 mod facemodel;
 mod landmarks_eval;
+mod recognition;
 mod robustness;
 mod sphere_validate;
 
@@ -23,7 +24,7 @@ enum Task {
     /// The paper's sections 4-6 on the face set (issue 7).
     Robustness(robustness::Args),
     /// Identification/verification benchmark on sampled faces (issue 7).
-    Recognition,
+    Recognition(recognition::Args),
     /// Landmark detection accuracy on sampled faces (issue 6).
     LandmarksEval(landmarks_eval::Args),
 }
@@ -33,7 +34,7 @@ fn main() -> anyhow::Result<()> {
     match cli.task {
         Task::SphereValidate(args) => sphere_validate::run(args),
         Task::Robustness(args) => robustness::run(args),
-        Task::Recognition => anyhow::bail!("recognition is not implemented yet (issue 7)"),
+        Task::Recognition(args) => recognition::run(args),
         Task::LandmarksEval(args) => landmarks_eval::run(args),
     }
 }

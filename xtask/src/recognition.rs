@@ -1,0 +1,558 @@
+//! `cargo xtask recognition`: identification and verification on faces sampled from the ICT
+//! face model, for the bipolar descriptor, the single-pole descriptor and ICP on the raw meshes,
+//! each with ground-truth and with detected landmarks.
+//!
+//! N identities x M expressions are sampled (seeded); expression 0 of every identity is the
+//! neutral face and forms the gallery, the M - 1 others are the probes. Every face is moved by
+//! a random rigid motion, so nothing can rely on a shared frame. Scores are distances (lower =
+//! more similar): rank-1 identification rate over the probes, verification EER over all
+//! probe x gallery pairs, and the ROC curve. Results: `report.md`, `summary.json`, `roc.svg`,
+//! CSV tables, in the output folder printed on the last line.
+
+use crate::experiments::data::default_out_dir;
+use crate::experiments::descriptor::{best_rotation, KeyedPoints};
+use crate::experiments::pipeline::{bar, bipolar, dist, resolve_methods, Refs, Region};
+use crate::experiments::polar::{polar_descriptor, PolarOptions, Pole};
+use crate::experiments::report::{f4, line_plot, Report, Series};
+use crate::experiments::segment::face_frame;
+use crate::experiments::walk::Walker;
+use crate::facemodel::{default_model_dir, random_rigid_motion, FaceModel};
+use anyhow::{bail, Context, Result};
+use geodesic::{Method, SolveOptions, Source};
+use meshcore::{DVec3, FaceLocator, TriMesh};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Arguments of `cargo xtask recognition`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct Args {
+    /// Number of sampled identities.
+    #[arg(long, default_value_t = 50)]
+    pub identities: usize,
+    /// Faces per identity (the first is neutral and goes to the gallery).
+    #[arg(long, default_value_t = 6)]
+    pub expressions: usize,
+    /// Seed of the sampling.
+    #[arg(long, default_value_t = 7)]
+    pub seed: u64,
+    /// Geodesic method (exact falls back to fmm, then heat, if unavailable).
+    #[arg(long, default_value = "exact")]
+    pub method: String,
+    /// Levels between the reference points.
+    #[arg(long, default_value_t = 10)]
+    pub levels: u32,
+    /// Sectors of the single-pole descriptor.
+    #[arg(long, default_value_t = 16)]
+    pub sectors: u32,
+    /// Probe vertices used by ICP (evenly strided).
+    #[arg(long, default_value_t = 200)]
+    pub icp_points: usize,
+    /// ICT model folder (default `$BIPOLAR_SHARED/faces/ict-facekit/model`).
+    #[arg(long)]
+    pub model: Option<PathBuf>,
+    /// Output folder (default `target/recognition`).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+/// One sampled face.
+#[derive(Debug)]
+struct Sample {
+    identity: usize,
+    index: usize,
+    mesh: TriMesh,
+}
+
+/// Three reference vertices of a face.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Lm {
+    r: u32,
+    q: u32,
+    nose: u32,
+}
+
+/// Per face and landmark set: descriptors and landmark positions.
+#[derive(Debug, Clone)]
+struct Described {
+    bip: KeyedPoints,
+    pol: KeyedPoints,
+    lm_pos: [DVec3; 3],
+}
+
+/// Identification/verification figures of one score matrix.
+#[derive(Debug, Clone, serde::Serialize)]
+struct Metrics {
+    descriptor: String,
+    landmarks: String,
+    rank1: f64,
+    eer: f64,
+    genuine_mean: f64,
+    impostor_mean: f64,
+    failures: usize,
+    #[serde(skip)]
+    roc: Vec<(f64, f64)>,
+}
+
+/// Rank-1 rate, EER and ROC from a probes x gallery score matrix (NaN = failure = worst).
+fn metrics(
+    scores: &[Vec<f64>],
+    probe_id: &[usize],
+    gallery_id: &[usize],
+) -> (f64, f64, Vec<(f64, f64)>, f64, f64, usize) {
+    let mut correct = 0usize;
+    let mut gen = Vec::new();
+    let mut imp = Vec::new();
+    let mut failures = 0;
+    for (p, row) in scores.iter().enumerate() {
+        let clean: Vec<f64> = row
+            .iter()
+            .map(|v| if v.is_finite() { *v } else { f64::INFINITY })
+            .collect();
+        failures += row.iter().filter(|v| !v.is_finite()).count();
+        let best = (0..clean.len()).min_by(|&a, &b| clean[a].total_cmp(&clean[b]).then(a.cmp(&b)));
+        if best.is_some_and(|b| gallery_id[b] == probe_id[p] && clean[b].is_finite()) {
+            correct += 1;
+        }
+        for (g, v) in clean.iter().enumerate() {
+            if gallery_id[g] == probe_id[p] {
+                gen.push(*v);
+            } else {
+                imp.push(*v);
+            }
+        }
+    }
+    let rank1 = correct as f64 / scores.len().max(1) as f64;
+    let (eer, roc) = eer_roc(&gen, &imp);
+    let fmean = |v: &[f64]| {
+        let f: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+        f.iter().sum::<f64>() / f.len().max(1) as f64
+    };
+    (rank1, eer, roc, fmean(&gen), fmean(&imp), failures)
+}
+
+/// Equal error rate and ROC points (false accept rate, true accept rate) for distance scores:
+/// a pair is accepted when its score is <= the threshold.
+fn eer_roc(gen: &[f64], imp: &[f64]) -> (f64, Vec<(f64, f64)>) {
+    let mut thr: Vec<f64> = gen
+        .iter()
+        .chain(imp)
+        .copied()
+        .filter(|x| x.is_finite())
+        .collect();
+    thr.sort_by(f64::total_cmp);
+    thr.dedup();
+    let mut g = gen.to_vec();
+    let mut i = imp.to_vec();
+    g.sort_by(f64::total_cmp);
+    i.sort_by(f64::total_cmp);
+    let frac_le = |v: &[f64], t: f64| v.partition_point(|x| *x <= t) as f64 / v.len().max(1) as f64;
+    let mut roc = vec![(0.0, 0.0)];
+    let mut eer = 1.0;
+    let mut best_gap = f64::INFINITY;
+    for &t in &thr {
+        let far = frac_le(&i, t);
+        let tar = frac_le(&g, t);
+        roc.push((far, tar));
+        let frr = 1.0 - tar;
+        let gap = (far - frr).abs();
+        if gap < best_gap {
+            best_gap = gap;
+            eer = 0.5 * (far + frr);
+        }
+    }
+    roc.push((1.0, 1.0));
+    (eer, roc)
+}
+
+/// Rigid alignment of `src` onto `dst` (paired), with translation: (R, t) with dst ~ R src + t.
+fn rigid(src: &[DVec3], dst: &[DVec3]) -> (meshcore::DMat3, DVec3) {
+    let n = src.len().max(1) as f64;
+    let cs = src.iter().copied().sum::<DVec3>() / n;
+    let cd = dst.iter().copied().sum::<DVec3>() / n;
+    let a: Vec<DVec3> = dst.iter().map(|p| *p - cd).collect();
+    let b: Vec<DVec3> = src.iter().map(|p| *p - cs).collect();
+    let r = best_rotation(&a, &b);
+    (r, cd - r * cs)
+}
+
+/// ICP of the probe points onto the gallery surface (closest points on triangles), started from
+/// the landmark alignment; trims the worst 10 % of pairs; returns the RMS closest-point
+/// distance of all probe points at the final pose (cm).
+fn icp_score(
+    probe: &[DVec3],
+    probe_lm: &[DVec3; 3],
+    gallery: &FaceLocator<'_>,
+    gallery_lm: &[DVec3; 3],
+) -> f64 {
+    let (mut r, mut t) = rigid(probe_lm, gallery_lm);
+    let mut prev = f64::INFINITY;
+    for _ in 0..10 {
+        let moved: Vec<DVec3> = probe.iter().map(|p| r * *p + t).collect();
+        let mut pairs: Vec<(f64, DVec3, DVec3)> = Vec::with_capacity(probe.len());
+        for (k, m) in moved.iter().enumerate() {
+            let Ok((sp, d)) = gallery.nearest(*m) else {
+                return f64::NAN;
+            };
+            let Ok(c) = gallery.mesh().point_position(&sp) else {
+                return f64::NAN;
+            };
+            pairs.push((d, probe[k], c));
+        }
+        pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let keep = (pairs.len() * 9 / 10).max(3);
+        let rms = (pairs[..keep].iter().map(|p| p.0 * p.0).sum::<f64>() / keep as f64).sqrt();
+        let src: Vec<DVec3> = pairs[..keep].iter().map(|p| p.1).collect();
+        let dst: Vec<DVec3> = pairs[..keep].iter().map(|p| p.2).collect();
+        (r, t) = rigid(&src, &dst);
+        if (prev - rms).abs() <= 1e-6 * rms.max(1e-12) {
+            break;
+        }
+        prev = rms;
+    }
+    let ss: f64 = probe
+        .iter()
+        .map(|p| gallery.nearest(r * *p + t).map_or(f64::NAN, |(_, d)| d * d))
+        .sum();
+    (ss / probe.len().max(1) as f64).sqrt()
+}
+
+/// Runs the benchmark; prints the output folder on the last line.
+pub fn run(args: Args) -> Result<()> {
+    let t0 = Instant::now();
+    if args.identities < 2 || args.expressions < 2 {
+        bail!("need at least 2 identities and 2 expressions (one neutral gallery face + probes)");
+    }
+    let model_dir = args.model.clone().unwrap_or_else(default_model_dir);
+    let model = FaceModel::load(&model_dir)
+        .with_context(|| format!("loading the ICT model from {}", model_dir.display()))?;
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| default_out_dir("recognition"));
+    let gt = Lm {
+        r: model.landmark_id("right_eye_outer")?,
+        q: model.landmark_id("left_eye_outer")?,
+        nose: model.landmark_id("nose_tip")?,
+    };
+    // Sampling (sequential: deterministic).
+    let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
+    let mut samples = Vec::new();
+    for id in 0..args.identities {
+        let w = model.random_identity(&mut rng);
+        for e in 0..args.expressions {
+            let ew = if e == 0 {
+                vec![0.0; model.n_expressions()]
+            } else {
+                model.random_expression(&mut rng)
+            };
+            let mesh = model.sample(&w, &ew)?;
+            let motion = random_rigid_motion(&mut rng, 5.0);
+            let (pos, tri) = mesh.into_parts();
+            let pos = pos
+                .into_iter()
+                .map(|p| motion.transform_point3(p))
+                .collect();
+            samples.push(Sample {
+                identity: id,
+                index: e,
+                mesh: TriMesh::new(pos, tri)?,
+            });
+        }
+    }
+    let methods = resolve_methods(&args.method, &samples[0].mesh)?;
+    let method = methods[0].used;
+    let method_note = methods[0].note.clone();
+    eprintln!(
+        "{} faces sampled ({} identities x {}); geodesics: {}",
+        samples.len(),
+        args.identities,
+        args.expressions,
+        method.name()
+    );
+    // Landmark detection.
+    let generic = landmarks::GenericModel::default_model()
+        .map_err(|e| anyhow::anyhow!("landmark model: {e}"))?;
+    let pb = bar(samples.len(), "detecting landmarks");
+    let detected: Vec<Option<Lm>> = samples
+        .par_iter()
+        .map(|s| {
+            let r = landmarks::detect(&s.mesh, &generic).ok().map(|l| Lm {
+                r: l.outer_eye_right.vertex,
+                q: l.outer_eye_left.vertex,
+                nose: l.nose_tip.vertex,
+            });
+            pb.inc(1);
+            r
+        })
+        .collect();
+    pb.finish();
+    let det_err: Vec<[f64; 3]> = samples
+        .iter()
+        .zip(&detected)
+        .filter_map(|(s, d)| {
+            d.map(|d| {
+                [(gt.r, d.r), (gt.q, d.q), (gt.nose, d.nose)]
+                    .map(|(a, b)| (s.mesh.position(a) - s.mesh.position(b)).length())
+            })
+        })
+        .collect();
+    // Descriptors for both landmark sets.
+    let pb = bar(samples.len(), &format!("descriptors ({})", method.name()));
+    let described: Vec<[Option<Described>; 2]> = samples
+        .par_iter()
+        .zip(&detected)
+        .map(|(s, det)| -> Result<_> {
+            let solver = geodesic::new_solver(&s.mesh, method)?;
+            let walker = Walker::new(&s.mesh);
+            let mut out: [Option<Described>; 2] = [None, None];
+            for (k, lm) in [Some(gt), *det].into_iter().enumerate() {
+                let Some(lm) = lm else { continue };
+                if lm.r == lm.q {
+                    continue;
+                }
+                let (r, q, nose) = (
+                    s.mesh.position(lm.r),
+                    s.mesh.position(lm.q),
+                    s.mesh.position(lm.nose),
+                );
+                // Only the static lens (within D of both corners, D ~ 1.1 |q - r|) and polar
+                // radii up to D are used: the fields are cut off at 1.4 |q - r|.
+                let cut = SolveOptions {
+                    max_distance: Some(1.4 * (q - r).length()),
+                };
+                let ur = solver.distances(&[Source::Vertex(lm.r)], &cut)?;
+                let uq = solver.distances(&[Source::Vertex(lm.q)], &cut)?;
+                let un = solver.distances(&[Source::Vertex(lm.nose)], &cut)?;
+                let d = 0.5 * (ur[lm.q as usize] + uq[lm.r as usize]);
+                if !d.is_finite() || d <= 0.0 {
+                    continue;
+                }
+                let frame = face_frame(&s.mesh, r, q, nose);
+                let refs = Refs {
+                    ur,
+                    uq,
+                    d,
+                    r,
+                    q,
+                    nose,
+                    frame,
+                };
+                let bip = bipolar(&s.mesh, &refs, args.levels, Region::Static);
+                let opts = PolarOptions {
+                    step: d / f64::from(args.levels),
+                    levels: args.levels,
+                    sectors: args.sectors,
+                };
+                let pol =
+                    polar_descriptor(&walker, &un, Pole::Vertex(lm.nose), 0.5 * (r + q), &opts)
+                        .unwrap_or_default();
+                out[k] = Some(Described {
+                    bip,
+                    pol,
+                    lm_pos: [r, q, nose],
+                });
+            }
+            pb.inc(1);
+            Ok(out)
+        })
+        .collect::<Result<_>>()?;
+    pb.finish();
+    let gallery: Vec<usize> = (0..samples.len())
+        .filter(|&i| samples[i].index == 0)
+        .collect();
+    let probes: Vec<usize> = (0..samples.len())
+        .filter(|&i| samples[i].index != 0)
+        .collect();
+    let gid: Vec<usize> = gallery.iter().map(|&g| samples[g].identity).collect();
+    let pid: Vec<usize> = probes.iter().map(|&p| samples[p].identity).collect();
+    let locators: Vec<FaceLocator<'_>> = gallery
+        .iter()
+        .map(|&g| FaceLocator::new(&samples[g].mesh))
+        .collect();
+    let stride = (samples[0].mesh.n_vertices() / args.icp_points.max(3)).max(1);
+    let mut all = Vec::new();
+    let pb = bar(2 * probes.len(), "scoring (ICP dominates)");
+    for (k, lname) in ["ground_truth", "detected"].iter().enumerate() {
+        let rows: Vec<[Vec<f64>; 3]> = probes
+            .par_iter()
+            .map(|&p| {
+                let dp = described[p][k].as_ref();
+                let pts: Vec<DVec3> = samples[p]
+                    .mesh
+                    .positions()
+                    .iter()
+                    .step_by(stride)
+                    .copied()
+                    .collect();
+                let mut b = Vec::new();
+                let mut s = Vec::new();
+                let mut c = Vec::new();
+                for (gi, &g) in gallery.iter().enumerate() {
+                    let dg = described[g][k].as_ref();
+                    match (dp, dg) {
+                        (Some(x), Some(y)) => {
+                            b.push(dist(&x.bip, &y.bip));
+                            s.push(dist(&x.pol, &y.pol));
+                            c.push(icp_score(&pts, &x.lm_pos, &locators[gi], &y.lm_pos));
+                        }
+                        _ => {
+                            b.push(f64::NAN);
+                            s.push(f64::NAN);
+                            c.push(f64::NAN);
+                        }
+                    }
+                }
+                pb.inc(1);
+                [b, s, c]
+            })
+            .collect();
+        for (j, dname) in ["bipolar", "single_pole", "icp_raw_mesh"]
+            .iter()
+            .enumerate()
+        {
+            let m: Vec<Vec<f64>> = rows.iter().map(|r| r[j].clone()).collect();
+            let (rank1, eer, roc, gm, im, failures) = metrics(&m, &pid, &gid);
+            all.push(Metrics {
+                descriptor: dname.to_string(),
+                landmarks: lname.to_string(),
+                rank1,
+                eer,
+                genuine_mean: gm,
+                impostor_mean: im,
+                failures,
+                roc,
+            });
+        }
+    }
+    pb.finish();
+
+    // Output.
+    let mut rep = Report::new(&out, "Recognition benchmark on sampled ICT faces")?;
+    rep.para(&format!(
+        "{} identities x {} faces (seed {}): {} gallery faces (neutral), {} probes (random expressions: with probability 1/2 a recipe at strength 0.3-1, plus random blendshapes), every face under a random rigid motion. Geodesics: {}{}. Bipolar descriptor: static area, N = {} levels between the outer eye corners (grid reading, keyed distance); single pole: {} sectors x {} radius levels around the nose tip; ICP: {} probe vertices onto the gallery surface, started from the 3-landmark alignment, 10 % trimmed, score = RMS closest-point distance (cm).",
+        args.identities, args.expressions, args.seed, gallery.len(), probes.len(), method.name(),
+        method_note.as_ref().map(|n| format!(" (exact requested: {n})")).unwrap_or_default(),
+        args.levels, args.sectors, args.levels, samples[0].mesh.positions().iter().step_by(stride).count()
+    ));
+    let n_det = detected.iter().filter(|d| d.is_some()).count();
+    let mean_err =
+        |k: usize| det_err.iter().map(|e| e[k]).sum::<f64>() / det_err.len().max(1) as f64;
+    rep.para(&format!("Landmark detection: {n_det} of {} faces detected; mean error right corner {:.3} cm, left corner {:.3} cm, nose tip {:.3} cm.", samples.len(), mean_err(0), mean_err(1), mean_err(2)));
+    let rows: Vec<Vec<String>> = all
+        .iter()
+        .map(|m| {
+            vec![
+                m.descriptor.clone(),
+                m.landmarks.clone(),
+                format!("{:.3}", m.rank1),
+                format!("{:.3}", m.eer),
+                f4(m.genuine_mean),
+                f4(m.impostor_mean),
+                m.failures.to_string(),
+            ]
+        })
+        .collect();
+    let hdr = [
+        "descriptor",
+        "landmarks",
+        "rank-1",
+        "EER",
+        "mean genuine score",
+        "mean impostor score",
+        "failed pairs",
+    ];
+    rep.table(&hdr, &rows);
+    rep.csv("results.csv", &hdr, &rows)?;
+    let series: Vec<Series> = all
+        .iter()
+        .map(|m| Series {
+            label: format!("{} ({})", m.descriptor, m.landmarks),
+            points: m.roc.clone(),
+            dashed: m.landmarks == "detected",
+        })
+        .collect();
+    line_plot(
+        &rep.path("roc.svg"),
+        "ROC (verification)",
+        "false accept rate",
+        "true accept rate",
+        &series,
+    )?;
+    rep.figure("roc.svg", "ROC curves; dashed: detected landmarks");
+    let secs = t0.elapsed().as_secs_f64();
+    rep.para(&format!("Run time: {secs:.1} s."));
+    rep.finish()?;
+    let summary = serde_json::json!({
+        "identities": args.identities,
+        "faces_per_identity": args.expressions,
+        "seed": args.seed,
+        "gallery": gallery.len(),
+        "probes": probes.len(),
+        "geodesic_method": method.name(),
+        "geodesic_note": method_note,
+        "levels": args.levels,
+        "sectors": args.sectors,
+        "landmark_detection": { "detected": n_det, "faces": samples.len(), "mean_error_cm": { "right_eye_outer": mean_err(0), "left_eye_outer": mean_err(1), "nose_tip": mean_err(2) } },
+        "results": all,
+        "roc_plot": "roc.svg",
+        "seconds": secs,
+    });
+    std::fs::write(
+        out.join("summary.json"),
+        serde_json::to_string_pretty(&summary)?,
+    )?;
+    let _ = Method::Dijkstra;
+    println!("{}", out.display());
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn eer_and_rank1_on_known_scores() {
+        // 2 gallery ids, 2 probes each; probe 3 is misidentified.
+        let gid = vec![0, 1];
+        let pid = vec![0, 0, 1, 1];
+        let s = vec![
+            vec![0.1, 0.5],
+            vec![0.2, 0.6],
+            vec![0.7, 0.3],
+            vec![0.4, 0.45],
+        ];
+        let (rank1, eer, roc, gm, im, f) = metrics(&s, &pid, &gid);
+        assert!((rank1 - 0.75).abs() < 1e-12);
+        assert!((gm - (0.1 + 0.2 + 0.3 + 0.45) / 4.0).abs() < 1e-12);
+        assert!((im - (0.5 + 0.6 + 0.7 + 0.4) / 4.0).abs() < 1e-12);
+        assert_eq!(f, 0);
+        // Threshold 0.4: FAR 1/4, FRR 1/4 -> EER 0.25.
+        assert!((eer - 0.25).abs() < 1e-12, "{eer}");
+        assert_eq!(roc.first(), Some(&(0.0, 0.0)));
+        assert_eq!(roc.last(), Some(&(1.0, 1.0)));
+        // Perfect separation gives EER 0; NaN counts as a failure.
+        let (r, e, ..) = metrics(&[vec![0.1, f64::NAN], vec![0.9, 0.2]], &[0, 1], &gid);
+        assert_eq!((r, e), (1.0, 0.0));
+    }
+
+    #[test]
+    fn icp_recovers_a_rigid_copy() {
+        let m = crate::experiments::walk::tests::icosphere(2);
+        let rot = meshcore::DMat3::from_quat(meshcore::DQuat::from_axis_angle(
+            DVec3::new(1.0, 0.3, 0.2).normalize(),
+            1.1,
+        ));
+        let t = DVec3::new(3.0, -2.0, 1.0);
+        let probe: Vec<DVec3> = m.positions().iter().map(|p| rot * *p + t).collect();
+        let lm_g = [m.position(0), m.position(5), m.position(9)];
+        let lm_p = lm_g.map(|p| rot * p + t);
+        let loc = FaceLocator::new(&m);
+        assert!(icp_score(&probe, &lm_p, &loc, &lm_g) < 1e-9);
+        // A scaled copy is not at distance 0.
+        let big: Vec<DVec3> = probe.iter().map(|p| (*p - t) * 1.1 + t).collect();
+        assert!(icp_score(&big, &lm_p, &loc, &lm_g) > 0.01);
+    }
+}
