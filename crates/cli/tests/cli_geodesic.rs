@@ -124,9 +124,12 @@ fn writes_every_format() {
         .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
         .collect();
     assert_eq!(vals.len(), 81);
-    // Vertex (2, 3) is at Euclidean distance |(0.5, 0.25)| from the snapped point (2.5, 3.25).
-    let v23 = 3 * 9 + 2;
-    assert!((vals[v23] - 0.3125f64.sqrt()).abs() < 0.3, "{}", vals[v23]);
+    // The far corner (8, 8) is at Euclidean distance |(5.5, 4.75)| from the snapped point
+    // (2.5, 3.25, 0); the heat method is within about an edge length there (boundary corner).
+    let far = 8 * 9 + 8;
+    let e = (5.5f64 * 5.5 + 4.75 * 4.75).sqrt();
+    assert!((vals[far] - e).abs() < 1.5, "{} vs {e}", vals[far]);
+    assert!(vals.iter().all(|v| v.is_finite() && *v >= 0.0));
 
     // PLY with the field as a vertex property, with a cut-off.
     let ply = out("d.ply");
