@@ -137,14 +137,14 @@ impl Topology {
             x
         }
         for t in tris {
-            let r0 = find(&mut parent, t[0]);
             for &v in &t[1..] {
+                // Re-find both roots every time: a union may have changed t[0]'s root.
+                let r0 = find(&mut parent, t[0]);
                 let r = find(&mut parent, v);
                 if r != r0 {
                     let (lo, hi) = (r.min(r0), r.max(r0));
                     parent[hi as usize] = lo;
                 }
-                let _ = find(&mut parent, t[0]);
             }
         }
         let mut comp_of_root: HashMap<u32, u32> = HashMap::new();
@@ -338,6 +338,20 @@ mod tests {
             m.n_vertices() as i64 - t.edges.len() as i64 + m.n_faces() as i64,
             1
         );
+    }
+
+    #[test]
+    fn components_survive_root_changes() {
+        // A face whose corners come in decreasing order changes its first corner's root in the
+        // middle of the face: a stale root used to split even a single triangle in two.
+        let p = vec![DVec3::ZERO, DVec3::X, DVec3::Y];
+        let t = Topology::new(&TriMesh::new(p, vec![[2, 1, 0]]).unwrap());
+        assert_eq!(t.n_components, 1);
+        // A grid with reversed corner order is one component too.
+        let (pos, tris) = grid(7, 5).into_parts();
+        let tris: Vec<[u32; 3]> = tris.into_iter().map(|[a, b, c]| [c, b, a]).rev().collect();
+        let t = Topology::new(&TriMesh::new(pos, tris).unwrap());
+        assert_eq!(t.n_components, 1);
     }
 
     #[test]
