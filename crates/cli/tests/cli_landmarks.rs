@@ -1,0 +1,88 @@
+//! End-to-end tests of `bipolar landmarks`.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn bipolar(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_bipolar"))
+        .arg("landmarks")
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn paper_face(name: &str) -> Option<PathBuf> {
+    let shared = std::env::var_os("BIPOLAR_SHARED")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"));
+    let p = shared.join("faces/ict-facekit/paper-set").join(name);
+    if p.is_file() {
+        Some(p)
+    } else {
+        eprintln!("skipped: {} not found", p.display());
+        None
+    }
+}
+
+#[test]
+fn detects_on_a_paper_face_and_writes_json_and_lm3() {
+    let Some(mesh) = paper_face("id2_neutral.obj") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("lm.json");
+    let lm3 = dir.path().join("lm.lm3");
+    let out = bipolar(&[
+        mesh.to_str().unwrap(),
+        "--out",
+        json.to_str().unwrap(),
+        "--lm3",
+        lm3.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("confidence") && stdout.contains("outer_eye_right"));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    // The ICT truth of this face (cm): right outer eye corner near (-4.4, 3.4, 8.6).
+    let p = &v["landmarks"]["outer_eye_right"]["position"];
+    let x = p[0].as_f64().unwrap();
+    assert!((x + 4.4).abs() < 0.6, "outer_eye_right x = {x}");
+    let text = std::fs::read_to_string(&lm3).unwrap();
+    assert!(text.contains("5 landmarks:") && text.contains("Outer right eye corner"));
+}
+
+#[test]
+fn not_a_face_fails_with_a_clear_message() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("plane.obj");
+    let mut s = String::new();
+    for j in 0..=20 {
+        for i in 0..=20 {
+            s.push_str(&format!("v {} {} 0\n", i as f64 * 0.5, j as f64 * 0.5));
+        }
+    }
+    for j in 0..20 {
+        for i in 0..20 {
+            let a = j * 21 + i + 1;
+            s.push_str(&format!(
+                "f {} {} {}\nf {} {} {}\n",
+                a,
+                a + 1,
+                a + 22,
+                a,
+                a + 22,
+                a + 21
+            ));
+        }
+    }
+    std::fs::write(&obj, s).unwrap();
+    let out = bipolar(&[obj.to_str().unwrap()]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("not found") && err.contains("score"), "{err}");
+}
