@@ -42,7 +42,7 @@ pub fn info_json(loaded: &mesh_io::LoadedMesh, file: &str) -> serde_json::Value 
         "bbox": {"min": [bb.min.x, bb.min.y, bb.min.z], "max": [bb.max.x, bb.max.y, bb.max.z], "diagonal": bb.diagonal()},
         "area": m.area(),
         "mean_edge_length": m.mean_edge_length(),
-        "components": count_components(m),
+        "components": topo.n_components,
         "isolated_vertices": topo.isolated_vertices,
         "boundary_loops": loops.len(),
         "boundary_loop_lengths": loops,
@@ -89,32 +89,4 @@ fn print_text(r: &serde_json::Value) {
             println!("warning: {}", w.as_str().unwrap_or(""));
         }
     }
-}
-
-/// Connected components (faces sharing a vertex; isolated vertices count as their own), by
-/// union-find. Computed here because `Topology::n_components` (meshcore at 90e2524) reuses a
-/// stale root in its union step and over-counts (3 instead of 1 on the ICT faces).
-fn count_components(m: &meshcore::TriMesh) -> usize {
-    let mut parent: Vec<usize> = (0..m.n_vertices()).collect();
-    fn find(p: &mut [usize], mut x: usize) -> usize {
-        while p[x] != x {
-            p[x] = p[p[x]];
-            x = p[x];
-        }
-        x
-    }
-    for t in m.triangles() {
-        for k in 1..3 {
-            let (a, b) = (
-                find(&mut parent, t[0] as usize),
-                find(&mut parent, t[k] as usize),
-            );
-            if a != b {
-                parent[a] = b;
-            }
-        }
-    }
-    (0..m.n_vertices())
-        .filter(|&v| find(&mut parent, v) == v)
-        .count()
 }

@@ -69,8 +69,8 @@ fn writes_every_format() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let d = read_txt(&txt);
     assert_eq!(d.len(), 81);
-    for i in 0..=8 {
-        assert!((d[i] - i as f64).abs() < 1e-12);
+    for (i, di) in d.iter().enumerate().take(9) {
+        assert!((di - i as f64).abs() < 1e-12);
     }
 
     // Fast marching, CSV.

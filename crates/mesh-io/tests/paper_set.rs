@@ -18,9 +18,9 @@ fn shared() -> PathBuf {
 const PAPER_SET_BOUNDARY_LOOPS: usize = 4;
 const PAPER_SET_LOOP_LENGTHS: [usize; 4] = [42, 42, 74, 138];
 
-/// Connected components (faces sharing a vertex), by union-find with path halving. Computed here
-/// rather than with `Topology::n_components`, which at commit 90e2524 over-counts (3 instead of
-/// 1 on these faces: its union step reuses a stale root).
+/// Connected components (faces sharing a vertex), by an independent union-find with path
+/// halving: a cross-check of `Topology::n_components` (which once over-counted on these faces
+/// because its union step reused a stale root).
 fn components(m: &meshcore::TriMesh) -> usize {
     let mut parent: Vec<usize> = (0..m.n_vertices()).collect();
     fn find(p: &mut [usize], mut x: usize) -> usize {
@@ -66,6 +66,7 @@ fn paper_set_faces_load() {
         assert_eq!(m.mesh.n_vertices(), 6706, "{}", p.display());
         let t = Topology::new(&m.mesh);
         assert_eq!(components(&m.mesh), 1, "{}", p.display());
+        assert_eq!(t.n_components, 1, "{}", p.display());
         assert_eq!(t.isolated_vertices, 0);
         assert_eq!(
             t.boundary_loops.len(),
