@@ -147,10 +147,11 @@ fn matrix_is_symmetric_with_zero_diagonal_and_heatmap_is_written() {
         .iter()
         .map(|r| r[1..].iter().map(|x| x.parse().unwrap()).collect())
         .collect();
-    for i in 0..3 {
-        assert_eq!(m[i][i], 0.0);
-        for j in 0..3 {
-            assert_eq!(m[i][j], m[j][i]);
+    assert_eq!(m.len(), 3);
+    for (i, row) in m.iter().enumerate() {
+        assert_eq!(row[i], 0.0);
+        for (j, v) in row.iter().enumerate() {
+            assert_eq!(*v, m[j][i]);
         }
     }
     // More z-stretch, larger distance from face0.
