@@ -18,7 +18,7 @@ use crate::experiments::segment::face_frame;
 use crate::experiments::walk::Walker;
 use crate::facemodel::{default_model_dir, random_rigid_motion, FaceModel};
 use anyhow::{bail, Context, Result};
-use geodesic::{Method, SolveOptions, Source};
+use geodesic::{SolveOptions, Source};
 use meshcore::{DVec3, FaceLocator, TriMesh};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -48,7 +48,7 @@ pub struct Args {
     #[arg(long, default_value_t = 16)]
     pub sectors: u32,
     /// Probe vertices used by ICP (evenly strided).
-    #[arg(long, default_value_t = 200)]
+    #[arg(long, default_value_t = 100)]
     pub icp_points: usize,
     /// ICT model folder (default `$BIPOLAR_SHARED/faces/ict-facekit/model`).
     #[arg(long)]
@@ -96,12 +96,11 @@ struct Metrics {
     roc: Vec<(f64, f64)>,
 }
 
+/// (rank-1 rate, EER, ROC points, mean genuine score, mean impostor score, failed pairs).
+type Figures = (f64, f64, Vec<(f64, f64)>, f64, f64, usize);
+
 /// Rank-1 rate, EER and ROC from a probes x gallery score matrix (NaN = failure = worst).
-fn metrics(
-    scores: &[Vec<f64>],
-    probe_id: &[usize],
-    gallery_id: &[usize],
-) -> (f64, f64, Vec<(f64, f64)>, f64, f64, usize) {
+fn metrics(scores: &[Vec<f64>], probe_id: &[usize], gallery_id: &[usize]) -> Figures {
     let mut correct = 0usize;
     let mut gen = Vec::new();
     let mut imp = Vec::new();
@@ -189,7 +188,7 @@ fn icp_score(
 ) -> f64 {
     let (mut r, mut t) = rigid(probe_lm, gallery_lm);
     let mut prev = f64::INFINITY;
-    for _ in 0..10 {
+    for _ in 0..6 {
         let moved: Vec<DVec3> = probe.iter().map(|p| r * *p + t).collect();
         let mut pairs: Vec<(f64, DVec3, DVec3)> = Vec::with_capacity(probe.len());
         for (k, m) in moved.iter().enumerate() {
@@ -504,7 +503,6 @@ pub fn run(args: Args) -> Result<()> {
         out.join("summary.json"),
         serde_json::to_string_pretty(&summary)?,
     )?;
-    let _ = Method::Dijkstra;
     println!("{}", out.display());
     Ok(())
 }
