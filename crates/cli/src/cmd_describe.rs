@@ -57,7 +57,8 @@ pub struct Args {
 
 /// Parses a reference point: a vertex index, or `X,Y,Z` snapped to the nearest surface point.
 ///
-/// (Landmark names will be accepted here once the landmarks crate provides them.)
+/// A landmark name (`outer-eye-right`, `outer-eye-left`, ...) is detected with
+/// `landmarks::detect` and the default generic face model.
 pub fn parse_reference(spec: &str, mesh: &TriMesh) -> anyhow::Result<Source> {
     let s = spec.trim();
     if let Ok(v) = s.parse::<u32>() {
@@ -83,7 +84,22 @@ pub fn parse_reference(spec: &str, mesh: &TriMesh) -> anyhow::Result<Source> {
             return Ok(Source::Point(sp));
         }
     }
-    bail!("cannot read reference point {spec:?}: expected a vertex index or X,Y,Z")
+    if let Some(name) = landmarks::LandmarkName::parse(s) {
+        let model = landmarks::GenericModel::default_model()
+            .context("loading the default generic face model")?;
+        let found = landmarks::detect(mesh, &model)
+            .with_context(|| format!("detecting the landmark {name} on the mesh"))?;
+        let lm = found.get(name);
+        eprintln!(
+            "{name}: detected at vertex {} (confidence {:.2})",
+            lm.vertex, lm.confidence
+        );
+        return Ok(Source::Vertex(lm.vertex));
+    }
+    bail!(
+        "cannot read reference point {spec:?}: expected a vertex index, X,Y,Z or a landmark name \
+         (outer-eye-right, outer-eye-left, inner-eye-right, inner-eye-left, nose-tip)"
+    )
 }
 
 /// Builds descriptor options from the command line.

@@ -172,3 +172,54 @@ fn describe_reports_bad_input() {
     ]);
     assert!(e.contains("no descriptor points"), "{e}");
 }
+
+#[test]
+fn landmark_names_are_detected_or_fail_clearly() {
+    let dir = tempfile::tempdir().unwrap();
+    // A sphere is not a face: the detector must say so, not pick a point.
+    let obj = sphere_obj(dir.path());
+    let out = bin()
+        .args(["describe", obj.to_str().unwrap()])
+        .args(["--ref-a", "outer-eye-right", "--ref-b", "outer-eye-left"])
+        .args(["--out", dir.path().join("s.csv").to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("outer_eye_right"), "{err}");
+
+    // On a paper-set face the detected corners are within 5 mm of the ground-truth vertices.
+    let shared = std::env::var_os("BIPOLAR_SHARED")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"));
+    let face = shared.join("faces/ict-facekit/paper-set/id2_neutral.obj");
+    if !face.is_file() {
+        println!("skipped: {} is absent", face.display());
+        return;
+    }
+    let csv = dir.path().join("f.csv");
+    let out = bin()
+        .args(["describe", face.to_str().unwrap()])
+        .args(["--ref-a", "outer-eye-right", "--ref-b", "outer-eye-left"])
+        .args(["--levels", "5", "--out", csv.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(std::fs::read_to_string(&csv).unwrap().lines().count() > 10);
+    let mesh = mesh_io::read_mesh(&face).unwrap().mesh;
+    for (name, truth) in [("outer_eye_right", 1507u32), ("outer_eye_left", 3721)] {
+        let line = err.lines().find(|l| l.starts_with(name)).expect(name);
+        let v: u32 = line
+            .split("vertex ")
+            .nth(1)
+            .and_then(|r| r.split_whitespace().next())
+            .and_then(|x| x.parse().ok())
+            .expect(line);
+        let d = (mesh.position(v) - mesh.position(truth)).length();
+        assert!(
+            d < 0.5,
+            "{name}: detected vertex {v} is {d} cm from {truth}"
+        );
+    }
+}
