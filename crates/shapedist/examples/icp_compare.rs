@@ -56,15 +56,38 @@ fn read_gt(path: &str) -> DMat3 {
     DMat3::from_cols_array(&[v[0], v[3], v[6], v[1], v[4], v[7], v[2], v[5], v[8]])
 }
 
+/// CPU time of the whole process (all threads) in ms, from the scheduler's per-thread
+/// run-time counters (`/proc/self/task/*/schedstat`, nanoseconds); `None` off Linux.
+fn cpu_ms() -> Option<f64> {
+    let mut ns = 0u64;
+    for e in std::fs::read_dir("/proc/self/task").ok()? {
+        let s = std::fs::read_to_string(e.ok()?.path().join("schedstat")).ok()?;
+        ns += s.split_whitespace().next()?.parse::<u64>().ok()?;
+    }
+    Some(ns as f64 * 1e-6)
+}
+
+thread_local! {
+    /// Median CPU time of the last [`median_ms`] call.
+    static LAST_CPU: std::cell::Cell<f64> = const { std::cell::Cell::new(f64::NAN) };
+}
+
 fn median_ms<T>(reps: usize, mut f: impl FnMut() -> T) -> (f64, T) {
     let mut times = Vec::new();
+    let mut cpu = Vec::new();
     let mut out = None;
     for _ in 0..reps {
+        let c0 = cpu_ms();
         let t0 = Instant::now();
         out = Some(f());
         times.push(t0.elapsed().as_secs_f64() * 1e3);
+        if let (Some(c0), Some(c1)) = (c0, cpu_ms()) {
+            cpu.push(c1 - c0);
+        }
     }
     times.sort_by(f64::total_cmp);
+    cpu.sort_by(f64::total_cmp);
+    LAST_CPU.with(|c| c.set(cpu.get(reps / 2).copied().unwrap_or(f64::NAN)));
     (times[reps / 2], out.unwrap())
 }
 
@@ -79,9 +102,13 @@ fn main() {
         .map(|s| s.parse().unwrap())
         .collect();
     let variant = args.get(4).map_or("tgt", String::as_str);
-    let reps = 5;
-    println!("| N | rot | set | method | ms (median of {reps}) | iters | rot err (deg) | NN-RMSE | corr-RMSE |");
-    println!("|---|---|---|---|---|---|---|---|---|");
+    // "plain": only the fixed 50-iteration point-to-point row (the like-for-like one).
+    let only_plain = args.get(5).is_some_and(|s| s == "plain" || s == "once");
+    // "once": one run of the plain row, no brute-force check (for profilers).
+    let once = args.get(5).is_some_and(|s| s == "once");
+    let reps = if once { 1 } else { 5 };
+    println!("| N | rot | set | method | ms (median of {reps}) | CPU ms (median) | iters | rot err (deg) | NN-RMSE | corr-RMSE |");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
     for deg in degs {
         let stem = format!("{dir}/patch_N{n}_rot{deg}");
         let src = read_npy(&format!("{stem}_src.npy"));
@@ -92,6 +119,10 @@ fn main() {
         let a = PreparedSet::new(&tgt, &po, Which::A).unwrap();
         let b = PreparedSet::new(&src, &po, Which::B).unwrap();
         let row = |name: &str, ms: f64, iters: String, r: DMat3| {
+            if once {
+                println!("{name}: {ms:.2} ms, {iters} iterations");
+                return;
+            }
             let err = linalg::rotation_angle_between(r, rtrue).to_degrees();
             let st = closest_point_stats(&a, &b, r, DVec3::ZERO);
             let nn = {
@@ -123,7 +154,8 @@ fn main() {
                 "-".into()
             };
             let _ = st;
-            println!("| {n} | {deg} | {variant} | {name} | {ms:.2} | {iters} | {err:.3} | {nn:.5} | {corr} |");
+            let cpu = LAST_CPU.with(|c| c.get());
+            println!("| {n} | {deg} | {variant} | {name} | {ms:.2} | {cpu:.2} | {iters} | {err:.3} | {nn:.5} | {corr} |");
         };
         let fixed50 = IcpOptions {
             max_iterations: 50,
@@ -137,6 +169,9 @@ fn main() {
             res.iterations.to_string(),
             res.rotation,
         );
+        if only_plain {
+            continue;
+        }
         let sched = IcpOptions {
             max_iterations: 10,
             tolerance: 0.0,

@@ -22,22 +22,33 @@ use serde::Serialize;
 
 use crate::error::{ShapeDistError, Which};
 use crate::linalg::{axis_angle, kabsch_rotation, solve_sym, sym_eigen3};
+use crate::nn::{dist2, PointTree, GROUP};
 use crate::points::{centred, check_spread, outer, principal_axes, radius, validate};
 
 /// Below this many source points the correspondence search runs on one thread (rayon's
 /// overhead dominates; the global search parallelises over starts instead).
 const PAR_MIN: usize = 2048;
 
-/// A point set prepared for repeated comparisons: centred, with a k-d tree, a random
-/// subsample (and its tree) for the coarse global search, and lazily estimated normals.
+/// Source points per work unit. Partial sums are formed per chunk and added in chunk order,
+/// whatever the number of threads, so results do not depend on the thread count.
+const CHUNK: usize = 512;
+
+/// "No point" index.
+const NONE: u32 = u32::MAX;
+
+/// A point set prepared for repeated comparisons: centred, with k-d trees (the exact
+/// nearest-neighbour [`PointTree`] of the ICP loop, and kiddo's tree for the k nearest
+/// neighbours of the normals), a random subsample (and its tree) for the coarse global
+/// search, and lazily estimated normals.
 #[derive(Debug)]
 pub struct PreparedSet {
     points: Vec<DVec3>,
     centroid: DVec3,
     radius: f64,
     tree: ImmutableKdTree<f64, 3>,
+    nn: PointTree,
     sub_points: Vec<DVec3>,
-    sub_tree: ImmutableKdTree<f64, 3>,
+    sub_nn: PointTree,
     normals_k: usize,
     normals: OnceLock<Vec<DVec3>>,
 }
@@ -89,14 +100,15 @@ impl PreparedSet {
             idx.sort_unstable();
             idx.iter().map(|&i| pts[i]).collect()
         };
-        let sub_tree = build_tree(&sub_points);
+        let sub_nn = PointTree::new(&sub_points);
         Ok(Self {
             radius: radius(&pts),
+            nn: PointTree::new(&pts),
             points: pts,
             centroid: c,
             tree,
             sub_points,
-            sub_tree,
+            sub_nn,
             normals_k: opts.normals_k.max(3),
             normals: OnceLock::new(),
         })
@@ -148,9 +160,10 @@ impl PreparedSet {
         })
     }
 
-    fn nearest(&self, q: DVec3) -> (f64, usize) {
-        let n = self.tree.nearest_one::<SquaredEuclidean>(&q.to_array());
-        (n.distance, n.item as usize)
+    /// The exact nearest-neighbour tree of the centred points (its leaf order is the order in
+    /// which ICP visits the points of a source set).
+    pub fn point_tree(&self) -> &PointTree {
+        &self.nn
     }
 }
 
@@ -232,13 +245,57 @@ fn check_icp_options(o: &IcpOptions) -> Result<(), ShapeDistError> {
     Ok(())
 }
 
-/// Correspondence search: for each source point (transformed), squared distance and index of
-/// its nearest target point. With `warm`, `out` holds the previous correspondences and the
-/// distance to the previous partner bounds the search (still the exact nearest neighbour,
-/// but far fewer tree cells are visited when the pose changes little).
+/// Correspondence search over one chunk of source points: for each (transformed) source
+/// point, the exact nearest target point `(squared distance, index)`, the lexicographic
+/// minimum as [`crate::nn::nearest_brute_force`] defines it. The search is seeded with the
+/// previous partner (`warm`: `out` holds the previous correspondences) and with the partner of
+/// the preceding source point (the source is in a spatially coherent order); both only bound
+/// the search, the result is the same exact minimum. With `accumulate`, also returns the
+/// sums of all pairs (fused pass of the untrimmed point-to-point step).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn correspond_chunk(
+    tree: &PointTree,
+    tgt: &[DVec3],
+    src: &[DVec3],
+    r: DMat3,
+    t: DVec3,
+    out: &mut [(f64, u32)],
+    warm: bool,
+    accumulate: bool,
+) -> Sums {
+    let mut s = Sums::ZERO;
+    let mut prev = NONE;
+    let mut ps = [DVec3::ZERO; GROUP];
+    for (o, b) in out.chunks_mut(GROUP).zip(src.chunks(GROUP)) {
+        let g = o.len().min(b.len());
+        for k in 0..g {
+            let p = r * b[k] + t;
+            ps[k] = p;
+            // Seed: the previous partner, else the partner of the preceding point.
+            let j = if warm && o[k].1 != NONE { o[k].1 } else { prev };
+            o[k] = if j == NONE {
+                (f64::INFINITY, NONE)
+            } else {
+                (dist2(tgt[j as usize], p), j)
+            };
+        }
+        tree.nearest_group(&ps[..g], &mut o[..g]);
+        prev = o[g - 1].1;
+        if accumulate {
+            for k in 0..g {
+                s.push(tgt[o[k].1 as usize], b[k], o[k].0);
+            }
+        }
+    }
+    s
+}
+
+/// Correspondences of all source points (see [`correspond_chunk`]); returns the sums of all
+/// pairs when `accumulate` (added chunk by chunk in order: deterministic).
 #[allow(clippy::too_many_arguments)]
 fn correspond(
-    tree: &ImmutableKdTree<f64, 3>,
+    tree: &PointTree,
     tgt: &[DVec3],
     src: &[DVec3],
     r: DMat3,
@@ -246,36 +303,23 @@ fn correspond(
     out: &mut [(f64, u32)],
     parallel: bool,
     warm: bool,
-) {
-    let q = |b: &DVec3, prev: (f64, u32)| {
-        let p = r * *b + t;
-        if warm {
-            let bound = (p - tgt[prev.1 as usize]).length_squared();
-            let res = tree.nearest_n_within::<SquaredEuclidean>(
-                &p.to_array(),
-                bound,
-                NonZero::<usize>::MIN,
-                true,
-            );
-            if let Some(n) = res.first() {
-                return (n.distance, n.item as u32);
-            }
-        }
-        let n = tree.nearest_one::<SquaredEuclidean>(&p.to_array());
-        (n.distance, n.item as u32)
+    accumulate: bool,
+) -> Sums {
+    let run = |(o, s): (&mut [(f64, u32)], &[DVec3])| {
+        correspond_chunk(tree, tgt, s, r, t, o, warm, accumulate)
     };
     if parallel {
-        out.par_chunks_mut(512)
-            .zip(src.par_chunks(512))
-            .for_each(|(o, s)| {
-                for (oi, b) in o.iter_mut().zip(s) {
-                    *oi = q(b, *oi);
-                }
-            });
+        let parts: Vec<Sums> = out
+            .par_chunks_mut(CHUNK)
+            .zip(src.par_chunks(CHUNK))
+            .map(run)
+            .collect();
+        parts.into_iter().fold(Sums::ZERO, Sums::add)
     } else {
-        for (oi, b) in out.iter_mut().zip(src) {
-            *oi = q(b, *oi);
-        }
+        out.chunks_mut(CHUNK)
+            .zip(src.chunks(CHUNK))
+            .map(run)
+            .fold(Sums::ZERO, Sums::add)
     }
 }
 
@@ -311,6 +355,14 @@ impl Sums {
         sb: DVec3::ZERO,
         k: DMat3::ZERO,
     };
+    #[inline(always)]
+    fn push(&mut self, a: DVec3, b: DVec3, d2: f64) {
+        self.n += 1.0;
+        self.ss += d2;
+        self.sa += a;
+        self.sb += b;
+        self.k += outer(a, b);
+    }
     fn add(self, o: Sums) -> Sums {
         Sums {
             n: self.n + o.n,
@@ -322,12 +374,12 @@ impl Sums {
     }
 }
 
-/// Runs ICP of `src` (centred B, or a subsample) onto a target given by its points, tree
-/// and (for point-to-plane) normals, from the initial rotation `init`.
+/// Runs ICP of `src` (centred B, or a subsample, in any order) onto a target given by its
+/// points, tree and (for point-to-plane) normals, from the initial rotation `init`.
 #[allow(clippy::too_many_arguments)]
 fn icp_core(
     tgt_pts: &[DVec3],
-    tree: &ImmutableKdTree<f64, 3>,
+    tree: &PointTree,
     normals: Option<&[DVec3]>,
     src: &[DVec3],
     init: DMat3,
@@ -336,16 +388,20 @@ fn icp_core(
     parallel: bool,
 ) -> IcpResult {
     let parallel = parallel && src.len() >= PAR_MIN;
+    let plane = o.variant == IcpVariant::PointToPlane && normals.is_some();
+    // Untrimmed point-to-point: the sums of the closed-form step are accumulated in the
+    // correspondence pass itself (one pass over the source per iteration).
+    let fused = !plane && o.trim <= 0.0;
     let mut r = init;
     let mut t = init_t;
-    let mut corr = vec![(0.0, 0u32); src.len()];
+    let mut corr = vec![(f64::INFINITY, NONE); src.len()];
     let mut scratch = Vec::new();
     let mut prev_rmse = f64::INFINITY;
     let mut rmse = f64::INFINITY;
     let mut iterations = 0;
     let mut converged = false;
     while iterations < o.max_iterations {
-        correspond(
+        let all = correspond(
             tree,
             tgt_pts,
             src,
@@ -354,15 +410,17 @@ fn icp_core(
             &mut corr,
             parallel,
             iterations > 0,
+            fused,
         );
-        let thr = trim_threshold(&corr, o.trim, &mut scratch);
         iterations += 1;
         // Statistics of the kept pairs at the current pose.
-        let (n, ss) = corr
-            .iter()
-            .filter(|c| c.0 <= thr)
-            .fold((0usize, 0.0), |(n, s), c| (n + 1, s + c.0));
-        rmse = (ss / n.max(1) as f64).sqrt();
+        let (thr, kept) = if fused {
+            (f64::INFINITY, all)
+        } else {
+            let thr = trim_threshold(&corr, o.trim, &mut scratch);
+            (thr, kept_sums(tgt_pts, src, &corr, thr, parallel))
+        };
+        rmse = (kept.ss / kept.n.max(1.0)).sqrt();
         if rmse == 0.0
             || (prev_rmse.is_finite() && (prev_rmse - rmse).abs() <= o.tolerance * prev_rmse)
         {
@@ -374,20 +432,21 @@ fn icp_core(
             (IcpVariant::PointToPlane, Some(nrm)) => {
                 plane_step(tgt_pts, nrm, src, &corr, thr, r, t, o.translation)
             }
-            _ => point_step(tgt_pts, src, &corr, thr, r, t, o.translation, parallel),
+            _ => point_step(&kept, r, t, o.translation),
         };
         r = nr;
         t = nt;
     }
     if !converged {
         // Report the error at the returned pose.
-        correspond(tree, tgt_pts, src, r, t, &mut corr, parallel, true);
-        let thr = trim_threshold(&corr, o.trim, &mut scratch);
-        let (n, ss) = corr
-            .iter()
-            .filter(|c| c.0 <= thr)
-            .fold((0usize, 0.0), |(n, s), c| (n + 1, s + c.0));
-        rmse = (ss / n.max(1) as f64).sqrt();
+        let all = correspond(tree, tgt_pts, src, r, t, &mut corr, parallel, true, fused);
+        let kept = if fused {
+            all
+        } else {
+            let thr = trim_threshold(&corr, o.trim, &mut scratch);
+            kept_sums(tgt_pts, src, &corr, thr, parallel)
+        };
+        rmse = (kept.ss / kept.n.max(1.0)).sqrt();
     }
     IcpResult {
         rotation: r,
@@ -399,44 +458,34 @@ fn icp_core(
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-fn point_step(
-    tgt: &[DVec3],
-    src: &[DVec3],
-    corr: &[(f64, u32)],
-    thr: f64,
-    r: DMat3,
-    t: DVec3,
-    translation: bool,
-    parallel: bool,
-) -> (DMat3, DVec3) {
-    let acc = |c: &(f64, u32), b: &DVec3| -> Sums {
-        if c.0 > thr {
-            return Sums::ZERO;
+/// Sums over the pairs whose squared distance is at most `thr` (chunked, added in order).
+fn kept_sums(tgt: &[DVec3], src: &[DVec3], corr: &[(f64, u32)], thr: f64, parallel: bool) -> Sums {
+    let run = |(c, b): (&[(f64, u32)], &[DVec3])| {
+        let mut s = Sums::ZERO;
+        for (c, b) in c.iter().zip(b) {
+            if c.0 <= thr {
+                s.push(tgt[c.1 as usize], *b, c.0);
+            }
         }
-        let a = tgt[c.1 as usize];
-        Sums {
-            n: 1.0,
-            ss: 0.0,
-            sa: a,
-            sb: *b,
-            k: outer(a, *b),
-        }
+        s
     };
-    let s = if parallel {
-        corr.par_chunks(1024)
-            .zip(src.par_chunks(1024))
-            .map(|(c, b)| {
-                c.iter()
-                    .zip(b)
-                    .fold(Sums::ZERO, |s, (c, b)| s.add(acc(c, b)))
-            })
-            .reduce(|| Sums::ZERO, Sums::add)
+    if parallel {
+        let parts: Vec<Sums> = corr
+            .par_chunks(CHUNK)
+            .zip(src.par_chunks(CHUNK))
+            .map(run)
+            .collect();
+        parts.into_iter().fold(Sums::ZERO, Sums::add)
     } else {
-        corr.iter()
-            .zip(src)
-            .fold(Sums::ZERO, |s, (c, b)| s.add(acc(c, b)))
-    };
+        corr.chunks(CHUNK)
+            .zip(src.chunks(CHUNK))
+            .map(run)
+            .fold(Sums::ZERO, Sums::add)
+    }
+}
+
+/// Closed-form point-to-point update from the sums of the kept pairs (`a ~ R b (+ t)`).
+fn point_step(s: &Sums, r: DMat3, t: DVec3, translation: bool) -> (DMat3, DVec3) {
     if s.n < 3.0 {
         return (r, t);
     }
@@ -533,9 +582,9 @@ pub fn icp(
     if opts.coarse_iterations > 0 {
         let c = icp_core(
             &a.sub_points,
-            &a.sub_tree,
+            &a.sub_nn,
             None,
-            &b.sub_points,
+            b.sub_nn.leaf_order_points(),
             init,
             DVec3::ZERO,
             &IcpOptions {
@@ -547,7 +596,16 @@ pub fn icp(
         );
         (r0, t0, coarse_it) = (c.rotation, c.translation, c.iterations);
     }
-    let mut res = icp_core(&a.points, &a.tree, normals, &b.points, r0, t0, opts, true);
+    let mut res = icp_core(
+        &a.points,
+        &a.nn,
+        normals,
+        b.nn.leaf_order_points(),
+        r0,
+        t0,
+        opts,
+        true,
+    );
     res.coarse_iterations = coarse_it;
     Ok(res)
 }
@@ -678,9 +736,9 @@ pub fn global_icp(
                 i,
                 icp_core(
                     &a.sub_points,
-                    &a.sub_tree,
+                    &a.sub_nn,
                     None,
-                    &b.sub_points,
+                    b.sub_nn.leaf_order_points(),
                     r0,
                     DVec3::ZERO,
                     &coarse_opts,
@@ -708,9 +766,9 @@ pub fn global_icp(
         if opts.plane_warmup > 0 {
             let w = icp_core(
                 &a.points,
-                &a.tree,
+                &a.nn,
                 Some(a.normals()),
-                &b.points,
+                b.nn.leaf_order_points(),
                 r,
                 t,
                 &IcpOptions {
@@ -727,9 +785,9 @@ pub fn global_icp(
         let normals = (opts.refine.variant == IcpVariant::PointToPlane).then(|| a.normals());
         finals.push(icp_core(
             &a.points,
-            &a.tree,
+            &a.nn,
             normals,
-            &b.points,
+            b.nn.leaf_order_points(),
             r,
             t,
             &opts.refine,
@@ -775,22 +833,24 @@ pub fn closest_point_stats(
     t: DVec3,
 ) -> ClosestPointStats {
     let dir = |tgt: &PreparedSet, src: &[DVec3], r: DMat3, t: DVec3| -> (f64, f64, f64) {
-        src.par_chunks(1024)
+        // Per-chunk partial sums added in chunk order: deterministic whatever the threads.
+        let parts: Vec<(f64, f64, f64)> = src
+            .par_chunks(CHUNK)
             .map(|ch| {
                 ch.iter().fold((0.0f64, 0.0f64, 0.0f64), |(mx, s, s2), p| {
-                    let (d2, _) = tgt.nearest(r * *p + t);
+                    let (d2, _) = tgt.nn.nearest(r * *p + t);
                     let d = d2.sqrt();
                     (mx.max(d), s + d, s2 + d2)
                 })
             })
-            .reduce(
-                || (0.0, 0.0, 0.0),
-                |x, y| (x.0.max(y.0), x.1 + y.1, x.2 + y.2),
-            )
+            .collect();
+        parts
+            .into_iter()
+            .fold((0.0, 0.0, 0.0), |x, y| (x.0.max(y.0), x.1 + y.1, x.2 + y.2))
     };
-    let (mb, sb, s2b) = dir(a, &b.points, r, t);
+    let (mb, sb, s2b) = dir(a, b.nn.leaf_order_points(), r, t);
     let rt = r.transpose();
-    let (ma, sa, s2a) = dir(b, &a.points, rt, -(rt * t));
+    let (ma, sa, s2a) = dir(b, a.nn.leaf_order_points(), rt, -(rt * t));
     let (na, nb) = (a.points.len() as f64, b.points.len() as f64);
     let hausdorff = ma.max(mb);
     let mean = 0.5 * (sb / nb + sa / na);

@@ -23,6 +23,7 @@ pub mod icp;
 pub mod keyed;
 pub mod linalg;
 mod matrix;
+pub mod nn;
 pub mod points;
 
 use glam::{DMat3, DVec3};
