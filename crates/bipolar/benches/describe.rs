@@ -125,5 +125,37 @@ fn bench(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, bench);
+/// The whole `describe` (what `bipolar describe` computes): exact geodesic fields (cut off just
+/// past the region when `max_level` is set) plus the descriptor; with and without the solver's
+/// preparation.
+fn bench_whole(c: &mut Criterion) {
+    let Some((mesh, refs)) = face() else {
+        eprintln!("paper-set face not found; skipping the whole-describe bench");
+        return;
+    };
+    let mut g = c.benchmark_group("whole_describe_face_exact");
+    g.sample_size(10);
+    for (label, max_level) in [("region_30_of_30", Some(30)), ("whole_face", None)] {
+        let opts = DescriptorOptions {
+            levels: LevelSpec::Count(30),
+            max_level,
+            ..DescriptorOptions::default()
+        };
+        let solver = geodesic::new_solver(&mesh, geodesic::Method::Exact).unwrap();
+        let d = bipolar::describe(&mesh, solver.as_ref(), &refs, &opts).unwrap();
+        eprintln!("  {label}: {} points", d.len());
+        g.bench_function(format!("{label}_solver_prepared"), |b| {
+            b.iter(|| bipolar::describe(&mesh, solver.as_ref(), &refs, &opts).unwrap())
+        });
+        g.bench_function(format!("{label}_with_solver_setup"), |b| {
+            b.iter(|| {
+                let solver = geodesic::new_solver(&mesh, geodesic::Method::Exact).unwrap();
+                bipolar::describe(&mesh, solver.as_ref(), &refs, &opts).unwrap()
+            })
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench, bench_whole);
 criterion_main!(benches);

@@ -1,6 +1,5 @@
 //! Construction of the descriptor (specification §2).
 
-use crate::linalg::sym_eigen3;
 use crate::{
     BipolarError, Descriptor, DescriptorOptions, DescriptorPoint, DescriptorStats, Key, LevelSpec,
     SelectionRule, TangentMethod,
@@ -35,11 +34,90 @@ pub fn describe(
     }
     let topo = Topology::new(mesh);
     check_references(mesh, &topo, refs)?;
-    let fields = refs
-        .iter()
-        .map(|r| solver.distances(&[*r], &SolveOptions::default()))
-        .collect::<Result<Vec<_>, _>>()?;
+    let fields = match opts.max_level {
+        Some(m) if m > 0 => region_fields(mesh, &topo, solver, refs, opts.levels, m)?,
+        _ => refs
+            .iter()
+            .map(|r| solver.distances(&[*r], &SolveOptions::default()))
+            .collect::<Result<Vec<_>, _>>()?,
+    };
     describe_fields_with_refs(mesh, &topo, &fields, Some(refs), opts)
+}
+
+/// Distance fields cut off just past the region `levels 1..=max_level`, so that the solver
+/// stops early (the exact solver's cost grows with the area it covers).
+///
+/// Every value the descriptor reads is the uncut one: a vertex `v` next to a vertex `u` with
+/// `U(u) <= L` has `U(v) <= L + |uv|`, so a cut-off at `L + longest edge` keeps exact values on
+/// every edge and face a level `<= L` crosses. The cut also covers the distances between the
+/// reference points (needed for the step and the checks); when a cut turns out too short
+/// (the geodesic step was unknown before the first field), the field is solved again with a
+/// larger one, and a field that already covers its whole component is never solved again.
+fn region_fields(
+    mesh: &TriMesh,
+    topo: &Topology,
+    solver: &dyn GeodesicSolver,
+    refs: &[Source],
+    levels: LevelSpec,
+    max_level: u32,
+) -> Result<Vec<Vec<f64>>, BipolarError> {
+    let margin = topo
+        .edges
+        .iter()
+        .map(|e| (mesh.position(e.v[0]) - mesh.position(e.v[1])).length())
+        .fold(0.0f64, f64::max)
+        * (1.0 + 1e-9);
+    let pos = refs
+        .iter()
+        .map(|r| source_position(mesh, r))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut comp_size = vec![0usize; topo.n_components];
+    for &c in &topo.vertex_component {
+        comp_size[c as usize] += 1;
+    }
+    // Region radius L = max_level * step; for `Count` the step needs d(r0, r1), first guessed
+    // from the straight-line distance (a lower bound) and corrected after the first field.
+    let region = |d01: f64| match levels {
+        LevelSpec::Count(c) => max_level as f64 * d01 / c.max(1) as f64,
+        LevelSpec::Step(s) => max_level as f64 * s,
+    };
+    let mut d01_guess = (pos[0] - pos[1]).length();
+    let mut fields = Vec::with_capacity(refs.len());
+    for (a, r) in refs.iter().enumerate() {
+        let farthest_ref = (0..refs.len())
+            .map(|b| (pos[a] - pos[b]).length())
+            .fold(0.0f64, f64::max);
+        let mut cut = region(d01_guess * 1.25).max(farthest_ref * 1.25) + margin;
+        loop {
+            let opts = SolveOptions {
+                max_distance: Some(cut),
+            };
+            let f = solver.distances(&[*r], &opts)?;
+            let comp = topo.vertex_component[source_vertex(mesh, r) as usize] as usize;
+            let reached = f.iter().filter(|x| x.is_finite()).count();
+            let whole = reached >= comp_size[comp];
+            let mut needed = 0.0f64;
+            let mut missing = false;
+            for b in refs {
+                let d = field_at(mesh, &f, b)?;
+                if d.is_finite() {
+                    needed = needed.max(d);
+                } else {
+                    missing = true;
+                }
+            }
+            if a == 0 && !missing {
+                d01_guess = field_at(mesh, &f, &refs[1])?;
+            }
+            let want = region(d01_guess).max(needed) + margin;
+            if whole || (!missing && want <= cut) {
+                fields.push(f);
+                break;
+            }
+            cut = if missing { cut * 2.0 } else { want * 1.05 };
+        }
+    }
+    Ok(fields)
 }
 
 /// Builds the descriptor from precomputed distance fields (one per reference point, `+inf` for
@@ -1025,7 +1103,7 @@ impl<'c, 'a> Strip<'c, 'a> {
                 }
             }
         }
-        let (vals, vecs) = sym_eigen3(m);
+        let (vals, vecs) = shapedist::linalg::sym_eigen3(glam::DMat3::from_cols_array_2d(&m));
         if vals[0].is_nan() || vals[0] <= 0.0 || vals[0] < so.min_ratio * vals[1].max(0.0) {
             return None;
         }

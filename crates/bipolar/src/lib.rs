@@ -15,7 +15,6 @@
 //!   [`TangentMethod::Spline`] = the paper's method 2).
 //! * More than two reference points: every pair `a < b` contributes, keys carry the pair.
 //! * [`io`]: CSV / JSON / PLY files. [`synthetic`]: test meshes with analytic fields.
-//!   [`linalg`]: 3x3 eigen-decomposition and the keyed Kabsch distance.
 //!
 //! Determinism: points are sorted by key, then position. Errors: [`BipolarError`]; an empty
 //! result is an error ([`BipolarError::NoIntersections`]) carrying the reason.
@@ -27,7 +26,6 @@ mod build;
 mod error;
 pub mod io;
 mod key;
-pub mod linalg;
 pub mod synthetic;
 mod types;
 

@@ -648,3 +648,105 @@ fn files_round_trip() {
     assert_eq!(t.lines().count(), d.len() + 16);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Wraps a solver and records the cut-off of every call.
+#[derive(Debug)]
+struct Recording<'a> {
+    inner: &'a dyn geodesic::GeodesicSolver,
+    cuts: std::sync::Mutex<Vec<Option<f64>>>,
+}
+
+impl geodesic::GeodesicSolver for Recording<'_> {
+    fn method(&self) -> geodesic::Method {
+        self.inner.method()
+    }
+    fn n_vertices(&self) -> usize {
+        self.inner.n_vertices()
+    }
+    fn distances(
+        &self,
+        sources: &[Source],
+        opts: &geodesic::SolveOptions,
+    ) -> Result<Vec<f64>, geodesic::GeodesicError> {
+        self.cuts.lock().unwrap().push(opts.max_distance);
+        self.inner.distances(sources, opts)
+    }
+}
+
+#[test]
+fn a_region_limit_cuts_the_fields_off_without_changing_the_descriptor() {
+    let sphere = icosphere(4);
+    let plane = grid_plane(40, 0.075, -1.5, 0.3, 11, |_| false);
+    let near = |mesh: &TriMesh, p: DVec3| {
+        (0..mesh.n_vertices() as u32)
+            .min_by(|&a, &b| {
+                (mesh.position(a) - p)
+                    .length()
+                    .total_cmp(&(mesh.position(b) - p).length())
+            })
+            .unwrap()
+    };
+    for (mesh, a, b, c, far, step) in [
+        // Nearly antipodal references: the straight-line guess of d(r, q) is far too short and
+        // the first field has to be solved again.
+        (
+            &sphere,
+            DVec3::new(0.0, 0.0, 1.0),
+            DVec3::new(0.2, 0.0, -0.98),
+            DVec3::new(1.0, 0.0, 0.0),
+            true,
+            0.4,
+        ),
+        (
+            &plane,
+            DVec3::new(-0.4, 0.0, 0.0),
+            DVec3::new(0.4, 0.1, 0.0),
+            DVec3::new(0.0, 0.5, 0.0),
+            false,
+            0.12,
+        ),
+    ] {
+        let topo = Topology::new(mesh);
+        let sp = meshcore::FaceLocator::new(mesh).nearest(c).unwrap().0;
+        let refs = [
+            Source::Vertex(near(mesh, a)),
+            Source::Vertex(near(mesh, b)),
+            Source::Point(sp),
+        ];
+        for method in [geodesic::Method::Exact, geodesic::Method::Dijkstra] {
+            let inner = geodesic::new_solver(mesh, method).unwrap();
+            let full: Vec<Vec<f64>> = refs
+                .iter()
+                .map(|r| {
+                    inner
+                        .distances(&[*r], &geodesic::SolveOptions::default())
+                        .unwrap()
+                })
+                .collect();
+            for (levels, max_level) in [(LevelSpec::Count(6), 4), (LevelSpec::Step(step), 5)] {
+                let mut o = opts(SelectionRule::All, TangentMethod::Gradient, levels);
+                o.max_level = Some(max_level);
+                let rec = Recording {
+                    inner: inner.as_ref(),
+                    cuts: std::sync::Mutex::new(Vec::new()),
+                };
+                let got = describe(mesh, &rec, &refs, &o).unwrap();
+                let want = describe_fields_with_refs(mesh, &topo, &full, Some(&refs), &o).unwrap();
+                let cuts = rec.cuts.into_inner().unwrap();
+                assert!(cuts.iter().all(|c| c.is_some()), "{cuts:?}");
+                assert!(cuts.len() >= 3);
+                if far && matches!(levels, LevelSpec::Count(_)) {
+                    assert!(cuts.len() > 3, "expected a second solve: {cuts:?}");
+                }
+                assert_eq!(got.len(), want.len(), "{method:?} {levels:?}");
+                assert!(!got.is_empty());
+                assert_eq!(got.reference_distance, want.reference_distance);
+                for (p, q) in got.points.iter().zip(&want.points) {
+                    assert_eq!(p.key, q.key);
+                    assert_eq!(p.position, q.position);
+                    assert_eq!(p.cos, q.cos);
+                }
+            }
+        }
+    }
+}
