@@ -5,7 +5,7 @@
 use crate::facemodel::{self, FaceModel, LANDMARK_NAMES};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
-use landmarks::{detect, GenericModel, LandmarkName, TrainOptions};
+use landmarks::{detect_with, DetectOptions, GenericModel, LandmarkName, TrainOptions};
 use meshcore::{DVec3, TriMesh};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -40,10 +40,24 @@ pub struct Args {
     /// Evaluate only the test face of this index (debugging; set LANDMARKS_DEBUG=1 for a trace).
     #[arg(long)]
     pub only: Option<usize>,
+    /// Evaluate on the training faces (`--train` of them, training seed stream) instead of the
+    /// test faces: how detection thresholds are calibrated without looking at the test faces.
+    #[arg(long)]
+    pub on_training: bool,
+    /// Override `DetectOptions::min_symmetry` (0 disables the symmetry check).
+    #[arg(long)]
+    pub min_symmetry: Option<f64>,
+    /// Override `DetectOptions::min_confidence`.
+    #[arg(long)]
+    pub min_confidence: Option<f64>,
     /// Also write the trained generic model to this file (how the crate's default model is made).
     #[arg(long)]
     pub write_model: Option<PathBuf>,
 }
+
+/// Per test face: errors (mm), CPU ms, error message, confidence, symmetry, the weakest local
+/// template agreement.
+type Outcome = (Vec<f64>, f64, Option<String>, f64, f64, f64);
 
 /// Sampled face with the positions of its landmark vertices.
 type Sample = (TriMesh, [DVec3; 5]);
@@ -135,7 +149,11 @@ pub fn run(args: Args) -> Result<()> {
         eprintln!("wrote the generic model to {}", p.display());
     }
     std::fs::write(out.join("generic-model.json"), generic.to_json() + "\n")?;
-    let mut test = sample_faces(&ict, args.faces, test_seed, !args.neutral)?;
+    let mut test = if args.on_training {
+        sample_faces(&ict, args.train, train_seed, true)?
+    } else {
+        sample_faces(&ict, args.faces, test_seed, !args.neutral)?
+    };
     if let Some(i) = args.only {
         anyhow::ensure!(i < test.len(), "--only {i}: only {} test faces", test.len());
         test = vec![test.swap_remove(i)];
@@ -147,11 +165,18 @@ pub fn run(args: Args) -> Result<()> {
     );
     pb.set_message("detecting");
     let unit_mm = if ict.units() == "cm" { 10.0 } else { 1.0 };
-    let results: Vec<(Vec<f64>, f64, Option<String>, f64)> = test
+    let mut dopt = DetectOptions::default();
+    if let Some(x) = args.min_symmetry {
+        dopt.min_symmetry = x;
+    }
+    if let Some(x) = args.min_confidence {
+        dopt.min_confidence = x;
+    }
+    let results: Vec<Outcome> = test
         .par_iter()
         .map(|(mesh, gt)| {
             let c0 = thread_cpu_ns();
-            let r = detect(mesh, &generic);
+            let r = detect_with(mesh, &generic, &dopt);
             // CPU time of this thread (wall-clock time is meaningless on a loaded machine);
             // falls back to wall-clock time where /proc is unavailable.
             let ms = match (c0, thread_cpu_ns()) {
@@ -165,15 +190,32 @@ pub fn run(args: Args) -> Result<()> {
                         .iter()
                         .map(|&n| (lm.get(n).position - gt[n as usize]).length() * unit_mm)
                         .collect();
-                    (e, ms, None, lm.confidence)
+                    (
+                        e,
+                        ms,
+                        None,
+                        lm.confidence,
+                        lm.symmetry,
+                        LandmarkName::ALL
+                            .iter()
+                            .map(|&n| lm.get(n).confidence / lm.confidence.max(1e-12))
+                            .fold(1.0, f64::min),
+                    )
                 }
-                Err(e) => (vec![f64::INFINITY; 5], ms, Some(e.to_string()), 0.0),
+                Err(e) => (
+                    vec![f64::INFINITY; 5],
+                    ms,
+                    Some(e.to_string()),
+                    0.0,
+                    0.0,
+                    0.0,
+                ),
             }
         })
         .collect();
     pb.finish_and_clear();
     let mut per: Vec<Vec<f64>> = vec![Vec::new(); 5];
-    for (e, _, _, _) in &results {
+    for (e, ..) in &results {
         for k in 0..5 {
             per[k].push(e[k]);
         }
@@ -217,18 +259,61 @@ pub fn run(args: Args) -> Result<()> {
     let tmed = times[times.len() / 2];
     let tp95 = times[((times.len() - 1) as f64 * 0.95) as usize];
     println!("CPU time per face (thread CPU time, release): median {tmed:.1} ms, p95 {tp95:.1} ms");
-    for (i, e) in failures.iter().take(5) {
+    for (i, e) in failures.iter().take(20) {
         println!("face {i}: {e}");
     }
     println!("failures: {}", failures.len());
-    let worst: Vec<(usize, f64, f64)> = results
+    // Outcome per face: correct (every landmark within 10 mm), rejected (NotFound) or silently
+    // wrong (a detection with some landmark beyond 10 mm).
+    let n = results.len() as f64;
+    let correct = results
+        .iter()
+        .filter(|r| r.2.is_none() && r.0.iter().all(|&e| e <= 10.0))
+        .count();
+    let silent_wrong = results
+        .iter()
+        .filter(|r| r.2.is_none() && r.0.iter().any(|&e| e > 10.0))
+        .count();
+    let not_found = failures.len();
+    println!(
+        "outcomes: correct {correct} ({:.1} %), not found {not_found} ({:.1} %), silent wrong (> 10 mm) {silent_wrong} ({:.1} %)",
+        100.0 * correct as f64 / n,
+        100.0 * not_found as f64 / n,
+        100.0 * silent_wrong as f64 / n
+    );
+    for (what, get) in [
+        ("confidence", (|r: &Outcome| r.3) as fn(&Outcome) -> f64),
+        ("symmetry", |r| r.4),
+        ("local template agreement", |r| r.5),
+    ] {
+        let mut v: Vec<f64> = results
+            .iter()
+            .filter(|r| r.2.is_none() && r.0.iter().all(|&e| e <= 10.0))
+            .map(get)
+            .collect();
+        v.sort_by(f64::total_cmp);
+        if !v.is_empty() {
+            println!(
+                "{what} of correct detections: min {:.3}, p1 {:.3}, p5 {:.3}, median {:.3}",
+                v[0],
+                v[((v.len() - 1) as f64 * 0.01).round() as usize],
+                v[((v.len() - 1) as f64 * 0.05).round() as usize],
+                v[v.len() / 2]
+            );
+        }
+    }
+    let worst: Vec<(usize, f64, f64, f64, f64)> = results
         .iter()
         .enumerate()
-        .map(|(i, r)| (i, r.0.iter().copied().fold(0.0, f64::max), r.3))
-        .filter(|w| w.1 > 10.0)
+        .map(|(i, r)| (i, r.0.iter().copied().fold(0.0, f64::max), r.3, r.4, r.5))
+        .filter(|w| w.1 > 10.0 && w.1.is_finite())
         .collect();
-    for (i, e, c) in worst.iter().take(10) {
-        println!("face {i}: largest error {e:.1} mm, confidence {c:.2}");
+    for (i, e, c, sy, lo) in worst.iter().take(20) {
+        let each: Vec<String> = results[*i].0.iter().map(|x| format!("{x:.1}")).collect();
+        println!(
+            "face {i}: largest error {e:.1} mm (per landmark {}), confidence {c:.2}, symmetry {sy:.2}, local {lo:.2}",
+            each.join(" ")
+        );
     }
     let summary = serde_json::json!({
         "faces": test.len(),
@@ -239,6 +324,7 @@ pub fn run(args: Args) -> Result<()> {
         "landmark_vertices": LANDMARK_NAMES,
         "per_landmark": st,
         "cpu_time_ms_per_face": {"median": tmed, "p95": tp95},
+        "outcomes": {"correct": correct, "not_found": not_found, "silent_wrong_over_10mm": silent_wrong},
         "failures": failures.iter().map(|(i, e)| serde_json::json!({"face": i, "error": e})).collect::<Vec<_>>(),
     });
     std::fs::write(

@@ -21,15 +21,24 @@ pub struct DetectOptions {
     pub max_nose_candidates: usize,
     /// Maximum number of eye-corner candidates.
     pub max_eye_candidates: usize,
+    /// Mirror-symmetry score (see [`crate::Landmarks::symmetry`]) below which a fitted pose is
+    /// rejected; calibrated on training faces (see `docs/landmarks.md`). `0` disables the check.
+    pub min_symmetry: f64,
+    /// Weakest local template agreement (see [`crate::Landmark::confidence`]: the landmark's
+    /// confidence divided by the fit confidence) below which a fitted pose is rejected;
+    /// calibrated on training faces. `0` disables the check.
+    pub min_local_agreement: f64,
 }
 
 impl Default for DetectOptions {
     fn default() -> Self {
         Self {
             mesh_units_per_model_unit: 1.0,
-            min_confidence: 0.3,
+            min_confidence: 0.55,
             max_nose_candidates: 8,
             max_eye_candidates: 10,
+            min_symmetry: 0.5,
+            min_local_agreement: 0.85,
         }
     }
 }
@@ -85,6 +94,72 @@ struct Hypothesis {
     fit: FitScore,
 }
 
+/// Mirror-symmetry check of a fitted pose: the input vertices matched by the generic face are
+/// mirrored across the model's mid-sagittal plane (`x = 0` of the canonical frame, moved by the
+/// pose) and must land on the input surface again with agreeing normals. A face is nearly
+/// mirror-symmetric about that plane only when the pose is right; a pose rotated about the nose
+/// or fitted on a cheek, a chin or a non-face maps the matched region onto empty space or onto
+/// a differently oriented surface. Returns the share of mirrored vertices that are inliers
+/// (distance below `tau`, normals within 60 degrees), in `[0, 1]`.
+fn symmetry(idx: &SurfaceIndex, face: &[(DVec3, DVec3)], t: &Rigid, tau: f64) -> f64 {
+    let tau2 = tau * tau;
+    let mut verts: Vec<u32> = face
+        .iter()
+        .filter_map(|(p, n)| {
+            let h = idx.query(t.apply(*p));
+            (h.d2 < tau2 && idx.nrm[h.vertex as usize].dot(t.rotate(*n)) > 0.5).then_some(h.vertex)
+        })
+        .collect();
+    verts.sort_unstable();
+    verts.dedup();
+    if verts.is_empty() {
+        return 0.0;
+    }
+    let inv = t.inverse();
+    let mirror = |v: DVec3| DVec3::new(-v.x, v.y, v.z);
+    let ok = verts
+        .iter()
+        .filter(|&&v| {
+            let q = t.apply(mirror(inv.apply(idx.pos[v as usize])));
+            let nq = t.rotate(mirror(inv.rotate(idx.nrm[v as usize])));
+            let h = idx.query(q);
+            h.d2 < tau2 && idx.nrm[h.vertex as usize].dot(nq) > 0.5
+        })
+        .count();
+    ok as f64 / verts.len() as f64
+}
+
+/// Keeps the best `max` hypotheses (sorted by cost) whose predicted nose tip and outer eye
+/// corners are not all within `radius` of those of an already kept one: the coarse scores of
+/// near-duplicate poses (one pose reached from several eye-candidate pairs) would otherwise
+/// fill the list and push out the right pose.
+fn diverse(sorted: Vec<Hypothesis>, keys: [DVec3; 3], radius: f64, max: usize) -> Vec<Hypothesis> {
+    let mut kept: Vec<(Hypothesis, [DVec3; 3])> = Vec::new();
+    for h in sorted {
+        let k = keys.map(|p| h.t.apply(p));
+        let dup = kept
+            .iter()
+            .any(|(_, o)| (0..3).all(|i| (o[i] - k[i]).length() < radius));
+        if !dup {
+            kept.push((h, k));
+            if kept.len() >= max {
+                break;
+            }
+        }
+    }
+    kept.into_iter().map(|(h, _)| h).collect()
+}
+
+/// A finely fitted pose with its confidence, symmetry and (once computed) its refined landmarks
+/// with their weakest local agreement.
+#[derive(Debug, Clone, Copy)]
+struct Verified {
+    h: Hypothesis,
+    conf: f64,
+    sym: f64,
+    refined: Option<([Landmark; 5], f64)>,
+}
+
 /// Detects the five landmarks with the default options (mesh in the model's units).
 pub fn detect(mesh: &TriMesh, model: &GenericModel) -> Result<Landmarks, LandmarkError> {
     detect_with(mesh, model, &DetectOptions::default())
@@ -133,7 +208,16 @@ pub fn detect_with(
     use LandmarkName as L;
     let mut n_noses = 0;
     let mut n_eyes = 0;
-    let mut overall: Option<Hypothesis> = None;
+    let face = model.face.pairs();
+    let tau = p.inlier_distance;
+    let d = model.eye_distance();
+    let keys = [
+        model.landmark(L::NoseTip),
+        model.landmark(L::OuterEyeRight),
+        model.landmark(L::OuterEyeLeft),
+    ];
+    // Every finely fitted pose of every round, verified.
+    let mut fits: Vec<Verified> = Vec::new();
     // Round 0 with the nominal candidates; round 1, only when round 0 found no convincing face
     // (expressions can blur the curvature signatures), with three times more nose candidates
     // and a looser signature gate.
@@ -172,7 +256,6 @@ pub fn detect_with(
             continue;
         }
         // Pose hypotheses.
-        let d = model.eye_distance();
         let m_nose = model.landmark(L::NoseTip);
         let m_nn = DVec3::from_array(model.nose_normal);
         let m_ir = model.landmark(L::InnerEyeRight);
@@ -220,8 +303,6 @@ pub fn detect_with(
                 }
             }
         }
-        let face = model.face.pairs();
-        let tau = p.inlier_distance;
         let coarse: Vec<(DVec3, DVec3)> = face.iter().step_by(3).copied().collect();
         let mut scored: Vec<Hypothesis> = hyps
             .iter()
@@ -243,7 +324,7 @@ pub fn detect_with(
                     .collect::<Vec<_>>()
             );
         }
-        scored.truncate(12);
+        let scored = diverse(scored, keys, 0.25 * d, 12);
         // Coarse ICP of the best hypotheses with a wide inlier band, then the nominal band on the
         // best three.
         let mut coarse_fits: Vec<Hypothesis> = scored
@@ -257,27 +338,42 @@ pub fn detect_with(
             })
             .collect();
         coarse_fits.sort_by(|a, b| a.fit.cost.total_cmp(&b.fit.cost));
-        coarse_fits.truncate(3);
-        let mut best: Option<Hypothesis> = None;
+        let coarse_fits = diverse(coarse_fits, keys, 0.25 * d, 3);
         for h in &coarse_fits {
             let t2 = icp(&idx, &face, &h.t, 12, tau, 0.5);
             let fit = score(&idx, &face, &t2, tau, 0.5);
-            if best.as_ref().is_none_or(|b| fit.cost < b.fit.cost) {
-                best = Some(Hypothesis { t: t2, fit });
+            fits.push(Verified {
+                h: Hypothesis { t: t2, fit },
+                conf: fit_confidence(&fit, p.typical_rms, p.typical_inliers),
+                sym: symmetry(&idx, &face, &t2, tau),
+                refined: None,
+            });
+        }
+        fits.sort_by(|a, b| a.h.fit.cost.total_cmp(&b.h.fit.cost));
+        if debug {
+            for f in &fits {
+                eprintln!(
+                    "fit cost {:.4} confidence {:.3} symmetry {:.3} nose at {:?}",
+                    f.h.fit.cost,
+                    f.conf,
+                    f.sym,
+                    f.h.t.apply(keys[0])
+                );
             }
         }
-        if let Some(b) = best {
-            if overall.as_ref().is_none_or(|o| b.fit.cost < o.fit.cost) {
-                overall = Some(b);
-            }
-        }
-        if let Some(o) = &overall {
-            if fit_confidence(&o.fit, p.typical_rms, p.typical_inliers) >= 0.85 {
-                break;
+        // The best-fitting pose decides; a second round only when it is weak or not symmetric.
+        if let Some(f) = fits.first_mut() {
+            if f.conf >= 0.85 && f.sym >= options.min_symmetry {
+                let r = *f
+                    .refined
+                    .get_or_insert_with(|| refine_all(&idx, model, &f.h.t, f.conf, debug));
+                if r.1 >= options.min_local_agreement {
+                    break;
+                }
             }
         }
     }
-    let Some(best) = overall else {
+    if fits.is_empty() {
         return Err(LandmarkError::NotFound {
             reason: if n_noses == 0 {
                 "no convex cap (nose-tip candidate) on the surface".into()
@@ -288,26 +384,87 @@ pub fn detect_with(
             },
             best_score: 0.0,
         });
-    };
-    let conf_fit = fit_confidence(&best.fit, p.typical_rms, p.typical_inliers);
-    if conf_fit < options.min_confidence {
-        return Err(LandmarkError::NotFound {
-            reason: format!(
-                "the best fit of the generic face covers {:.0} % of it (rms {:.3} model units)",
-                100.0 * best.fit.inlier_fraction,
-                best.fit.rms
-            ),
-            best_score: conf_fit,
+    }
+    // The best-fitting pose that passes the three checks (fit confidence, mirror symmetry, local
+    // template agreement at every landmark), in increasing order of fit cost.
+    let mut rejected: Option<(String, f64)> = None;
+    for f in &mut fits {
+        let why = if f.conf < options.min_confidence {
+            Some(format!(
+                "the best fit of the generic face covers {:.0} % of it (rms {:.3} model units; confidence {:.2} < {:.2})",
+                100.0 * f.h.fit.inlier_fraction,
+                f.h.fit.rms,
+                f.conf,
+                options.min_confidence
+            ))
+        } else if f.sym < options.min_symmetry {
+            Some(format!(
+                "the best fit of the generic face is not mirror-symmetric (symmetry {:.2} < {:.2})",
+                f.sym, options.min_symmetry
+            ))
+        } else {
+            None
+        };
+        if let Some(why) = why {
+            rejected.get_or_insert((why, f.conf * f.sym));
+            continue;
+        }
+        let (out, local) = *f
+            .refined
+            .get_or_insert_with(|| refine_all(&idx, model, &f.h.t, f.conf, debug));
+        if local < options.min_local_agreement {
+            rejected.get_or_insert((
+                format!(
+                    "the surface around the landmarks predicted by the best fit does not match their templates (agreement {local:.2} < {:.2})",
+                    options.min_local_agreement
+                ),
+                f.conf * local,
+            ));
+            continue;
+        }
+        let best = f.h;
+        let out = out.map(|l| Landmark {
+            position: mesh.position(l.vertex),
+            ..l
+        });
+        let pose = DAffine3::from_mat3_translation(best.t.r, best.t.t * s);
+        return Ok(Landmarks {
+            outer_eye_right: out[L::OuterEyeRight as usize],
+            inner_eye_right: out[L::InnerEyeRight as usize],
+            inner_eye_left: out[L::InnerEyeLeft as usize],
+            outer_eye_left: out[L::OuterEyeLeft as usize],
+            nose_tip: out[L::NoseTip as usize],
+            confidence: f.conf,
+            fit_rms: best.fit.rms * s,
+            inlier_fraction: best.fit.inlier_fraction,
+            symmetry: f.sym,
+            model_to_mesh: pose,
         });
     }
-    // Local refinement of each landmark.
+    let (reason, best_score) = rejected.unwrap_or_default();
+    Err(LandmarkError::NotFound { reason, best_score })
+}
+
+/// Local template refinement of the five landmarks predicted by the pose `t`: the landmarks
+/// (positions in model units, confidences `conf_fit` times the local agreement) and the
+/// weakest local agreement.
+fn refine_all(
+    idx: &SurfaceIndex,
+    model: &GenericModel,
+    t: &Rigid,
+    conf_fit: f64,
+    debug: bool,
+) -> ([Landmark; 5], f64) {
+    use LandmarkName as L;
+    let p = &model.params;
     let mut out = [Landmark {
         vertex: 0,
         position: DVec3::ZERO,
         confidence: 0.0,
     }; 5];
+    let mut weakest = 1.0_f64;
     for name in L::ALL {
-        let pred = best.t.apply(model.landmark(name));
+        let pred = t.apply(model.landmark(name));
         let tpl = model.patches[name as usize].pairs();
         // The nose tip is a strong feature but far from the eyes that dominate the pose: wider
         // search.
@@ -316,7 +473,7 @@ pub fn detect_with(
         } else {
             p.search_radius
         };
-        let (v, cost) = refine(&idx, &tpl, &best.t, pred, radius, p.inlier_distance);
+        let (v, cost) = refine(idx, &tpl, t, pred, radius, p.inlier_distance);
         if debug {
             eprintln!(
                 "{name}: predicted at {:?} (vertex {}), refined to vertex {v} (cost {cost:.2e})",
@@ -325,24 +482,14 @@ pub fn detect_with(
             );
         }
         let c_local = (-(cost / (p.typical_rms * p.typical_rms)) * 0.1).exp();
+        weakest = weakest.min(c_local);
         out[name as usize] = Landmark {
             vertex: v,
-            position: mesh.position(v),
+            position: idx.pos[v as usize],
             confidence: (conf_fit * c_local).clamp(0.0, 1.0),
         };
     }
-    let pose = DAffine3::from_mat3_translation(best.t.r, best.t.t * s);
-    Ok(Landmarks {
-        outer_eye_right: out[L::OuterEyeRight as usize],
-        inner_eye_right: out[L::InnerEyeRight as usize],
-        inner_eye_left: out[L::InnerEyeLeft as usize],
-        outer_eye_left: out[L::OuterEyeLeft as usize],
-        nose_tip: out[L::NoseTip as usize],
-        confidence: conf_fit,
-        fit_rms: best.fit.rms * s,
-        inlier_fraction: best.fit.inlier_fraction,
-        model_to_mesh: pose,
-    })
+    (out, weakest)
 }
 
 /// Confidence in `[0, 1]` of a face fit from its inlier share and inlier RMS, relative to the

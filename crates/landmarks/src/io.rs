@@ -142,7 +142,7 @@ pub fn read_ict_landmarks(path: &Path) -> Result<BTreeMap<String, [DVec3; 5]>, L
     parse_ict_landmarks(&text, &path.display().to_string())
 }
 
-/// JSON of detected landmarks: `{"confidence", "fit_rms", "inlier_fraction", "landmarks":
+/// JSON of detected landmarks: `{"confidence", "fit_rms", "inlier_fraction", "symmetry", "landmarks":
 /// {"outer_eye_right": {"vertex", "position": [x, y, z], "confidence"}, ...}}`.
 pub fn landmarks_to_json(lm: &Landmarks) -> serde_json::Value {
     let mut m = serde_json::Map::new();
@@ -161,6 +161,7 @@ pub fn landmarks_to_json(lm: &Landmarks) -> serde_json::Value {
         "confidence": lm.confidence,
         "fit_rms": lm.fit_rms,
         "inlier_fraction": lm.inlier_fraction,
+        "symmetry": lm.symmetry,
         "landmarks": m,
     })
 }

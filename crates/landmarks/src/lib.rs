@@ -131,6 +131,9 @@ pub struct Landmarks {
     pub fit_rms: f64,
     /// Share of the generic face surface that found the input surface.
     pub inlier_fraction: f64,
+    /// Mirror symmetry of the fit in `[0, 1]`: share of the matched input vertices that, mirrored
+    /// across the fitted mid-sagittal plane, land on the input surface again.
+    pub symmetry: f64,
     /// Rigid motion from the model's canonical frame to the input (model units scaled to input
     /// units only in the translation).
     pub model_to_mesh: DAffine3,
