@@ -302,107 +302,19 @@ pub fn random_rigid_motion<R: Rng>(rng: &mut R, translation_sigma: f64) -> DAffi
     DAffine3::from_rotation_translation(q, t)
 }
 
-/// Minimal Wavefront OBJ reader: `v x y z` and `f` lines (polygons fan-triangulated, `v/vt/vn`
-/// and negative indices accepted); everything else ignored.
+/// Reads a Wavefront OBJ file with `mesh_io` (the project's one OBJ reader: `v` and `f`
+/// lines, polygons fan-triangulated, `v/vt/vn` and negative indices accepted): positions and
+/// triangles.
 pub fn read_obj(path: &Path) -> Result<(Vec<DVec3>, Vec<[u32; 3]>)> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let mut v = Vec::new();
-    let mut f = Vec::new();
-    for (ln, line) in text.lines().enumerate() {
-        let mut it = line.split_whitespace();
-        match it.next() {
-            Some("v") => {
-                let c: Vec<f64> = it
-                    .take(3)
-                    .map(str::parse)
-                    .collect::<std::result::Result<_, _>>()
-                    .with_context(|| format!("{}:{}: bad vertex", path.display(), ln + 1))?;
-                if c.len() != 3 {
-                    bail!(
-                        "{}:{}: vertex with {} coordinates",
-                        path.display(),
-                        ln + 1,
-                        c.len()
-                    );
-                }
-                v.push(DVec3::new(c[0], c[1], c[2]));
-            }
-            Some("f") => {
-                let mut idx = Vec::new();
-                for tok in it {
-                    let s = tok.split('/').next().unwrap_or("");
-                    let i: i64 = s.parse().with_context(|| {
-                        format!("{}:{}: bad face index", path.display(), ln + 1)
-                    })?;
-                    let i = if i < 0 { v.len() as i64 + i } else { i - 1 };
-                    if i < 0 {
-                        bail!("{}:{}: face index out of range", path.display(), ln + 1);
-                    }
-                    idx.push(i as u32);
-                }
-                for k in 1..idx.len().saturating_sub(1) {
-                    f.push([idx[0], idx[k], idx[k + 1]]);
-                }
-            }
-            _ => {}
-        }
-    }
-    Ok((v, f))
+    let loaded = mesh_io::read_mesh(path).with_context(|| format!("reading {}", path.display()))?;
+    Ok((
+        loaded.mesh.positions().to_vec(),
+        loaded.mesh.triangles().to_vec(),
+    ))
 }
 
-/// Reads a little-endian float32 C-order `.npy` file (format 1.0-3.0): shape and data.
+/// Reads a little-endian float32 C-order `.npy` file with `mesh_io` (the project's one `.npy`
+/// reader): shape and data.
 pub fn read_npy_f32(path: &Path) -> Result<(Vec<usize>, Vec<f32>)> {
-    let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
-    let p = path.display();
-    if bytes.len() < 10 || &bytes[..6] != b"\x93NUMPY" {
-        bail!("{p}: not a .npy file (bad magic)");
-    }
-    let (hlen, start) = match bytes[6] {
-        1 => (u16::from_le_bytes([bytes[8], bytes[9]]) as usize, 10),
-        2 | 3 if bytes.len() >= 12 => (
-            u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]) as usize,
-            12,
-        ),
-        v => bail!("{p}: unsupported .npy version {v}"),
-    };
-    let header = bytes
-        .get(start..start + hlen)
-        .ok_or_else(|| anyhow!("{p}: truncated header"))?;
-    let header = std::str::from_utf8(header).with_context(|| format!("{p}: header not UTF-8"))?;
-    if !header.contains("'<f4'") {
-        bail!("{p}: dtype is not little-endian float32: {header}");
-    }
-    if header.contains("'fortran_order': True") {
-        bail!("{p}: Fortran order is not supported");
-    }
-    let s = header
-        .find("'shape':")
-        .ok_or_else(|| anyhow!("{p}: no shape in header"))?;
-    let rest = &header[s..];
-    let (a, b) = (
-        rest.find('(').ok_or_else(|| anyhow!("{p}: bad shape"))?,
-        rest.find(')').ok_or_else(|| anyhow!("{p}: bad shape"))?,
-    );
-    let shape: Vec<usize> = rest[a + 1..b]
-        .split(',')
-        .map(str::trim)
-        .filter(|t| !t.is_empty())
-        .map(str::parse)
-        .collect::<std::result::Result<_, _>>()
-        .with_context(|| format!("{p}: bad shape"))?;
-    let count: usize = shape.iter().product();
-    let data = &bytes[start + hlen..];
-    if data.len() != count * 4 {
-        bail!(
-            "{p}: {} data bytes for shape {shape:?} ({} expected)",
-            data.len(),
-            count * 4
-        );
-    }
-    let vals = data
-        .chunks_exact(4)
-        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-        .collect();
-    Ok((shape, vals))
+    mesh_io::read_npy_f32(path).with_context(|| format!("reading {}", path.display()))
 }
