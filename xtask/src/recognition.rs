@@ -6,7 +6,7 @@
 //! neutral face and forms the gallery, the M - 1 others are the probes. Every face is moved by
 //! a random rigid motion, so nothing can rely on a shared frame. Scores are distances (lower =
 //! more similar): rank-1 identification rate over the probes, verification EER over all
-//! probe x gallery pairs, and the ROC curve. Results: `report.md`, `summary.json`, `roc.svg`,
+//! probe x gallery pairs, and the ROC curve. Results: `report.md`, `summary.json`, `roc.svg` (and `roc.png`),
 //! CSV tables, in the output folder printed on the last line.
 
 use crate::experiments::data::default_out_dir;
@@ -481,6 +481,7 @@ pub fn run(args: Args) -> Result<()> {
         &series,
     )?;
     rep.figure("roc.svg", "ROC curves; dashed: detected landmarks");
+    rep.png_twins()?;
     let secs = t0.elapsed().as_secs_f64();
     rep.para(&format!("Run time: {secs:.1} s."));
     rep.finish()?;
