@@ -16,45 +16,65 @@
 
 #![allow(clippy::needless_range_loop)] // index loops over parallel per-vertex arrays
 
+mod factor;
+
 use crate::{GeodesicError, GeodesicSolver, Method, SolveOptions, Source, TriMesh};
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::Llt;
-use faer::sparse::{SparseColMat, Triplet};
-use faer::Side;
+use factor::Factor;
+use faer::sparse::Triplet;
 use glam::DVec3;
+
+/// Per-face data of the gradient and divergence operators (internal vertex numbering).
+///
+/// With `a_c = ½ n × e_c` (`n` the unit normal, `e_c` the edge opposite corner `c` along the
+/// winding), the hat-function gradients are `∇φ_c = a_c / A` and `a_0 + a_1 + a_2 = 0`. The
+/// heat gradient is therefore parallel to `g = (u_1 - u_0) a_1 + (u_2 - u_0) a_2`, the unit
+/// field is `X = -g / |g|`, and the integrated divergence of `X` at corner `c` (the cotan
+/// formula of Crane et al.) is `-A ∇φ_c · X = -a_c · X`; the Poisson right-hand side
+/// `-div X` gets `a_c · X` per corner. No areas, cotangents or positions are needed per solve.
+#[derive(Debug, Clone, Copy)]
+struct FaceOp {
+    /// Internal indices of the corners.
+    v: [u32; 3],
+    /// `a_1`.
+    a1: DVec3,
+    /// `a_2`.
+    a2: DVec3,
+}
 
 /// Heat-method geodesic distance.
 ///
-/// Smooth and fast per source once prepared (two sparse triangular solve pairs and two linear
-/// passes over the faces), but only an approximation: the error shrinks slowly with refinement
+/// Smooth and fast per source once prepared (two sparse triangular solve pairs and one linear
+/// pass over the faces), but only an approximation: the error shrinks slowly with refinement
 /// and is largest near the source and at the cut locus. Unreachable vertices (components
 /// without a source, and vertices touched by no non-degenerate face) get `f64::INFINITY`.
 #[derive(Debug)]
 pub struct HeatMethod {
     positions: Vec<DVec3>,
     triangles: Vec<[u32; 3]>,
-    /// Per face: `N × e_i / (2A)` for each corner `i` (gradient of the hat functions); zero for
-    /// degenerate faces.
-    grad_basis: Vec<[DVec3; 3]>,
-    /// Per face: half cotangents of the angles at its corners (0 for degenerate faces).
-    half_cot: Vec<[f64; 3]>,
-    /// Component of each vertex (faces connected through shared vertices, degenerate faces
-    /// ignored); `u32::MAX` for vertices touched by no non-degenerate face.
+    /// Internal (fill-reducing) index of each original vertex; every per-solve array is in
+    /// internal order, so the factors are used without permuting.
+    internal: Vec<u32>,
+    /// Non-degenerate faces, sorted by their smallest internal corner (memory locality).
+    faces: Vec<FaceOp>,
+    /// Component of each internal vertex (faces connected through shared vertices, degenerate
+    /// faces ignored); `u32::MAX` for vertices touched by no non-degenerate face.
     component: Vec<u32>,
-    /// Pinned vertex of each component.
+    /// Pinned vertex (internal index) of each component: its smallest original vertex.
     pins: Vec<u32>,
     /// Number of vertices per component.
     comp_size: Vec<usize>,
     /// Heat time step `t`.
     t: f64,
-    heat: Llt<usize, f64>,
-    /// Heat matrix with zero Dirichlet conditions on boundary vertices (meshes with boundary:
-    /// the heat flow is the average of the Neumann and Dirichlet solutions, as recommended by
-    /// Crane et al. and done by libigl).
-    heat_dirichlet: Option<Llt<usize, f64>>,
-    /// Boundary vertices (edges with one face).
+    /// Cholesky factor of `M + tL` (internal numbering).
+    heat: Factor,
+    /// Factor of the heat matrix with zero Dirichlet conditions on boundary vertices (meshes with
+    /// boundary: the heat flow is the average of the Neumann and Dirichlet solutions, as
+    /// recommended by Crane et al. and done by libigl).
+    heat_dirichlet: Option<Factor>,
+    /// Boundary vertices (edges with one face), internal numbering.
     is_boundary: Vec<bool>,
-    poisson: Llt<usize, f64>,
+    /// Factor of `L` with the pinned vertices' rows and columns replaced by the identity.
+    poisson: Factor,
 }
 
 impl HeatMethod {
@@ -77,8 +97,13 @@ impl HeatMethod {
         let pos = mesh.positions();
         let tris = mesh.triangles();
         let n = pos.len();
-        let mut grad_basis = Vec::with_capacity(tris.len());
-        let mut half_cot = Vec::with_capacity(tris.len());
+        if u32::try_from(n).is_err() {
+            return Err(GeodesicError::Numerical(format!(
+                "{n} vertices are too many for the heat method's 32-bit indices"
+            )));
+        }
+        // Per non-degenerate face (original numbering): corners and a_1, a_2.
+        let mut ops: Vec<FaceOp> = Vec::with_capacity(tris.len());
         let mut mass = vec![0.0f64; n];
         // Union-find over non-degenerate faces.
         let mut parent: Vec<u32> = (0..n as u32).collect();
@@ -90,7 +115,10 @@ impl HeatMethod {
             }
             x
         }
-        let mut lap: Vec<Triplet<usize, usize, f64>> = Vec::with_capacity(tris.len() * 6);
+        // Cotan Laplacian, lower triangle (row >= col), original numbering.
+        let mut lap: Vec<Triplet<u32, u32, f64>> = Vec::with_capacity(tris.len() * 6);
+        // Edges of non-degenerate faces, (min, max), for the boundary.
+        let mut edges: Vec<(u32, u32)> = Vec::with_capacity(tris.len() * 3);
         for t3 in tris {
             let [i, j, k] = t3.map(|v| v as usize);
             let (pi, pj, pk) = (pos[i], pos[j], pos[k]);
@@ -101,30 +129,25 @@ impl HeatMethod {
                 .max((pk - pj).length_squared())
                 .max((pi - pk).length_squared());
             if i == j || j == k || i == k || dbl_area.is_nan() || dbl_area <= 1e-14 * scale {
-                grad_basis.push([DVec3::ZERO; 3]);
-                half_cot.push([0.0; 3]);
                 continue;
             }
             let nu = nrm / dbl_area;
             let corners = [(i, pi), (j, pj), (k, pk)];
-            let mut gb = [DVec3::ZERO; 3];
             let mut hc = [0.0; 3];
             for c in 0..3 {
                 let (_, p0) = corners[c];
                 let (_, p1) = corners[(c + 1) % 3];
                 let (_, p2) = corners[(c + 2) % 3];
-                // Edge opposite corner c, oriented along the face winding.
-                gb[c] = nu.cross(p2 - p1) / dbl_area;
                 let (u, w) = (p1 - p0, p2 - p0);
                 hc[c] = 0.5 * u.dot(w) / dbl_area;
             }
             for c in 0..3 {
-                let (a, b) = (corners[(c + 1) % 3].0, corners[(c + 2) % 3].0);
+                let (a, b) = (corners[(c + 1) % 3].0 as u32, corners[(c + 2) % 3].0 as u32);
                 let wgt = hc[c];
-                // Lower triangle only (row >= col).
                 lap.push(Triplet::new(a.max(b), a.min(b), -wgt));
                 lap.push(Triplet::new(a, a, wgt));
                 lap.push(Triplet::new(b, b, wgt));
+                edges.push((a.min(b), a.max(b)));
             }
             for &v in &[i, j, k] {
                 mass[v] += dbl_area / 6.0;
@@ -138,8 +161,12 @@ impl HeatMethod {
                     parent[hi as usize] = lo;
                 }
             }
-            grad_basis.push(gb);
-            half_cot.push(hc);
+            // a_c = ½ n × (edge opposite c, along the winding).
+            ops.push(FaceOp {
+                v: *t3,
+                a1: 0.5 * nu.cross(pi - pk),
+                a2: 0.5 * nu.cross(pj - pi),
+            });
         }
         // Components (numbered in order of their smallest vertex) and pins (that vertex).
         let mut component = vec![u32::MAX; n];
@@ -166,87 +193,90 @@ impl HeatMethod {
         for &p in &pins {
             is_pin[p as usize] = true;
         }
-
-        // Heat matrix M + tL; untouched vertices get an identity row.
-        let mut heat_trip: Vec<Triplet<usize, usize, f64>> = lap
-            .iter()
-            .map(|e| Triplet::new(e.row, e.col, t * e.val))
-            .collect();
-        // Poisson matrix: L without the rows/columns of pinned and untouched vertices.
-        let mut pois_trip: Vec<Triplet<usize, usize, f64>> = lap
-            .into_iter()
-            .filter(|e| !is_pin[e.row] && !is_pin[e.col])
-            .collect();
-        for v in 0..n {
-            if touched[v] {
-                heat_trip.push(Triplet::new(v, v, mass[v]));
-            } else {
-                heat_trip.push(Triplet::new(v, v, 1.0));
-            }
-            if is_pin[v] || !touched[v] {
-                pois_trip.push(Triplet::new(v, v, 1.0));
-            }
-        }
-        let factor_of = |trip: &[Triplet<usize, usize, f64>], what: &str| {
-            let m = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, trip).map_err(|e| {
-                GeodesicError::Numerical(format!("building the {what} matrix: {e:?}"))
-            })?;
-            m.sp_cholesky(Side::Lower).map_err(|e| {
-                GeodesicError::Numerical(format!(
-                    "Cholesky factorisation of the {what} matrix failed ({e:?}); \
-                     the mesh probably has near-degenerate faces"
-                ))
-            })
-        };
         // Boundary vertices: endpoints of edges used by exactly one non-degenerate face.
-        let mut edge_count: std::collections::HashMap<(u32, u32), u32> =
-            std::collections::HashMap::with_capacity(tris.len() * 2);
-        for (f, t3) in tris.iter().enumerate() {
-            if half_cot[f] == [0.0; 3] && grad_basis[f] == [DVec3::ZERO; 3] {
-                continue;
-            }
-            for k in 0..3 {
-                let (a, b) = (t3[k], t3[(k + 1) % 3]);
-                *edge_count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
-            }
-        }
+        edges.sort_unstable();
         let mut is_boundary = vec![false; n];
-        for (&(a, b), &c) in &edge_count {
-            if c == 1 {
-                is_boundary[a as usize] = true;
-                is_boundary[b as usize] = true;
+        let mut e = 0;
+        while e < edges.len() {
+            let mut f = e + 1;
+            while f < edges.len() && edges[f] == edges[e] {
+                f += 1;
             }
+            if f - e == 1 {
+                is_boundary[edges[e].0 as usize] = true;
+                is_boundary[edges[e].1 as usize] = true;
+            }
+            e = f;
         }
-        let heat_dirichlet = if is_boundary.iter().any(|&b| b) {
-            let mut trip: Vec<Triplet<usize, usize, f64>> = heat_trip
-                .iter()
-                .filter(|e| !is_boundary[e.row] && !is_boundary[e.col])
-                .copied()
-                .collect();
-            for v in 0..n {
-                if is_boundary[v] {
-                    trip.push(Triplet::new(v, v, 1.0));
+        let has_boundary = is_boundary.iter().any(|&b| b);
+
+        // All matrices share one pattern (the Laplacian's plus the diagonal), hence one
+        // symbolic analysis; rows and columns replaced by the identity keep their positions
+        // as explicit zeros (dropped again when the factor is copied out).
+        let mut trip: Vec<Triplet<u32, u32, f64>> = lap.clone();
+        for v in 0..n as u32 {
+            trip.push(Triplet::new(v, v, 0.0));
+        }
+        // Heat matrix M + tL; untouched vertices get an identity row.
+        for (e, l) in trip.iter_mut().zip(&lap) {
+            e.val = t * l.val;
+        }
+        for v in 0..n {
+            trip[lap.len() + v].val = if touched[v] { mass[v] } else { 1.0 };
+        }
+        let heat_mat = factor::lower_matrix(n, &trip, "heat")?;
+        let symbolic = factor::analyse(&heat_mat)?;
+        let heat = Factor::new(&symbolic, &heat_mat, "heat")?;
+        drop(heat_mat);
+        let heat_dirichlet = if has_boundary {
+            // Boundary rows and columns become the identity (the diagonal triplets come last).
+            let mut d = trip.clone();
+            for (idx, e) in d.iter_mut().enumerate() {
+                if is_boundary[e.row as usize] || is_boundary[e.col as usize] {
+                    e.val = if idx >= lap.len() { 1.0 } else { 0.0 };
                 }
             }
-            Some(factor_of(&trip, "Dirichlet heat")?)
+            let m = factor::lower_matrix(n, &d, "Dirichlet heat")?;
+            Some(Factor::new(&symbolic, &m, "Dirichlet heat")?)
         } else {
             None
         };
-        let heat = factor_of(&heat_trip, "heat")?;
-        let poisson = factor_of(&pois_trip, "Poisson")?;
+        // Poisson matrix: L with the rows/columns of pinned and untouched vertices replaced by
+        // the identity.
+        for (e, l) in trip.iter_mut().zip(&lap) {
+            let (r, c) = (l.row as usize, l.col as usize);
+            e.val = if is_pin[r] || is_pin[c] { 0.0 } else { l.val };
+        }
+        for v in 0..n {
+            trip[lap.len() + v].val = if is_pin[v] || !touched[v] { 1.0 } else { 0.0 };
+        }
+        let pois_mat = factor::lower_matrix(n, &trip, "Poisson")?;
+        let poisson = Factor::new(&symbolic, &pois_mat, "Poisson")?;
+        drop(pois_mat);
+
+        // Internal numbering = the fill-reducing ordering.
+        let (original, internal) = factor::permutation(&symbolic);
+        let mut faces = ops;
+        for f in faces.iter_mut() {
+            f.v = f.v.map(|v| internal[v as usize]);
+        }
+        faces.sort_by_key(|f| f.v.iter().copied().min().unwrap_or(0));
+        let by_internal =
+            |x: &[bool]| -> Vec<bool> { original.iter().map(|&v| x[v as usize]).collect() };
+        let component_int: Vec<u32> = original.iter().map(|&v| component[v as usize]).collect();
         Ok(Self {
             positions: pos.to_vec(),
             triangles: tris.to_vec(),
-            grad_basis,
-            half_cot,
-            component,
-            pins,
+            faces,
+            component: component_int,
+            pins: pins.iter().map(|&p| internal[p as usize]).collect(),
             comp_size,
             t,
             heat,
             heat_dirichlet,
-            is_boundary,
+            is_boundary: by_internal(&is_boundary),
             poisson,
+            internal,
         })
     }
 
@@ -285,6 +315,32 @@ impl HeatMethod {
         }
         Ok(out)
     }
+
+    /// Adds `-div X` of the normalised negative gradient of `u` (internal numbering) to `rhs`.
+    fn divergence_of_unit_gradient(&self, u: &[f64], rhs: &mut [f64]) {
+        for f in &self.faces {
+            let [i, j, k] = f.v.map(|v| v as usize);
+            let ui = u[i];
+            let mut g = (u[j] - ui) * f.a1 + (u[k] - ui) * f.a2;
+            let mut sq = g.length_squared();
+            // Far from the source u can be so small that |g|² underflows; the direction is
+            // scale invariant, so rescale by the largest component.
+            if !(sq > 1e-280 && sq.is_finite()) {
+                let m = g.abs().max_element();
+                if !(m > 0.0 && m.is_finite()) {
+                    continue;
+                }
+                g /= m;
+                sq = g.length_squared();
+            }
+            let s = 1.0 / sq.sqrt();
+            // rhs_c += a_c · X with X = -g/|g| and a_0 = -(a_1 + a_2).
+            let (r1, r2) = (f.a1.dot(g) * s, f.a2.dot(g) * s);
+            rhs[i] += r1 + r2;
+            rhs[j] -= r1;
+            rhs[k] -= r2;
+        }
+    }
 }
 
 impl GeodesicSolver for HeatMethod {
@@ -306,85 +362,77 @@ impl GeodesicSolver for HeatMethod {
         };
         let n = self.positions.len();
         let weights = self.source_weights(sources)?;
-        // 1. Heat flow.
+        // 1. Heat flow (internal numbering). The right-hand side is zero before the smallest
+        // internal source index, which the forward substitution skips.
         let mut u = vec![0.0f64; n];
+        let mut start = n;
         for &(v, w) in &weights {
-            if self.component[v as usize] != u32::MAX {
-                u[v as usize] += w;
+            let p = self.internal[v as usize] as usize;
+            if self.component[p] != u32::MAX && w != 0.0 {
+                u[p] += w;
+                start = start.min(p);
             }
         }
-        let u0 = if self.heat_dirichlet.is_some() {
-            u.clone()
-        } else {
-            Vec::new()
-        };
-        self.heat
-            .solve_in_place(faer::MatMut::from_column_major_slice_mut(&mut u, n, 1));
+        let mut rhs = vec![0.0f64; n];
         if let Some(hd) = &self.heat_dirichlet {
-            let mut ud = u0;
-            for (x, &b) in ud.iter_mut().zip(&self.is_boundary) {
-                if b {
-                    *x = 0.0;
+            // Dirichlet solution first, in `rhs` (used as scratch), then averaged into `u`.
+            let mut sd = n;
+            for p in start..n {
+                if u[p] != 0.0 && !self.is_boundary[p] {
+                    rhs[p] = u[p];
+                    sd = sd.min(p);
                 }
             }
-            hd.solve_in_place(faer::MatMut::from_column_major_slice_mut(&mut ud, n, 1));
-            for ((x, y), &b) in u.iter_mut().zip(&ud).zip(&self.is_boundary) {
+            hd.solve_in_place(&mut rhs, sd);
+            self.heat.solve_in_place(&mut u, start);
+            for ((x, y), &b) in u.iter_mut().zip(rhs.iter_mut()).zip(&self.is_boundary) {
                 *x = 0.5 * (*x + if b { 0.0 } else { *y });
+                *y = 0.0;
             }
+        } else {
+            self.heat.solve_in_place(&mut u, start);
         }
         // 2-3. Normalised gradient and its integrated divergence (right-hand side -div X).
-        let mut rhs = vec![0.0f64; n];
-        for (f, t) in self.triangles.iter().enumerate() {
-            let gb = &self.grad_basis[f];
-            let [i, j, k] = t.map(|v| v as usize);
-            let g = u[i] * gb[0] + u[j] * gb[1] + u[k] * gb[2];
-            let gl = g.length();
-            if gl.is_nan() || gl <= 0.0 {
-                continue;
-            }
-            let x = -g / gl;
-            let hc = &self.half_cot[f];
-            let (pi, pj, pk) = (self.positions[i], self.positions[j], self.positions[k]);
-            // div at i: cot_k (e_ij . X) + cot_j (e_ik . X), with half cotangents.
-            let (xij, xjk, xki) = ((pj - pi).dot(x), (pk - pj).dot(x), (pi - pk).dot(x));
-            rhs[i] -= hc[2] * xij - hc[1] * xki;
-            rhs[j] -= hc[0] * xjk - hc[2] * xij;
-            rhs[k] -= hc[1] * xki - hc[0] * xjk;
-        }
+        self.divergence_of_unit_gradient(&u, &mut rhs);
         // Project onto the range of L (zero sum per component), then pin.
         let nc = self.pins.len();
-        let mut sum = vec![0.0f64; nc];
-        for v in 0..n {
-            let c = self.component[v];
-            if c != u32::MAX {
-                sum[c as usize] += rhs[v];
+        if nc == 1 && self.comp_size[0] == n {
+            let mean = rhs.iter().sum::<f64>() / n as f64;
+            for r in rhs.iter_mut() {
+                *r -= mean;
             }
-        }
-        for v in 0..n {
-            let c = self.component[v];
-            if c != u32::MAX {
-                rhs[v] -= sum[c as usize] / self.comp_size[c as usize] as f64;
-            } else {
-                rhs[v] = 0.0;
+        } else {
+            let mut sum = vec![0.0f64; nc];
+            for (r, &c) in rhs.iter().zip(&self.component) {
+                if c != u32::MAX {
+                    sum[c as usize] += *r;
+                }
+            }
+            for (r, &c) in rhs.iter_mut().zip(&self.component) {
+                if c != u32::MAX {
+                    *r -= sum[c as usize] / self.comp_size[c as usize] as f64;
+                } else {
+                    *r = 0.0;
+                }
             }
         }
         for &p in &self.pins {
             rhs[p as usize] = 0.0;
         }
-        self.poisson
-            .solve_in_place(faer::MatMut::from_column_major_slice_mut(&mut rhs, n, 1));
+        self.poisson.solve_in_place(&mut rhs, 0);
         let phi = rhs;
         // Shift each component so that the smallest source value is zero.
         let mut offset = vec![f64::INFINITY; nc];
+        let at = |v: u32| self.internal[v as usize] as usize;
         for s in sources {
             let (val, c) = match *s {
-                Source::Vertex(v) => (phi[v as usize], self.component[v as usize]),
+                Source::Vertex(v) => (phi[at(v)], self.component[at(v)]),
                 Source::Point(sp) => {
                     let t = self.triangles[sp.face as usize];
-                    let val = (0..3).map(|k| sp.bary[k] * phi[t[k] as usize]).sum::<f64>();
+                    let val = (0..3).map(|k| sp.bary[k] * phi[at(t[k])]).sum::<f64>();
                     let c = t
                         .iter()
-                        .map(|&v| self.component[v as usize])
+                        .map(|&v| self.component[at(v)])
                         .find(|&c| c != u32::MAX)
                         .unwrap_or(u32::MAX);
                     (val, c)
@@ -394,13 +442,19 @@ impl GeodesicSolver for HeatMethod {
                 offset[c as usize] = val;
             }
         }
-        let mut dist = vec![f64::INFINITY; n];
-        for v in 0..n {
-            let c = self.component[v];
-            if c != u32::MAX && offset[c as usize].is_finite() {
-                let d = (phi[v] - offset[c as usize]).max(0.0);
-                if d <= cut {
-                    dist[v] = d;
+        // Output in original numbering, reusing the heat buffer.
+        let mut dist = u;
+        for (d, &p) in dist.iter_mut().zip(&self.internal) {
+            let p = p as usize;
+            let c = self.component[p];
+            *d = f64::INFINITY;
+            if c != u32::MAX {
+                let o = offset[c as usize];
+                if o.is_finite() {
+                    let x = (phi[p] - o).max(0.0);
+                    if x <= cut {
+                        *d = x;
+                    }
                 }
             }
         }
