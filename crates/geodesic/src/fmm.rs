@@ -21,6 +21,12 @@ use std::collections::BinaryHeap;
 /// Maximum number of faces unfolded when looking for the split vertex of one obtuse corner.
 const MAX_UNFOLD: usize = 64;
 
+/// Closest focus of a converging front, in edge lengths of the update triangle, that the
+/// curved-front update models (measured on the peers' spheres: 3-4 keeps the antipodal error of
+/// the UV sphere from the equator below 2 %, 0 lets it reach 3.5 %, 6 and more let it grow
+/// again; the icospheres prefer small values but stay below the peers' errors up to 6).
+const FOCUS_MIN_EDGES: f64 = 4.0;
+
 /// A planar triangle `(c, a, b)` in which the time of `c` is updated from `a` and `b`.
 #[derive(Debug, Clone, Copy)]
 struct UpdTri {
@@ -40,9 +46,10 @@ struct UpdTri {
 ///
 /// Measured (see `docs/bench-geodesic.md`): the plane-wave update (classic Kimmel-Sethian)
 /// ignores the curvature of the front and overestimates around point sources; the point-source
-/// update is exact on flat and developable meshes and 3x more accurate on the paper-set faces,
-/// but underestimates where geodesics converge (towards the antipode of a closed sphere, where
-/// its max error exceeds the plane wave's). Their mean lies in between.
+/// update is exact on flat and developable meshes but assumes the flat-plane front curvature
+/// `1 / T`, so it underestimates where geodesics converge (towards the antipode of a closed
+/// sphere). The curved-front update (the default) tracks the front curvature per vertex and is
+/// right in both regimes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum FmmUpdate {
     /// Kimmel-Sethian: the front is locally a plane wave (`T` linear in the triangle with unit
@@ -50,11 +57,22 @@ pub enum FmmUpdate {
     PlaneWave,
     /// The front is locally a circle around a virtual point source at distances `T_a`, `T_b`
     /// from `a`, `b` (the unfolded source of the triangle). Exact for point sources on flat and
-    /// developable meshes. The default.
-    #[default]
+    /// developable meshes.
     PointSource,
     /// The mean of the plane-wave and point-source updates (an empirical compromise).
     Blend,
+    /// The front is locally a circle whose signed geodesic curvature `kappa` is carried from
+    /// vertex to vertex: diverging (virtual source behind the front, as
+    /// [`FmmUpdate::PointSource`]), converging (focus ahead of the front) or straight (plane
+    /// wave). `kappa` evolves along the characteristics by the Riccati equation
+    /// `dkappa/ds = -kappa^2 - K`: the `-kappa^2` part exactly by the flat circle geometry within
+    /// each (unfolded) triangle, the Gaussian curvature `K` (angle defect over a third of the
+    /// incident area, zero on the boundary) by `kappa -= K * step`. Equals
+    /// [`FmmUpdate::PointSource`] on flat meshes (`kappa = 1 / T`); on a sphere it follows
+    /// `kappa = cot T` through the equator (plane wave) to the converging front at the antipode.
+    /// The default.
+    #[default]
+    CurvedFront,
 }
 
 /// Fast marching distance on a triangle mesh.
@@ -76,6 +94,8 @@ pub struct FastMarching {
     dep_offsets: Vec<u32>,
     deps: Vec<(u32, u32)>,
     rule: FmmUpdate,
+    /// Gaussian curvature density per vertex (angle defect / (area / 3); zero on the boundary).
+    gauss: Vec<f64>,
     /// Obtuse corners found / split successfully (diagnostics).
     n_obtuse: usize,
     n_split: usize,
@@ -115,7 +135,7 @@ fn unfold_point(p: DVec2, q: DVec2, lp: f64, lq: f64, away: DVec2) -> Option<DVe
 
 impl FastMarching {
     /// Prepares the solver for `mesh`: adjacency and the unfolding of every obtuse corner. Uses
-    /// the default update rule ([`FmmUpdate::PointSource`]).
+    /// the default update rule ([`FmmUpdate::CurvedFront`]).
     pub fn new(mesh: &TriMesh) -> Result<Self, GeodesicError> {
         Self::with_update(mesh, FmmUpdate::default())
     }
@@ -215,6 +235,7 @@ impl FastMarching {
                 }
             }
         }
+        let gauss = gaussian_curvature(mesh, &topo);
         Ok(Self {
             positions: pos.to_vec(),
             triangles: tris_in.to_vec(),
@@ -222,6 +243,7 @@ impl FastMarching {
             dep_offsets,
             deps,
             rule,
+            gauss,
             n_obtuse,
             n_split,
         })
@@ -303,12 +325,13 @@ impl FastMarching {
     }
 }
 
-/// Plane-wave update (Kimmel-Sethian) of `c` from `a` (time `ta`) and `b` (time `tb`).
+/// Plane-wave solve of `c` from `a` (time `ta`) and `b` (time `tb`): the time of `c` and the
+/// unit gradient `g` of `T` in the triangle, or `None` when the wave does not come through the
+/// triangle (upwind condition) or arrives before `a` or `b`.
 #[inline]
-fn update_plane(t: &UpdTri, ta: f64, tb: f64) -> f64 {
-    let edge = (ta + t.la).min(tb + t.lb);
+fn solve_plane(t: &UpdTri, ta: f64, tb: f64) -> Option<(f64, f64, f64)> {
     if t.by <= 0.0 {
-        return edge;
+        return None;
     }
     // Rows of P: a = (ax, 0), b = (bx, by). T(x) = tc + g.x with |g| = 1.
     let (ax, bx, by) = (t.la, t.bx, t.by);
@@ -322,20 +345,207 @@ fn update_plane(t: &UpdTri, ta: f64, tb: f64) -> f64 {
     let qc = ux * ux + uy * uy - 1.0;
     let disc = qb * qb - 4.0 * qa * qc;
     if disc < 0.0 || qa <= 0.0 {
-        return edge;
+        return None;
     }
     let tc = (-qb + disc.sqrt()) / (2.0 * qa);
-    if tc < ta.max(tb) {
-        return edge;
+    if tc.is_nan() || tc < ta.max(tb) {
+        return None;
     }
     // Upwind: -g must point into the triangle, -g = alpha a + beta b with alpha, beta >= 0.
     let (gx, gy) = (ux - tc * wx, uy - tc * wy);
     let beta = -gy / by;
     let alpha = (-gx - beta * bx) / ax;
     if alpha < -1e-12 || beta < -1e-12 {
+        return None;
+    }
+    Some((tc, gx, gy))
+}
+
+/// Plane-wave update (Kimmel-Sethian) of `c` from `a` (time `ta`) and `b` (time `tb`).
+#[inline]
+fn update_plane(t: &UpdTri, ta: f64, tb: f64) -> f64 {
+    let edge = (ta + t.la).min(tb + t.lb);
+    match solve_plane(t, ta, tb) {
+        Some((tc, _, _)) => tc.min(edge),
+        None => edge,
+    }
+}
+
+/// Geodesic curvature of a front that had curvature `kappa` and travelled `step` along its
+/// characteristics through a surface of constant Gaussian curvature `kg`: the exact solution of
+/// the Riccati equation `dkappa/ds = -kappa^2 - kg`, `(kappa - kg sigma) / (1 + kappa sigma)`
+/// with `sigma = tan(sqrt(kg) step) / sqrt(kg)` (`tanh` for `kg < 0`, `step` for `kg = 0`). On
+/// a plane the radius `1 / kappa` grows by `step`, and a converging front passes its focus and
+/// diverges; `kappa = inf` (a point source) gives `1 / sigma`.
+#[inline]
+fn advance(kappa: f64, kg: f64, step: f64) -> f64 {
+    let y = kg * step * step;
+    let sigma = if y.abs() < 1e-2 {
+        step * (1.0 + y / 3.0 + 2.0 * y * y / 15.0)
+    } else if y > 0.0 && y < 2.4 {
+        let q = kg.sqrt();
+        (q * step).tan() / q
+    } else if y < 0.0 {
+        let q = (-kg).sqrt();
+        (q * step).tanh() / q
+    } else {
+        // Beyond the conjugate distance of the local curvature: keep the flat evolution.
+        step
+    };
+    if kappa.is_infinite() {
+        1.0 / sigma
+    } else {
+        (kappa - kg * sigma) / (1.0 + kappa * sigma)
+    }
+}
+
+/// [`advance`] by a step of either sign, `None` when a backward step would pass a source (or
+/// a forward one a focus).
+#[inline]
+fn transport(kappa: f64, kg: f64, step: f64) -> Option<f64> {
+    if step == 0.0 {
+        return Some(kappa);
+    }
+    if kappa.is_infinite() {
+        return (step > 0.0).then(|| advance(kappa, kg, step));
+    }
+    let k = advance(kappa, kg, step);
+    (k.is_finite() && (k > 0.0) == (kappa > 0.0)).then_some(k)
+}
+
+/// Edge update of `c` from the better of `a`, `b` in the curved-front rule: `(time, kappa)`.
+#[inline]
+fn edge_curved(t: &UpdTri, ta: f64, tb: f64, ka: f64, kb: f64, kg: f64) -> (f64, f64) {
+    if ta + t.la <= tb + t.lb {
+        (ta + t.la, advance(ka, kg, t.la))
+    } else {
+        (tb + t.lb, advance(kb, kg, t.lb))
+    }
+}
+
+/// `true` when the direction `v` lies in the cone spanned by `a = (ax, 0)` and `b = (bx, by)`.
+#[inline]
+fn in_cone(ax: f64, bx: f64, by: f64, vx: f64, vy: f64, tol: f64) -> bool {
+    ax * vy >= tol && vx * by - vy * bx >= tol
+}
+
+/// Curved-front update of `c` from `a`, `b` (times `ta`, `tb`, front curvatures `ka`, `kb`;
+/// `kg` the Gaussian curvature density of the triangle): `(time, kappa)` of `c`.
+///
+/// The front through `a` and `b` is a circle of signed radius `rho` (the mean of theirs):
+/// `rho > 0` a virtual source behind the front at distances `rho +- (ta - tb) / 2` from `a` and
+/// `b`, `rho < 0` a focus ahead of it at distances `|rho| -+ (ta - tb) / 2`, `|rho|` huge a plane
+/// wave. The characteristic reaching `c` must cross the segment `ab`; otherwise (or if the front
+/// cannot be placed) the edge update is used.
+fn update_curved(t: &UpdTri, ta: f64, tb: f64, ka: f64, kb: f64, kg: f64) -> (f64, f64) {
+    let edge = edge_curved(t, ta, tb, ka, kb, kg);
+    if t.by <= 0.0 {
         return edge;
     }
-    tc.min(edge)
+    let (ax, bx, by) = (t.la, t.bx, t.by);
+    let (ex, ey) = (bx - ax, by);
+    let l2 = ex * ex + ey * ey;
+    let l = l2.sqrt();
+    let dt = ta - tb;
+    if l.is_nan() || l <= 0.0 || dt.abs() >= l {
+        return edge;
+    }
+    // Both curvatures carried to the mean time (the radius is convex in time on a sphere, so
+    // averaging radii taken at different times would bias it), then averaged: radii when the
+    // fronts agree in sense, curvatures otherwise (near a straight front).
+    let tm = 0.5 * (ta + tb);
+    let (ka, kb) = match (transport(ka, kg, tm - ta), transport(kb, kg, tm - tb)) {
+        (Some(x), Some(y)) => (x, y),
+        _ => (ka, kb),
+    };
+    let rho = if (ka > 0.0 && kb > 0.0) || (ka < 0.0 && kb < 0.0) {
+        0.5 * (1.0 / ka + 1.0 / kb)
+    } else {
+        1.0 / (0.5 * (ka + kb))
+    };
+    let scale = ax.max(t.lb).max(l);
+    let tol = -1e-12 * scale * scale;
+    // A focus closer than a few edge lengths cannot be resolved by the vertex samples, and near
+    // a conjugate point (the antipode of a sphere) errors in the carried curvature are
+    // amplified without bound; model such fronts as converging on a focus FOCUS_MIN_EDGES
+    // edges away.
+    let rho = if rho < 0.0 {
+        rho.min(-FOCUS_MIN_EDGES * scale)
+    } else {
+        rho
+    };
+    // (time of c, unit backward direction of the characteristic at c, flat curvature at c).
+    let (tc, dx, dy, kflat) = if rho.is_nan() || rho.abs() >= 1e6 * scale {
+        // Plane wave (or NaN curvature): the curvature is carried along.
+        let Some((tc, gx, gy)) = solve_plane(t, ta, tb) else {
+            return edge;
+        };
+        let gl = (gx * gx + gy * gy).sqrt();
+        let (dx, dy) = (-gx / gl, -gy / gl);
+        let k = 0.5 * (ka + kb);
+        let k = if k.is_finite() { k } else { 0.0 };
+        (tc, dx, dy, k) // advanced below
+    } else {
+        let (ra, rb) = if rho > 0.0 {
+            (rho + 0.5 * dt, rho - 0.5 * dt)
+        } else {
+            (-rho - 0.5 * dt, -rho + 0.5 * dt)
+        };
+        if !(ra >= 0.0 && rb >= 0.0) {
+            return edge;
+        }
+        // Centre p with |p - a| = ra, |p - b| = rb: behind ab (away from c = 0) for a source,
+        // ahead of it (c's side) for a focus.
+        let x = (ra * ra - rb * rb + l2) / (2.0 * l);
+        let y2 = ra * ra - x * x;
+        // Tolerate rounding when the centre lies on ab (a source next to both a and b).
+        if y2 < -1e-10 * (ra * ra + rb * rb) {
+            return edge;
+        }
+        let y = y2.max(0.0).sqrt();
+        let (ux, uy) = (ex / l, ey / l);
+        // (uy, -ux) points away from c (see `update_point`).
+        let side = if rho > 0.0 { 1.0 } else { -1.0 };
+        let (px, py) = (ax + x * ux + side * y * uy, x * uy - side * y * ux);
+        let pl = (px * px + py * py).sqrt();
+        if pl.is_nan() || pl <= 0.0 {
+            return edge;
+        }
+        if rho > 0.0 {
+            if !in_cone(ax, bx, by, px, py, tol) {
+                return edge;
+            }
+            (ta - ra + pl, px / pl, py / pl, 1.0 / pl)
+        } else if in_cone(ax, bx, by, -px, -py, tol) {
+            // c before the focus.
+            (ta + ra - pl, -px / pl, -py / pl, -1.0 / pl)
+        } else if in_cone(ax, bx, by, px, py, tol) {
+            // The focus lies in the triangle: c is past it.
+            (ta + ra + pl, px / pl, py / pl, 1.0 / pl)
+        } else {
+            return edge;
+        }
+    };
+    // As in the point-source update, a circle may reach `c` before `a` or `b` (strongly
+    // obtuse corners that could not be split); the value is still the front's.
+    if tc.is_nan() || tc >= edge.0 {
+        return edge;
+    }
+    // Length of the characteristic from ab to c: c + step * d lies on ab.
+    let cross_ed = ex * dy - ey * dx;
+    let step = if cross_ed < 0.0 {
+        (-ey * ax / cross_ed).max(0.0)
+    } else {
+        0.0
+    };
+    // Curvature where the characteristic crosses ab (undo the flat step), then the step
+    // through the curved surface.
+    let kp = if rho.abs() < 1e6 * scale {
+        kflat / (1.0 - kflat * step)
+    } else {
+        kflat
+    };
+    (tc, advance(kp, kg, step))
 }
 
 /// Point-source update of `c` from `a` (time `ta`) and `b` (time `tb`) in triangle `t`.
@@ -375,30 +585,64 @@ fn update_point(t: &UpdTri, ta: f64, tb: f64) -> f64 {
     (sx * sx + sy * sy).sqrt().min(edge)
 }
 
-impl GeodesicSolver for FastMarching {
-    fn method(&self) -> Method {
-        Method::Fmm
+/// Gaussian curvature density per vertex: angle defect over a third of the incident area; zero
+/// at boundary and non-manifold vertices and where the area vanishes.
+fn gaussian_curvature(mesh: &TriMesh, topo: &Topology) -> Vec<f64> {
+    let pos = mesh.positions();
+    let n = mesh.n_vertices();
+    let mut angle = vec![0.0f64; n];
+    let mut area = vec![0.0f64; n];
+    for t in mesh.triangles() {
+        let p = t.map(|v| pos[v as usize]);
+        let a3 = (p[1] - p[0]).cross(p[2] - p[0]).length() / 6.0;
+        for k in 0..3 {
+            let u = p[(k + 1) % 3] - p[k];
+            let w = p[(k + 2) % 3] - p[k];
+            let (lu, lw) = (u.length(), w.length());
+            if lu > 0.0 && lw > 0.0 {
+                angle[t[k] as usize] += (u.dot(w) / (lu * lw)).clamp(-1.0, 1.0).acos();
+            }
+            area[t[k] as usize] += a3;
+        }
     }
-    fn n_vertices(&self) -> usize {
-        self.positions.len()
+    let mut skip = vec![false; n];
+    for e in &topo.edges {
+        if e.n_faces != 2 {
+            skip[e.v[0] as usize] = true;
+            skip[e.v[1] as usize] = true;
+        }
     }
-    fn distances(
-        &self,
-        sources: &[Source],
-        opts: &SolveOptions,
-    ) -> Result<Vec<f64>, GeodesicError> {
-        let cut = match opts.max_distance {
-            Some(c) if c.is_nan() || c <= 0.0 => return Err(GeodesicError::InvalidCutoff(c)),
-            Some(c) => c,
-            None => f64::INFINITY,
-        };
+    for &v in &topo.non_manifold_vertices {
+        skip[v as usize] = true;
+    }
+    (0..n)
+        .map(|v| {
+            if skip[v] || area[v].is_nan() || area[v] <= 0.0 {
+                0.0
+            } else {
+                (2.0 * std::f64::consts::PI - angle[v]) / area[v]
+            }
+        })
+        .collect()
+}
+
+impl FastMarching {
+    /// The marching itself: distances (not yet cut off) and, for the curved-front rule, the
+    /// front curvature per vertex (empty otherwise).
+    fn march(&self, sources: &[Source], cut: f64) -> Result<(Vec<f64>, Vec<f64>), GeodesicError> {
         let n = self.positions.len();
         let mut dist = vec![f64::INFINITY; n];
+        let curved = self.rule == FmmUpdate::CurvedFront;
+        // Front curvature per vertex (curved-front rule only).
+        let mut kap = if curved { vec![0.0; n] } else { Vec::new() };
         let mut done = vec![false; n];
         let mut heap = BinaryHeap::new();
         for (v, d) in seeds(&self.positions, &self.triangles, sources)? {
             if d < dist[v as usize] {
                 dist[v as usize] = d;
+                if curved {
+                    kap[v as usize] = 1.0 / d;
+                }
                 heap.push(Item(d, v));
             }
         }
@@ -420,11 +664,31 @@ impl GeodesicSolver for FastMarching {
                 }
                 let t = &self.tris[ti as usize];
                 let (ta, tb) = (dist[t.a as usize], dist[t.b as usize]);
+                if curved {
+                    let kg = (self.gauss[c as usize]
+                        + self.gauss[t.a as usize]
+                        + self.gauss[t.b as usize])
+                        / 3.0;
+                    let (ka, kb) = (kap[t.a as usize], kap[t.b as usize]);
+                    let (cand, kc) = if done[t.a as usize] && done[t.b as usize] {
+                        update_curved(t, ta, tb, ka, kb, kg)
+                    } else if t.a == u {
+                        (ta + t.la, advance(ka, kg, t.la))
+                    } else {
+                        (tb + t.lb, advance(kb, kg, t.lb))
+                    };
+                    if cand < dist[c as usize] {
+                        dist[c as usize] = cand;
+                        kap[c as usize] = kc;
+                        heap.push(Item(cand, c));
+                    }
+                    continue;
+                }
                 let cand = if done[t.a as usize] && done[t.b as usize] {
                     match self.rule {
                         FmmUpdate::PointSource => update_point(t, ta, tb),
                         FmmUpdate::PlaneWave => update_plane(t, ta, tb),
-                        FmmUpdate::Blend => {
+                        FmmUpdate::Blend | FmmUpdate::CurvedFront => {
                             0.5 * (update_point(t, ta, tb) + update_plane(t, ta, tb))
                         }
                     }
@@ -439,6 +703,28 @@ impl GeodesicSolver for FastMarching {
                 }
             }
         }
+        Ok((dist, kap))
+    }
+}
+
+impl GeodesicSolver for FastMarching {
+    fn method(&self) -> Method {
+        Method::Fmm
+    }
+    fn n_vertices(&self) -> usize {
+        self.positions.len()
+    }
+    fn distances(
+        &self,
+        sources: &[Source],
+        opts: &SolveOptions,
+    ) -> Result<Vec<f64>, GeodesicError> {
+        let cut = match opts.max_distance {
+            Some(c) if c.is_nan() || c <= 0.0 => return Err(GeodesicError::InvalidCutoff(c)),
+            Some(c) => c,
+            None => f64::INFINITY,
+        };
+        let (mut dist, _) = self.march(sources, cut)?;
         if cut.is_finite() {
             dist.iter_mut()
                 .filter(|d| **d > cut)
@@ -499,5 +785,122 @@ mod tests {
         let q = DVec2::new(2.0, 0.0);
         let w = unfold_point(p, q, 2f64.sqrt(), 2f64.sqrt(), DVec2::new(1.0, 1.0)).unwrap();
         assert!((w - DVec2::new(1.0, -1.0)).length() < 1e-14);
+    }
+    /// Diagnostic (not a check): walks back from the worst vertex of the curved-front solution
+    /// on the peers' UV sphere from the equator and prints every step.
+    #[test]
+    #[ignore = "diagnostic: needs /tmp/peers-geo/meshes/uv10k.obj; prints, asserts nothing"]
+    fn trace_uv10k_equator() {
+        let path = std::env::var("FMM_TRACE_MESH")
+            .unwrap_or_else(|_| "/tmp/peers-geo/meshes/uv10k.obj".to_string());
+        let Ok(text) = std::fs::read_to_string(&path) else {
+            println!("skipping: no {path}");
+            return;
+        };
+        let (mut p, mut f) = (Vec::new(), Vec::new());
+        for line in text.lines() {
+            let w: Vec<&str> = line.split_whitespace().collect();
+            match w.first() {
+                Some(&"v") => p.push(DVec3::new(
+                    w[1].parse().unwrap(),
+                    w[2].parse().unwrap(),
+                    w[3].parse().unwrap(),
+                )),
+                Some(&"f") => {
+                    let c: Vec<u32> = w[1..]
+                        .iter()
+                        .map(|s| s.split('/').next().unwrap().parse::<u32>().unwrap() - 1)
+                        .collect();
+                    f.push([c[0], c[1], c[2]]);
+                }
+                _ => {}
+            }
+        }
+        let mesh = TriMesh::new(p, f).unwrap();
+        let src: u32 = std::env::var("FMM_TRACE_SRC")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(4901);
+        let fm = FastMarching::with_update(&mesh, FmmUpdate::CurvedFront).unwrap();
+        let (d, kap) = fm.march(&[Source::Vertex(src)], f64::INFINITY).unwrap();
+        let ps = mesh.position(src).normalize();
+        let g: Vec<f64> = mesh
+            .positions()
+            .iter()
+            .map(|v| v.normalize().dot(ps).clamp(-1.0, 1.0).acos())
+            .collect();
+        // Front curvature against the sphere's cot(g), by distance.
+        for k in 0..16 {
+            let (lo, hi) = (k as f64 * 0.2, (k + 1) as f64 * 0.2);
+            let sel: Vec<usize> = (0..d.len()).filter(|&i| g[i] >= lo && g[i] < hi).collect();
+            if sel.is_empty() {
+                continue;
+            }
+            let mean_k = sel.iter().map(|&i| kap[i]).sum::<f64>() / sel.len() as f64;
+            let mean_c = sel.iter().map(|&i| 1.0 / g[i].tan()).sum::<f64>() / sel.len() as f64;
+            let mean_e = sel.iter().map(|&i| d[i] - g[i]).sum::<f64>() / sel.len() as f64;
+            let max_e = sel.iter().map(|&i| (d[i] - g[i]).abs()).fold(0.0, f64::max);
+            println!(
+                "g in [{lo:.1}, {hi:.1}): kappa {mean_k:+.3} sphere {mean_c:+.3} mean err {mean_e:+.2e} max |err| {max_e:.2e}"
+            );
+        }
+        let mut v = std::env::var("FMM_TRACE_V")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or_else(|| {
+                (0..d.len())
+                    .max_by(|&i, &j| (d[i] - g[i]).abs().total_cmp(&(d[j] - g[j]).abs()))
+                    .unwrap() as u32
+            });
+        for _ in 0..60 {
+            let q = mesh.position(v).normalize();
+            println!(
+                "v{v}: lat {:+.1} lon {:+.1} T {:.4} err {:+.2e} kappa {:+.3e} (sphere {:+.3e}) K {:.3}",
+                q.z.asin().to_degrees(),
+                q.y.atan2(q.x).to_degrees(),
+                d[v as usize],
+                d[v as usize] - g[v as usize],
+                kap[v as usize],
+                1.0 / g[v as usize].tan(),
+                fm.gauss[v as usize]
+            );
+            if v == src {
+                break;
+            }
+            // All candidates of v from vertices accepted before it.
+            let mut cands = Vec::new();
+            for (ti, t) in fm.tris.iter().enumerate() {
+                let _ = ti;
+                let owner = fm.deps[fm.dep_offsets[t.a as usize] as usize
+                    ..fm.dep_offsets[t.a as usize + 1] as usize]
+                    .iter()
+                    .any(|&(c, i)| c == v && i as usize == ti);
+                if !owner {
+                    continue;
+                }
+                let (a, b) = (t.a as usize, t.b as usize);
+                if !(d[a] < d[v as usize] && d[b] < d[v as usize]) {
+                    continue;
+                }
+                let kg = (fm.gauss[v as usize] + fm.gauss[a] + fm.gauss[b]) / 3.0;
+                let (tc, kc) = update_curved(t, d[a], d[b], kap[a], kap[b], kg);
+                let edge = edge_curved(t, d[a], d[b], kap[a], kap[b], kg).0;
+                cands.push((tc, kc, a, b, tc == edge, t.la, t.lb));
+            }
+            cands.sort_by(|x, y| x.0.total_cmp(&y.0));
+            for c in cands.iter().take(3) {
+                println!(
+                    "    cand T {:.4} kappa {:+.3e} from a v{} (err {:+.2e}) b v{} (err {:+.2e}) edge {} la {:.4} lb {:.4}",
+                    c.0, c.1, c.2, d[c.2] - g[c.2], c.3, d[c.3] - g[c.3], c.4, c.5, c.6
+                );
+            }
+            let Some(best) = cands.first() else { break };
+            // Follow the corner with the larger error magnitude.
+            v = if (d[best.2] - g[best.2]).abs() >= (d[best.3] - g[best.3]).abs() {
+                best.2 as u32
+            } else {
+                best.3 as u32
+            };
+        }
     }
 }

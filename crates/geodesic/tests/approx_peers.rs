@@ -160,8 +160,14 @@ fn peer_comparison() {
                     "fmm_point" => {
                         Box::new(FastMarching::with_update(&mesh, FmmUpdate::PointSource).unwrap())
                     }
+                    "fmm_plane" => {
+                        Box::new(FastMarching::with_update(&mesh, FmmUpdate::PlaneWave).unwrap())
+                    }
                     "fmm_blend" => {
                         Box::new(FastMarching::with_update(&mesh, FmmUpdate::Blend).unwrap())
+                    }
+                    "fmm_curved" => {
+                        Box::new(FastMarching::with_update(&mesh, FmmUpdate::CurvedFront).unwrap())
                     }
                     "heat" => Box::new(HeatMethod::new(&mesh).unwrap()),
                     "dijkstra" => Box::new(Dijkstra::new(&mesh).unwrap()),
@@ -198,6 +204,22 @@ fn peer_comparison() {
             }
             if std::env::var("GEODESIC_WHERE").is_ok() {
                 println!("max error of {m} at analytic distance {:.3}", e.at);
+                // The worst vertices: latitude / longitude (degrees, about the z axis), analytic
+                // distance, signed error against the sphere and against the exact polyhedral
+                // distance.
+                let mut idx: Vec<usize> = (0..d.len()).collect();
+                idx.sort_by(|&i, &j| (d[j] - g[j]).abs().total_cmp(&(d[i] - g[i]).abs()));
+                for &i in idx.iter().take(8) {
+                    let q = mesh.position(i as u32).normalize();
+                    println!(
+                        "  v{i}: lat {:+.1} lon {:+.1} dist {:.4} err {:+.2e} vs exact {:+.2e}",
+                        q.z.asin().to_degrees(),
+                        q.y.atan2(q.x).to_degrees(),
+                        g[i],
+                        d[i] - g[i],
+                        exact.as_ref().map(|x| d[i] - x[i]).unwrap_or(f64::NAN)
+                    );
+                }
             }
             println!(
                 "| {case} | {} | {m} (ours) | {} | {} | {} | {:.2e} | {:.2e} | {:.2e} | {:.1e} |",
