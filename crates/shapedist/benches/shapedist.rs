@@ -1,5 +1,8 @@
 //! Criterion benches: keyed closed form on 10k pairs, point-to-point ICP on 10k points
-//! (50 iterations, plain and coarse-to-fine), global ICP from 90 and 180 degrees.
+//! (50 iterations, plain and coarse-to-fine), global ICP from 30, 90 and 180 degrees.
+//!
+//! Everything runs on one thread (a one-thread rayon pool), as the comparison with Open3D
+//! (`OMP_NUM_THREADS=1`) in `docs/bench-shapedist.md`.
 //!
 //! The point sets follow the ICP peers' `make_clouds.py` patch (a smooth asymmetric height
 //! field over an ellipse, noise sigma 0.005); `examples/icp_compare.rs` runs on the peers' own
@@ -59,6 +62,10 @@ fn case(deg: f64) -> (Vec<DVec3>, Vec<DVec3>) {
 }
 
 fn benches(c: &mut Criterion) {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("one-thread pool");
     let mut g = c.benchmark_group("shapedist");
     g.sample_size(10);
     let (tgt, src) = case(30.0);
@@ -66,7 +73,11 @@ fn benches(c: &mut Criterion) {
         .map(|k| k.wrapping_mul(0x9E37_79B9_7F4A_7C15))
         .collect();
     g.bench_function("keyed_kabsch_10k_pairs", |bch| {
-        bch.iter(|| keyed_distance(&keys, &tgt, &keys, &src, &KeyedOptions::default()).unwrap())
+        bch.iter(|| {
+            pool.install(|| {
+                keyed_distance(&keys, &tgt, &keys, &src, &KeyedOptions::default()).unwrap()
+            })
+        })
     });
     let po = PrepareOptions::default();
     for deg in [30.0, 90.0, 180.0] {
@@ -79,7 +90,7 @@ fn benches(c: &mut Criterion) {
             ..Default::default()
         };
         g.bench_function(format!("icp_p2p_10k_50it_from_{deg}deg"), |bch| {
-            bch.iter(|| icp(&a, &b, DMat3::IDENTITY, &plain).unwrap())
+            bch.iter(|| pool.install(|| icp(&a, &b, DMat3::IDENTITY, &plain).unwrap()))
         });
         let sched = IcpOptions {
             max_iterations: 10,
@@ -88,10 +99,10 @@ fn benches(c: &mut Criterion) {
             ..Default::default()
         };
         g.bench_function(format!("icp_p2p_10k_40it@500+10it_from_{deg}deg"), |bch| {
-            bch.iter(|| icp(&a, &b, DMat3::IDENTITY, &sched).unwrap())
+            bch.iter(|| pool.install(|| icp(&a, &b, DMat3::IDENTITY, &sched).unwrap()))
         });
         g.bench_function(format!("global_icp_10k_from_{deg}deg"), |bch| {
-            bch.iter(|| global_icp(&a, &b, &GlobalOptions::default()).unwrap())
+            bch.iter(|| pool.install(|| global_icp(&a, &b, &GlobalOptions::default()).unwrap()))
         });
     }
     g.finish();
