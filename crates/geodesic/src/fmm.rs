@@ -21,12 +21,6 @@ use std::collections::BinaryHeap;
 /// Maximum number of faces unfolded when looking for the split vertex of one obtuse corner.
 const MAX_UNFOLD: usize = 64;
 
-/// Closest focus of a converging front, in edge lengths of the update triangle, that the
-/// curved-front update models (measured on the peers' spheres: 3-4 keeps the antipodal error of
-/// the UV sphere from the equator below 2 %, 0 lets it reach 3.5 %, 6 and more let it grow
-/// again; the icospheres prefer small values but stay below the peers' errors up to 6).
-const FOCUS_MIN_EDGES: f64 = 4.0;
-
 /// A planar triangle `(c, a, b)` in which the time of `c` is updated from `a` and `b`.
 #[derive(Debug, Clone, Copy)]
 struct UpdTri {
@@ -64,13 +58,14 @@ pub enum FmmUpdate {
     /// The front is locally a circle whose signed geodesic curvature `kappa` is carried from
     /// vertex to vertex: diverging (virtual source behind the front, as
     /// [`FmmUpdate::PointSource`]), converging (focus ahead of the front) or straight (plane
-    /// wave). `kappa` evolves along the characteristics by the Riccati equation
-    /// `dkappa/ds = -kappa^2 - K`: the `-kappa^2` part exactly by the flat circle geometry within
-    /// each (unfolded) triangle, the Gaussian curvature `K` (angle defect over a third of the
-    /// incident area, zero on the boundary) by `kappa -= K * step`. Equals
-    /// [`FmmUpdate::PointSource`] on flat meshes (`kappa = 1 / T`); on a sphere it follows
-    /// `kappa = cot T` through the equator (plane wave) to the converging front at the antipode.
-    /// The default.
+    /// wave). The circle through `a` and `b` gives the time of `c`; `kappa` itself follows the
+    /// characteristics by the Riccati equation `dkappa/ds = -kappa^2 - K`, solved exactly for
+    /// the Gaussian curvature `K` of the triangle (angle defect over a third of the incident
+    /// area, averaged over its corners; zero on the boundary). Equals
+    /// [`FmmUpdate::PointSource`] on flat and developable meshes (`kappa = 1 / T`); on a sphere
+    /// it follows `kappa = cot T` through the equator (plane wave) to the converging front at
+    /// the antipode, where the point-source rule underestimates and the plane-wave rule
+    /// overestimates. The default.
     #[default]
     CurvedFront,
 }
@@ -380,8 +375,9 @@ fn update_plane(t: &UpdTri, ta: f64, tb: f64) -> f64 {
 #[inline]
 fn advance(kappa: f64, kg: f64, step: f64) -> f64 {
     let y = kg * step * step;
-    let sigma = if y.abs() < 1e-2 {
-        step * (1.0 + y / 3.0 + 2.0 * y * y / 15.0)
+    let sigma = if y.abs() < 1e-3 {
+        // Series of tan(x) / x (tanh for y < 0), x^2 = |y|; relative error below 1e-13.
+        step * (1.0 + y * (1.0 / 3.0 + y * (2.0 / 15.0 + y * (17.0 / 315.0))))
     } else if y > 0.0 && y < 2.4 {
         let q = kg.sqrt();
         (q * step).tan() / q
@@ -432,7 +428,8 @@ fn in_cone(ax: f64, bx: f64, by: f64, vx: f64, vy: f64, tol: f64) -> bool {
 /// Curved-front update of `c` from `a`, `b` (times `ta`, `tb`, front curvatures `ka`, `kb`;
 /// `kg` the Gaussian curvature density of the triangle): `(time, kappa)` of `c`.
 ///
-/// The front through `a` and `b` is a circle of signed radius `rho` (the mean of theirs):
+/// The front through `a` and `b` is a circle of signed radius `rho` (the mean of theirs, both
+/// carried to the mean time):
 /// `rho > 0` a virtual source behind the front at distances `rho +- (ta - tb) / 2` from `a` and
 /// `b`, `rho < 0` a focus ahead of it at distances `|rho| -+ (ta - tb) / 2`, `|rho|` huge a plane
 /// wave. The characteristic reaching `c` must cross the segment `ab`; otherwise (or if the front
@@ -450,9 +447,9 @@ fn update_curved(t: &UpdTri, ta: f64, tb: f64, ka: f64, kb: f64, kg: f64) -> (f6
     if l.is_nan() || l <= 0.0 || dt.abs() >= l {
         return edge;
     }
-    // Both curvatures carried to the mean time (the radius is convex in time on a sphere, so
-    // averaging radii taken at different times would bias it), then averaged: radii when the
-    // fronts agree in sense, curvatures otherwise (near a straight front).
+    // Both curvatures carried to the mean time (on a curved surface the radius of curvature
+    // grows at the rate 1 + K rho^2, not 1), then averaged: radii when the fronts agree in
+    // sense, curvatures otherwise (near a straight front).
     let tm = 0.5 * (ta + tb);
     let (ka, kb) = match (transport(ka, kg, tm - ta), transport(kb, kg, tm - tb)) {
         (Some(x), Some(y)) => (x, y),
@@ -463,28 +460,18 @@ fn update_curved(t: &UpdTri, ta: f64, tb: f64, ka: f64, kb: f64, kg: f64) -> (f6
     } else {
         1.0 / (0.5 * (ka + kb))
     };
+    // Curvature of the front at the mean time, carried to c along the characteristic by the
+    // Riccati equation (not read off the circle below: within a triangle the fronts of
+    // different times are concentric circles only on a plane).
+    let kmid = if rho.is_nan() { 0.0 } else { 1.0 / rho };
     let scale = ax.max(t.lb).max(l);
     let tol = -1e-12 * scale * scale;
-    // A focus closer than a few edge lengths cannot be resolved by the vertex samples, and near
-    // a conjugate point (the antipode of a sphere) errors in the carried curvature are
-    // amplified without bound; model such fronts as converging on a focus FOCUS_MIN_EDGES
-    // edges away.
-    let rho = if rho < 0.0 {
-        rho.min(-FOCUS_MIN_EDGES * scale)
-    } else {
-        rho
-    };
-    // (time of c, unit backward direction of the characteristic at c, flat curvature at c).
-    let (tc, dx, dy, kflat) = if rho.is_nan() || rho.abs() >= 1e6 * scale {
-        // Plane wave (or NaN curvature): the curvature is carried along.
-        let Some((tc, gx, gy)) = solve_plane(t, ta, tb) else {
-            return edge;
-        };
-        let gl = (gx * gx + gy * gy).sqrt();
-        let (dx, dy) = (-gx / gl, -gy / gl);
-        let k = 0.5 * (ka + kb);
-        let k = if k.is_finite() { k } else { 0.0 };
-        (tc, dx, dy, k) // advanced below
+    let tc = if rho.is_nan() || rho.abs() >= 1e6 * scale {
+        // Plane wave.
+        match solve_plane(t, ta, tb) {
+            Some((tc, _, _)) => tc,
+            None => return edge,
+        }
     } else {
         let (ra, rb) = if rho > 0.0 {
             (rho + 0.5 * dt, rho - 0.5 * dt)
@@ -511,17 +498,17 @@ fn update_curved(t: &UpdTri, ta: f64, tb: f64, ka: f64, kb: f64, kg: f64) -> (f6
         if pl.is_nan() || pl <= 0.0 {
             return edge;
         }
+        // The characteristic through c must cross ab: the centre (a source, or a focus c has
+        // passed) seen from c, or the direction away from a focus ahead, lies in the corner.
         if rho > 0.0 {
             if !in_cone(ax, bx, by, px, py, tol) {
                 return edge;
             }
-            (ta - ra + pl, px / pl, py / pl, 1.0 / pl)
+            ta - ra + pl
         } else if in_cone(ax, bx, by, -px, -py, tol) {
-            // c before the focus.
-            (ta + ra - pl, -px / pl, -py / pl, -1.0 / pl)
+            ta + ra - pl
         } else if in_cone(ax, bx, by, px, py, tol) {
-            // The focus lies in the triangle: c is past it.
-            (ta + ra + pl, px / pl, py / pl, 1.0 / pl)
+            ta + ra + pl
         } else {
             return edge;
         }
@@ -531,21 +518,7 @@ fn update_curved(t: &UpdTri, ta: f64, tb: f64, ka: f64, kb: f64, kg: f64) -> (f6
     if tc.is_nan() || tc >= edge.0 {
         return edge;
     }
-    // Length of the characteristic from ab to c: c + step * d lies on ab.
-    let cross_ed = ex * dy - ey * dx;
-    let step = if cross_ed < 0.0 {
-        (-ey * ax / cross_ed).max(0.0)
-    } else {
-        0.0
-    };
-    // Curvature where the characteristic crosses ab (undo the flat step), then the step
-    // through the curved surface.
-    let kp = if rho.abs() < 1e6 * scale {
-        kflat / (1.0 - kflat * step)
-    } else {
-        kflat
-    };
-    (tc, advance(kp, kg, step))
+    (tc, advance(kmid, kg, tc - tm))
 }
 
 /// Point-source update of `c` from `a` (time `ta`) and `b` (time `tb`) in triangle `t`.
@@ -780,6 +753,52 @@ mod tests {
     }
 
     #[test]
+    fn riccati_advance_follows_geodesic_circles() {
+        // Unit sphere: geodesic circles of radius r have curvature cot r.
+        for (r0, s) in [(0.3, 0.05), (1.2, 0.4), (2.0, -0.3), (2.5, 0.5)] {
+            let k = advance(1.0 / f64::tan(r0), 1.0, s);
+            assert!((k - 1.0 / f64::tan(r0 + s)).abs() < 1e-11, "{r0} {s}: {k}");
+        }
+        assert!((advance(f64::INFINITY, 1.0, 0.7) - 1.0 / 0.7f64.tan()).abs() < 1e-12);
+        // Hyperbolic plane (K = -1): coth r.
+        let k = advance(1.0 / 0.5f64.tanh(), -1.0, 0.8);
+        assert!((k - 1.0 / 1.3f64.tanh()).abs() < 1e-12);
+        // Plane: the radius grows by the step, a focus is passed.
+        assert!((advance(0.5, 0.0, 1.0) - 1.0 / 3.0).abs() < 1e-15);
+        assert!((advance(-1.0, 0.0, 3.0) - 0.5).abs() < 1e-15);
+    }
+
+    #[test]
+    fn curved_update_is_exact_for_flat_circles_both_ways() {
+        // c = 0, a = (1, 0), b = (0.3, 0.9).
+        let t = UpdTri {
+            a: 0,
+            b: 1,
+            la: 1.0,
+            lb: DVec2::new(0.3, 0.9).length(),
+            bx: 0.3,
+            by: 0.9,
+        };
+        let (pa, pb) = (DVec2::new(1.0, 0.0), DVec2::new(0.3, 0.9));
+        // Diverging from a source behind ab: the point-source update.
+        let s = DVec2::new(2.0, 1.5);
+        let (ta, tb) = ((s - pa).length(), (s - pb).length());
+        let (tc, kc) = update_curved(&t, ta, tb, 1.0 / ta, 1.0 / tb, 0.0);
+        assert!((tc - s.length()).abs() < 1e-12 && (kc - 1.0 / s.length()).abs() < 1e-12);
+        // Converging on a focus beyond c: T = 10 - |x - f|, f = -(2, 1.5).
+        let f = -s;
+        let time = |p: DVec2| 10.0 - (p - f).length();
+        let (ta, tb) = (time(pa), time(pb));
+        let (ka, kb) = (-1.0 / (pa - f).length(), -1.0 / (pb - f).length());
+        let (tc, kc) = update_curved(&t, ta, tb, ka, kb, 0.0);
+        assert!((tc - time(DVec2::ZERO)).abs() < 1e-12, "{tc}");
+        assert!((kc + 1.0 / f.length()).abs() < 1e-12, "{kc}");
+        // The point-source and plane-wave updates both miss it.
+        assert!((update_point(&t, ta, tb) - time(DVec2::ZERO)).abs() > 1e-3);
+        assert!((update_plane(&t, ta, tb) - time(DVec2::ZERO)).abs() > 1e-3);
+    }
+
+    #[test]
     fn unfold_point_places_across() {
         let p = DVec2::new(0.0, 0.0);
         let q = DVec2::new(2.0, 0.0);
@@ -844,6 +863,26 @@ mod tests {
                 "g in [{lo:.1}, {hi:.1}): kappa {mean_k:+.3} sphere {mean_c:+.3} mean err {mean_e:+.2e} max |err| {max_e:.2e}"
             );
         }
+        // Where the carried curvature is worst at moderate distance.
+        let mut sel: Vec<usize> = (0..d.len())
+            .filter(|&i| g[i] >= 2.0 && g[i] < 2.4)
+            .collect();
+        sel.sort_by(|&i, &j| {
+            (kap[j] - 1.0 / g[j].tan())
+                .abs()
+                .total_cmp(&(kap[i] - 1.0 / g[i].tan()).abs())
+        });
+        for &i in sel.iter().take(12) {
+            let q = mesh.position(i as u32).normalize();
+            println!(
+                "  kappa off at v{i}: lat {:+.1} lon {:+.1} g {:.3} kappa {:+.3} sphere {:+.3}",
+                q.z.asin().to_degrees(),
+                q.y.atan2(q.x).to_degrees(),
+                g[i],
+                kap[i],
+                1.0 / g[i].tan()
+            );
+        }
         let mut v = std::env::var("FMM_TRACE_V")
             .ok()
             .and_then(|s| s.parse().ok())
@@ -885,6 +924,10 @@ mod tests {
                 let kg = (fm.gauss[v as usize] + fm.gauss[a] + fm.gauss[b]) / 3.0;
                 let (tc, kc) = update_curved(t, d[a], d[b], kap[a], kap[b], kg);
                 let edge = edge_curved(t, d[a], d[b], kap[a], kap[b], kg).0;
+                let (tx, kx) = update_curved(t, g[a], g[b], 1.0 / g[a].tan(), 1.0 / g[b].tan(), kg);
+                if cands.is_empty() {
+                    println!("    [exact inputs for the first triangle: T {tx:.5} (g {:.5}) kappa {kx:+.3e}]", g[v as usize]);
+                }
                 cands.push((tc, kc, a, b, tc == edge, t.la, t.lb));
             }
             cands.sort_by(|x, y| x.0.total_cmp(&y.0));
