@@ -150,7 +150,8 @@ fn uv_sphere_from_the_equator_within_two_percent() {
         &solve(&m, FmmUpdate::CurvedFront, &[Source::Vertex(src)]),
         &g,
     );
-    assert!(max < 0.02, "max error {max}");
+    // The issue asks for 2 %; measured 6.3e-4.
+    assert!(max < 0.005, "max error {max}");
     assert!(mae < 1e-3, "MAE {mae}");
     let (mae_p, max_p) = errors(&solve(&m, FmmUpdate::PlaneWave, &[Source::Vertex(src)]), &g);
     assert!(
@@ -170,7 +171,7 @@ fn icosphere_errors_far_below_the_plane_wave() {
     let (mae_p, max_p) = errors(&solve(&m, FmmUpdate::PlaneWave, &[Source::Vertex(0)]), &g);
     let (_, max_s) = errors(&solve(&m, FmmUpdate::PointSource, &[Source::Vertex(0)]), &g);
     assert!(
-        max < 0.5 * max_p && max < 0.5 * max_s,
+        max < 0.1 * max_p && max < 0.1 * max_s,
         "max {max} vs {max_p}, {max_s}"
     );
     assert!(mae < 0.05 * mae_p, "MAE {mae} vs {mae_p}");
