@@ -539,7 +539,7 @@ mod tests {
 
     #[test]
     fn icp_recovers_a_rigid_copy() {
-        let m = crate::experiments::walk::tests::icosphere(2);
+        let m = meshcore::shapes::icosphere(2);
         let rot = meshcore::DMat3::from_quat(meshcore::DQuat::from_axis_angle(
             DVec3::new(1.0, 0.3, 0.2).normalize(),
             1.1,

@@ -7,6 +7,7 @@ use geodesic::{
     HeatMethod, Method, SolveOptions, Source, SurfacePoint, TriMesh,
 };
 use glam::{DAffine3, DQuat, DVec3};
+use meshcore::shapes::{icosphere, uv_sphere};
 use proptest::prelude::*;
 use std::f64::consts::PI;
 
@@ -41,107 +42,6 @@ fn grid(nx: usize, ny: usize, sx: f64, sy: f64, alternate: bool) -> TriMesh {
         }
     }
     TriMesh::new(p, t).unwrap()
-}
-
-/// Unit icosphere with `level` midpoint subdivisions.
-fn icosphere(level: usize) -> TriMesh {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut v: Vec<DVec3> = [
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ]
-    .iter()
-    .map(|a| DVec3::from_array(*a).normalize())
-    .collect();
-    let mut f: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..level {
-        let mut mid = std::collections::HashMap::new();
-        let mut nf = Vec::with_capacity(f.len() * 4);
-        let mut m = |a: u32, b: u32, v: &mut Vec<DVec3>| -> u32 {
-            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                v.push((v[a as usize] + v[b as usize]).normalize());
-                (v.len() - 1) as u32
-            })
-        };
-        for [a, b, c] in f {
-            let ab = m(a, b, &mut v);
-            let bc = m(b, c, &mut v);
-            let ca = m(c, a, &mut v);
-            nf.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        f = nf;
-    }
-    TriMesh::new(v, f).unwrap()
-}
-
-/// UV sphere: north pole, `rings - 1` rings of `seg` vertices, south pole (like the peers').
-fn uv_sphere(rings: usize, seg: usize) -> TriMesh {
-    let mut v = vec![DVec3::Z];
-    for i in 1..rings {
-        let th = PI * i as f64 / rings as f64;
-        for j in 0..seg {
-            let ph = 2.0 * PI * j as f64 / seg as f64;
-            v.push(DVec3::new(
-                th.sin() * ph.cos(),
-                th.sin() * ph.sin(),
-                th.cos(),
-            ));
-        }
-    }
-    v.push(-DVec3::Z);
-    let south = (v.len() - 1) as u32;
-    let ring = |i: usize, j: usize| (1 + (i - 1) * seg + j % seg) as u32;
-    let mut f = Vec::new();
-    for j in 0..seg {
-        f.push([0, ring(1, j), ring(1, j + 1)]);
-    }
-    for i in 1..rings - 1 {
-        for j in 0..seg {
-            let (p, q, r, s) = (
-                ring(i, j),
-                ring(i, j + 1),
-                ring(i + 1, j),
-                ring(i + 1, j + 1),
-            );
-            f.push([p, r, s]);
-            f.push([p, s, q]);
-        }
-    }
-    for j in 0..seg {
-        f.push([south, ring(rings - 1, j + 1), ring(rings - 1, j)]);
-    }
-    TriMesh::new(v, f).unwrap()
 }
 
 /// Open cylinder of radius `r` and height `h` (`na` segments around, `nh` rows).

@@ -2,6 +2,7 @@
 
 use glam::DVec3;
 use levelcurves::{isolines, isolines_uniform, uniform_level_range, uniform_levels, Isoline};
+use meshcore::shapes::icosphere;
 use meshcore::{Topology, TriMesh};
 use proptest::prelude::*;
 use std::collections::HashSet;
@@ -63,71 +64,6 @@ fn grid(
                 }
             }
         }
-    }
-    TriMesh::new(pos, tris).unwrap()
-}
-
-/// Icosphere of radius 1 with `sub` subdivisions (outward winding).
-fn icosphere(sub: u32) -> TriMesh {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut pos: Vec<DVec3> = [
-        (-1.0, t, 0.0),
-        (1.0, t, 0.0),
-        (-1.0, -t, 0.0),
-        (1.0, -t, 0.0),
-        (0.0, -1.0, t),
-        (0.0, 1.0, t),
-        (0.0, -1.0, -t),
-        (0.0, 1.0, -t),
-        (t, 0.0, -1.0),
-        (t, 0.0, 1.0),
-        (-t, 0.0, -1.0),
-        (-t, 0.0, 1.0),
-    ]
-    .iter()
-    .map(|&(x, y, z)| DVec3::new(x, y, z).normalize())
-    .collect();
-    let mut tris: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..sub {
-        let mut mid = std::collections::HashMap::new();
-        let mut next = Vec::new();
-        for tri in &tris {
-            let mut m = [0u32; 3];
-            for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                let key = (a.min(b), a.max(b));
-                m[k] = *mid.entry(key).or_insert_with(|| {
-                    pos.push(((pos[a as usize] + pos[b as usize]) / 2.0).normalize());
-                    (pos.len() - 1) as u32
-                });
-            }
-            next.push([tri[0], m[0], m[2]]);
-            next.push([tri[1], m[1], m[0]]);
-            next.push([tri[2], m[2], m[1]]);
-            next.push(m);
-        }
-        tris = next;
     }
     TriMesh::new(pos, tris).unwrap()
 }

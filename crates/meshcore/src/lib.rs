@@ -14,6 +14,7 @@ mod error;
 mod locate;
 mod mesh;
 pub mod repair;
+pub mod shapes;
 mod topology;
 
 pub use error::MeshError;

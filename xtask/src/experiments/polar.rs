@@ -114,7 +114,8 @@ pub fn polar_descriptor(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::experiments::walk::tests::{icosphere, plane};
+    use crate::experiments::walk::tests::plane;
+    use meshcore::shapes::icosphere;
 
     #[test]
     fn keys_round_trip() {
