@@ -10,6 +10,8 @@
 //!   boundaries. The optimised solver must agree with it to rounding (1e-11 relative to the
 //!   largest distance; measured: a few 1e-14), on closed, jittered, bounded and two-component meshes, with vertex and point sources.
 
+#![allow(clippy::needless_range_loop)] // the reference mirrors the previous index loops
+
 use faer::linalg::solvers::Solve;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::Side;

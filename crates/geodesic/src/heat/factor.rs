@@ -1,14 +1,16 @@
 //! Sparse Cholesky factors for the heat method: faer computes the fill-reducing ordering and the
-//! numerical factorisation (supernodal or simplicial, whichever faer picks), then the factor is
-//! copied into plain compressed-column arrays (`u32` row indices, diagonal kept apart, exact
-//! zeros dropped) and solved with the hand-written triangular solves below.
+//! numerical factorisation (supernodal or simplicial, whichever faer picks); the factor is then
+//! copied out (exact zeros, e.g. of faer's relaxed supernodes, dropped), regrouped into
+//! fundamental supernodes (row indices stored once per supernode, values as small dense blocks)
+//! and solved with the hand-written triangular solves below.
 //!
-//! Why not faer's own `solve_in_place`: at the mesh sizes of interest (10^4-10^5 vertices) the
-//! supernodes are tiny (a few columns), and the per-supernode dense kernels, the workspace
-//! allocation and the permutation copies of faer's solve cost more than the arithmetic. The
-//! flat loops here are 2-4x faster per solve and allocate nothing; a right-hand side that is
-//! zero up to some index (a point source) skips the columns before it and every column whose
-//! forward value is still zero.
+//! Why not faer's own `solve_in_place`: at 10^3-10^5 vertices most supernodes have a few
+//! columns, and per solve faer dispatches a dense kernel per supernode, allocates its workspace
+//! and copies the right-hand side through the permutation twice; profiled on a 10k-vertex
+//! sphere this was ~75 % of the per-solve time. The loops here allocate nothing, work in the
+//! permuted numbering directly (the caller keeps its per-solve arrays in it), and skip every
+//! column whose forward value is zero (a point source starts deep in the elimination tree).
+//! The solves are sequential and deterministic (fixed summation order).
 
 use crate::GeodesicError;
 use faer::dyn_stack::{MemBuffer, MemStack};
@@ -60,24 +62,136 @@ pub(crate) fn permutation(symbolic: &SymbolicCholesky<u32>) -> (Vec<u32>, Vec<u3
     }
 }
 
-/// Lower Cholesky factor `L` of `P A Pᵀ` (`P` the permutation of the symbolic analysis), in
-/// compressed columns.
+/// Lower Cholesky factor `L` of `P A Pᵀ` (`P` the permutation of the symbolic analysis).
 pub(crate) struct Factor {
     /// Diagonal of `L`.
     diag: Vec<f64>,
+    /// Off-diagonal part, by supernodes.
+    blocks: Blocks,
+}
+
+/// `L` in compressed columns (off-diagonal entries only), the intermediate form between faer's
+/// factor and [`Blocks`].
+struct Csc {
+    diag: Vec<f64>,
     /// Off-diagonal entries of column `j` are `col_ptr[j]..col_ptr[j + 1]`.
     col_ptr: Vec<usize>,
-    /// Row of each off-diagonal entry (always greater than its column).
     row_idx: Vec<u32>,
-    /// Value of each off-diagonal entry.
     val: Vec<f64>,
+}
+
+/// The factor grouped into fundamental supernodes (consecutive columns `c0..c1` whose
+/// off-diagonal rows are the rest of the block plus one shared list of rows below it): the
+/// row indices are stored once per supernode and the values as small dense blocks, which
+/// halves the index traffic of the solves and lets the inner loops vectorise.
+#[derive(Default)]
+struct Blocks {
+    /// First column of each supernode, plus `n` at the end.
+    begin: Vec<u32>,
+    /// Rows below supernode `s`: `pat[pat_ptr[s]..pat_ptr[s + 1]]` (ascending).
+    pat_ptr: Vec<usize>,
+    pat: Vec<u32>,
+    /// Strictly lower triangle of the diagonal block, packed by columns.
+    tri_ptr: Vec<usize>,
+    tri: Vec<f64>,
+    /// Rows of `pat` times the block's columns, row-major.
+    rect_ptr: Vec<usize>,
+    rect: Vec<f64>,
+}
+
+impl Blocks {
+    fn from_csc(csc: &Csc) -> Self {
+        let (col_ptr, row_idx, val) = (&csc.col_ptr, &csc.row_idx, &csc.val);
+        let n = csc.diag.len();
+        // Columns sorted by row.
+        let mut rows: Vec<u32> = Vec::with_capacity(row_idx.len());
+        let mut vals: Vec<f64> = Vec::with_capacity(val.len());
+        let mut tmp: Vec<(u32, f64)> = Vec::new();
+        for j in 0..n {
+            tmp.clear();
+            let r = col_ptr[j]..col_ptr[j + 1];
+            tmp.extend(
+                row_idx[r.clone()]
+                    .iter()
+                    .copied()
+                    .zip(val[r].iter().copied()),
+            );
+            tmp.sort_unstable_by_key(|e| e.0);
+            rows.extend(tmp.iter().map(|e| e.0));
+            vals.extend(tmp.iter().map(|e| e.1));
+        }
+        let col = |j: usize| col_ptr[j]..col_ptr[j + 1];
+        let mut b = Blocks {
+            begin: vec![0],
+            pat_ptr: vec![0],
+            tri_ptr: vec![0],
+            rect_ptr: vec![0],
+            ..Default::default()
+        };
+        let mut c0 = 0;
+        while c0 < n {
+            let mut c1 = c0 + 1;
+            while c1 < n {
+                let (prev, next) = (&rows[col(c1 - 1)], &rows[col(c1)]);
+                if prev.first() == Some(&(c1 as u32)) && &prev[1..] == next {
+                    c1 += 1;
+                } else {
+                    break;
+                }
+            }
+            let k = c1 - c0;
+            let pat = &rows[col(c1 - 1)];
+            b.pat.extend_from_slice(pat);
+            for jj in 0..k {
+                let v = &vals[col(c0 + jj)];
+                b.tri.extend_from_slice(&v[..k - 1 - jj]);
+            }
+            let m = pat.len();
+            let base = b.rect.len();
+            b.rect.resize(base + m * k, 0.0);
+            for jj in 0..k {
+                let v = &vals[col(c0 + jj)][k - 1 - jj..];
+                for (r, &x) in v.iter().enumerate() {
+                    b.rect[base + r * k + jj] = x;
+                }
+            }
+            b.begin.push(c1 as u32);
+            b.pat_ptr.push(b.pat.len());
+            b.tri_ptr.push(b.tri.len());
+            b.rect_ptr.push(b.rect.len());
+            c0 = c1;
+        }
+        b
+    }
+}
+
+/// `Σ a_i b_i` with four accumulators (fixed order: deterministic).
+#[inline]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut s = [0.0f64; 4];
+    let (ca, cb) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ra, rb) = (ca.remainder(), cb.remainder());
+    for (x, y) in ca.zip(cb) {
+        for q in 0..4 {
+            s[q] += x[q] * y[q];
+        }
+    }
+    let mut t = (s[0] + s[2]) + (s[1] + s[3]);
+    for (x, y) in ra.iter().zip(rb) {
+        t += x * y;
+    }
+    t
 }
 
 impl std::fmt::Debug for Factor {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Factor")
             .field("n", &self.diag.len())
-            .field("off_diagonal_nnz", &self.val.len())
+            .field("supernodes", &(self.blocks.begin.len() - 1))
+            .field(
+                "off_diagonal_nnz",
+                &(self.blocks.tri.len() + self.blocks.rect.len()),
+            )
             .finish()
     }
 }
@@ -114,7 +228,7 @@ impl Factor {
                 ))
             })?;
         let n = symbolic.nrows();
-        let mut out = Factor {
+        let mut out = Csc {
             diag: vec![0.0; n],
             col_ptr: Vec::with_capacity(n + 1),
             row_idx: Vec::new(),
@@ -193,43 +307,107 @@ impl Factor {
         {
             return Err(bad_layout());
         }
-        Ok(out)
+        let blocks = Blocks::from_csc(&out);
+        Ok(Factor {
+            diag: out.diag,
+            blocks,
+        })
     }
 
     /// Solves `L Lᵀ x = b` in place (internal numbering). `b` must be zero before index
     /// `start` (pass 0 when unknown).
     pub(crate) fn solve_in_place(&self, x: &mut [f64], start: usize) {
-        let n = self.diag.len();
-        debug_assert_eq!(x.len(), n);
-        debug_assert!(x[..start.min(n)].iter().all(|&v| v == 0.0));
-        // Forward: L y = b, column by column; columns whose value is zero change nothing.
-        for j in start..n {
-            let xj = x[j];
-            if xj == 0.0 {
+        let b = &self.blocks;
+        let ns = b.begin.len() - 1;
+        debug_assert_eq!(x.len(), self.diag.len());
+        // Forward: L y = b.
+        for s in 0..ns {
+            let (c0, c1) = (b.begin[s] as usize, b.begin[s + 1] as usize);
+            if c1 <= start {
                 continue;
             }
-            let xj = xj / self.diag[j];
-            x[j] = xj;
-            let r = self.col_ptr[j]..self.col_ptr[j + 1];
-            for (&i, &l) in self.row_idx[r.clone()].iter().zip(&self.val[r]) {
-                x[i as usize] -= l * xj;
+            let k = c1 - c0;
+            if k == 1 {
+                // Single column: a plain sparse column.
+                let v = x[c0];
+                if v != 0.0 {
+                    let v = v / self.diag[c0];
+                    x[c0] = v;
+                    let r = b.pat_ptr[s]..b.pat_ptr[s + 1];
+                    for (&i, &l) in b.pat[r].iter().zip(&b.rect[b.rect_ptr[s]..]) {
+                        x[i as usize] -= l * v;
+                    }
+                }
+                continue;
+            }
+            let (lo, hi) = x.split_at_mut(c1);
+            let xt = &mut lo[c0..];
+            let tri = &b.tri[b.tri_ptr[s]..b.tri_ptr[s + 1]];
+            let diag = &self.diag[c0..c1];
+            let mut t = 0;
+            let mut any = false;
+            for jj in 0..k {
+                let len = k - 1 - jj;
+                let v = xt[jj];
+                if v == 0.0 {
+                    t += len;
+                    continue;
+                }
+                any = true;
+                let v = v / diag[jj];
+                xt[jj] = v;
+                let (_, below) = xt.split_at_mut(jj + 1);
+                for (y, &l) in below.iter_mut().zip(&tri[t..t + len]) {
+                    *y -= l * v;
+                }
+                t += len;
+            }
+            if !any {
+                continue;
+            }
+            let pat = &b.pat[b.pat_ptr[s]..b.pat_ptr[s + 1]];
+            let rect = &b.rect[b.rect_ptr[s]..b.rect_ptr[s + 1]];
+            for (&r, w) in pat.iter().zip(rect.chunks_exact(k)) {
+                hi[r as usize - c1] -= dot(w, xt);
             }
         }
-        // Backward: Lᵀ x = y, a dot product per column (two accumulators to hide latency).
-        for j in (0..n).rev() {
-            let r = self.col_ptr[j]..self.col_ptr[j + 1];
-            let (ri, v) = (&self.row_idx[r.clone()], &self.val[r]);
-            let (mut s0, mut s1) = (0.0f64, 0.0f64);
-            let mut ci = ri.chunks_exact(2);
-            let mut cv = v.chunks_exact(2);
-            for (i2, v2) in (&mut ci).zip(&mut cv) {
-                s0 += v2[0] * x[i2[0] as usize];
-                s1 += v2[1] * x[i2[1] as usize];
+        // Backward: Lᵀ x = y.
+        for s in (0..ns).rev() {
+            let (c0, c1) = (b.begin[s] as usize, b.begin[s + 1] as usize);
+            let k = c1 - c0;
+            let pat = &b.pat[b.pat_ptr[s]..b.pat_ptr[s + 1]];
+            let rect = &b.rect[b.rect_ptr[s]..b.rect_ptr[s + 1]];
+            if k == 1 {
+                let (mut s0, mut s1) = (0.0f64, 0.0f64);
+                let (mut ci, mut cv) = (pat.chunks_exact(2), rect.chunks_exact(2));
+                for (i2, v2) in (&mut ci).zip(&mut cv) {
+                    s0 += v2[0] * x[i2[0] as usize];
+                    s1 += v2[1] * x[i2[1] as usize];
+                }
+                if let ([i], [l]) = (ci.remainder(), cv.remainder()) {
+                    s0 += l * x[*i as usize];
+                }
+                x[c0] = (x[c0] - (s0 + s1)) / self.diag[c0];
+                continue;
             }
-            if let ([i], [l]) = (ci.remainder(), cv.remainder()) {
-                s0 += l * x[*i as usize];
+            let (lo, hi) = x.split_at_mut(c1);
+            let xt = &mut lo[c0..];
+            for (&r, w) in pat.iter().zip(rect.chunks_exact(k)) {
+                let xr = hi[r as usize - c1];
+                for (y, &l) in xt.iter_mut().zip(w) {
+                    *y -= l * xr;
+                }
             }
-            x[j] = (x[j] - (s0 + s1)) / self.diag[j];
+            let tri = &b.tri[b.tri_ptr[s]..b.tri_ptr[s + 1]];
+            let diag = &self.diag[c0..c1];
+            let mut end = tri.len();
+            for jj in (0..k).rev() {
+                let len = k - 1 - jj;
+                let col = &tri[end - len..end];
+                end -= len;
+                let (head, below) = xt.split_at_mut(jj + 1);
+                head[jj] = (head[jj] - dot(col, below)) / diag[jj];
+            }
         }
     }
 }
