@@ -375,9 +375,13 @@ fn update_plane(t: &UpdTri, ta: f64, tb: f64) -> f64 {
 #[inline]
 fn advance(kappa: f64, kg: f64, step: f64) -> f64 {
     let y = kg * step * step;
-    let sigma = if y.abs() < 1e-3 {
-        // Series of tan(x) / x (tanh for y < 0), x^2 = |y|; relative error below 1e-13.
-        step * (1.0 + y * (1.0 / 3.0 + y * (2.0 / 15.0 + y * (17.0 / 315.0))))
+    let sigma = if y.abs() < 0.05 {
+        // Series of tan(x) / x (tanh for y < 0), x^2 = |y|; relative error below 1e-10 (and
+        // below 1e-14 for |y| < 1e-2, the usual case: y ~ K h^2).
+        step * (1.0
+            + y * (1.0 / 3.0
+                + y * (2.0 / 15.0
+                    + y * (17.0 / 315.0 + y * (62.0 / 2835.0 + y * (1382.0 / 155925.0))))))
     } else if y > 0.0 && y < 2.4 {
         let q = kg.sqrt();
         (q * step).tan() / q
