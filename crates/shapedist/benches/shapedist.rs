@@ -79,6 +79,16 @@ fn benches(c: &mut Criterion) {
             })
         })
     });
+    // Keys already in the same ascending order in both sets (as the example's 0..n): the
+    // pairing sorts are then linear.
+    let sorted: Vec<u64> = (0..10_000u64).collect();
+    g.bench_function("keyed_kabsch_10k_pairs_sorted_keys", |bch| {
+        bch.iter(|| {
+            pool.install(|| {
+                keyed_distance(&sorted, &tgt, &sorted, &src, &KeyedOptions::default()).unwrap()
+            })
+        })
+    });
     let po = PrepareOptions::default();
     for deg in [30.0, 90.0, 180.0] {
         let (tgt, src) = case(deg);
