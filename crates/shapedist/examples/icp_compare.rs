@@ -2,10 +2,13 @@
 //!
 //! ```text
 //! python make_clouds.py --resample --out /tmp/clouds
-//! cargo run --release -p shapedist --example icp_compare -- /tmp/clouds [N] [degs] [variant]
+//! cargo run --release -p shapedist --example icp_compare -- /tmp/clouds [N] [degs] [variant] [plain|once]
 //! ```
-//! Prints one line per method: time (median of 5), iterations, rotation error against the
-//! ground truth, NN-RMSE (source -> target) and correspondence RMSE, as `icp_peer.py` does.
+//! Prints one line per method: wall time and CPU time (medians of 5), iterations, rotation
+//! error against the ground truth, NN-RMSE (source -> target) and correspondence RMSE, as
+//! `icp_peer.py` does. `plain`: only the fixed 50-iteration point-to-point row; `once`: that
+//! row run once without the brute-force checks (for profilers). Run with
+//! `RAYON_NUM_THREADS=1` for single-threaded figures.
 
 use std::time::Instant;
 
