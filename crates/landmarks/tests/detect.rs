@@ -1,7 +1,9 @@
 //! Detection: rigid-motion invariance, a small evaluation on the shared paper set (skipped when
 //! the data is absent), and clear failures on non-faces and faces seen from behind.
 
-use landmarks::{detect, io, GenericModel, LandmarkError, LandmarkName};
+use landmarks::{
+    detect, detect_with, io, DetectOptions, GenericModel, LandmarkError, LandmarkName,
+};
 use meshcore::{DAffine3, DQuat, DVec3, TriMesh};
 use std::path::PathBuf;
 
@@ -230,6 +232,105 @@ fn non_faces_are_not_found() {
                 assert!(msg.contains("not found") && msg.contains("score"), "{msg}");
             }
             other => panic!("{what}: expected NotFound, got {other:?}"),
+        }
+    }
+}
+
+/// The part of `m` whose triangles have every corner satisfying `keep` (vertices re-indexed).
+fn part(m: &TriMesh, keep: impl Fn(DVec3) -> bool) -> TriMesh {
+    let mut map = vec![u32::MAX; m.n_vertices()];
+    let mut pos = Vec::new();
+    let mut tri = Vec::new();
+    for t in m.triangles() {
+        if t.iter().all(|&v| keep(m.position(v))) {
+            tri.push(t.map(|v| {
+                if map[v as usize] == u32::MAX {
+                    map[v as usize] = pos.len() as u32;
+                    pos.push(m.position(v));
+                }
+                map[v as usize]
+            }));
+        }
+    }
+    TriMesh::new(pos, tri).unwrap()
+}
+
+#[test]
+fn each_verification_rejects_with_its_reason() {
+    let Some(dir) = paper_set() else { return };
+    let model = GenericModel::default_model().unwrap();
+    let mesh = read_obj(&dir.join("id2_neutral.obj"));
+    let defaults = DetectOptions::default();
+    let lm = detect(&mesh, &model).unwrap();
+    // A correct detection on a neutral face is mirror-symmetric and agrees with every template.
+    assert!(lm.symmetry > 0.9, "symmetry {}", lm.symmetry);
+    for n in LandmarkName::ALL {
+        let local = lm.get(n).confidence / lm.confidence;
+        assert!(local > defaults.min_local_agreement, "{n}: {local}");
+    }
+    // Thresholds no fit can reach: NotFound naming the failed check, with the best score.
+    let cases = [
+        (
+            DetectOptions {
+                min_confidence: 1.001,
+                ..defaults
+            },
+            "covers",
+        ),
+        (
+            DetectOptions {
+                min_symmetry: 1.001,
+                ..defaults
+            },
+            "mirror-symmetric",
+        ),
+        (
+            DetectOptions {
+                min_local_agreement: 1.001,
+                ..defaults
+            },
+            "templates",
+        ),
+    ];
+    for (opts, word) in cases {
+        match detect_with(&mesh, &model, &opts) {
+            Err(LandmarkError::NotFound { reason, best_score }) => {
+                assert!(reason.contains(word), "{reason}");
+                assert!(best_score > 0.5 && best_score <= 1.0, "{best_score}");
+            }
+            other => panic!("expected NotFound ({word}), got {other:?}"),
+        }
+    }
+}
+
+#[test]
+fn partial_faces_are_found_right_or_not_at_all() {
+    let Some(dir) = paper_set() else { return };
+    let truth = io::read_ict_landmarks(&dir.join("landmarks.json")).unwrap();
+    let model = GenericModel::default_model().unwrap();
+    let mesh = read_obj(&dir.join("id4_neutral.obj"));
+    let gt = truth["id4_neutral"];
+    // Below the eyes (mouth, chin and nose only): there are no eye corners to find.
+    let lower = part(&mesh, |p| p.y < 1.5);
+    for t in motions() {
+        match detect(&lower.transformed(&t), &model) {
+            Err(LandmarkError::NotFound { .. }) => {}
+            other => panic!("lower face: expected NotFound, got {other:?}"),
+        }
+    }
+    // The subject's right half and the nose: either right or rejected, never a wrong point.
+    let half = part(&mesh, |p| p.x < 0.6);
+    for t in motions() {
+        match detect(&half.transformed(&t), &model) {
+            Err(LandmarkError::NotFound { .. }) => {}
+            Ok(lm) => {
+                for n in [LandmarkName::OuterEyeRight, LandmarkName::NoseTip] {
+                    let back = t.inverse().transform_point3(lm.get(n).position);
+                    let err = (back - gt[n as usize]).length();
+                    assert!(err < 0.5, "half face {n}: {err} cm from the truth");
+                }
+            }
+            Err(e) => panic!("half face: {e}"),
         }
     }
 }
