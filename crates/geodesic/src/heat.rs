@@ -13,6 +13,13 @@
 //! Both factorisations are computed once in [`HeatMethod::new`] and reused by every solve.
 //! On meshes with boundary the heat flow is the mean of the Neumann and zero-Dirichlet
 //! solutions (Crane et al., section 3.2; libigl does the same), a third factorisation.
+//!
+//! Per-solve cost (see `docs/bench-geodesic-heat.md`): the matrices share one fill-reducing
+//! ordering, and every per-solve array lives in that order, so the triangular solves
+//! (`heat/factor.rs`, hand-written over faer's factor) need no permutation; the gradient and
+//! divergence use two precomputed vectors per face and no geometry; a solve allocates its two
+//! working vectors (one becomes the result) and nothing else. Results equal the textbook
+//! formulation to rounding (`tests/heat_accuracy.rs` keeps a reference implementation).
 
 #![allow(clippy::needless_range_loop)] // index loops over parallel per-vertex arrays
 
