@@ -34,6 +34,8 @@ struct UpdTri {
     /// at `c`, with `sin >= 0`.
     bx: f64,
     by: f64,
+    /// Gaussian curvature density of the triangle (mean of its corners'; curved-front rule).
+    kg: f64,
 }
 
 /// How the arrival time of a vertex is computed from the two other corners of a triangle.
@@ -89,8 +91,6 @@ pub struct FastMarching {
     dep_offsets: Vec<u32>,
     deps: Vec<(u32, u32)>,
     rule: FmmUpdate,
-    /// Gaussian curvature density per vertex (angle defect / (area / 3); zero on the boundary).
-    gauss: Vec<f64>,
     /// Obtuse corners found / split successfully (diagnostics).
     n_obtuse: usize,
     n_split: usize,
@@ -176,6 +176,7 @@ impl FastMarching {
                     lb,
                     bx: lb * cos,
                     by: lb * sin,
+                    kg: 0.0,
                 };
                 if cos < 0.0 && sin > 0.0 {
                     n_obtuse += 1;
@@ -190,6 +191,7 @@ impl FastMarching {
                             lb: lw,
                             bx: pw.x,
                             by: pw.y,
+                            kg: 0.0,
                         });
                         // (c, w, b) in a frame where w lies on the x axis.
                         let pb = DVec2::new(plain.bx, plain.by);
@@ -201,6 +203,7 @@ impl FastMarching {
                             lb,
                             bx: pb.dot(ew),
                             by: (ew.x * pb.y - ew.y * pb.x).max(0.0),
+                            kg: 0.0,
                         });
                         continue;
                     }
@@ -231,6 +234,12 @@ impl FastMarching {
             }
         }
         let gauss = gaussian_curvature(mesh, &topo);
+        for c in 0..n {
+            for ti in tri_offsets[c]..tri_offsets[c + 1] {
+                let t = &mut tris[ti as usize];
+                t.kg = (gauss[c] + gauss[t.a as usize] + gauss[t.b as usize]) / 3.0;
+            }
+        }
         Ok(Self {
             positions: pos.to_vec(),
             triangles: tris_in.to_vec(),
@@ -238,7 +247,6 @@ impl FastMarching {
             dep_offsets,
             deps,
             rule,
-            gauss,
             n_obtuse,
             n_split,
         })
@@ -439,9 +447,11 @@ fn in_cone(ax: f64, bx: f64, by: f64, vx: f64, vy: f64, tol: f64) -> bool {
 /// wave. The characteristic reaching `c` must cross the segment `ab`; otherwise (or if the front
 /// cannot be placed) the edge update is used.
 fn update_curved(t: &UpdTri, ta: f64, tb: f64, ka: f64, kb: f64, kg: f64) -> (f64, f64) {
-    let edge = edge_curved(t, ta, tb, ka, kb, kg);
+    // The edge update (its curvature only computed when it is the answer).
+    let edge_t = (ta + t.la).min(tb + t.lb);
+    let edge = || edge_curved(t, ta, tb, ka, kb, kg);
     if t.by <= 0.0 {
-        return edge;
+        return edge();
     }
     let (ax, bx, by) = (t.la, t.bx, t.by);
     let (ex, ey) = (bx - ax, by);
@@ -449,7 +459,7 @@ fn update_curved(t: &UpdTri, ta: f64, tb: f64, ka: f64, kb: f64, kg: f64) -> (f6
     let l = l2.sqrt();
     let dt = ta - tb;
     if l.is_nan() || l <= 0.0 || dt.abs() >= l {
-        return edge;
+        return edge();
     }
     // Both curvatures carried to the mean time (on a curved surface the radius of curvature
     // grows at the rate 1 + K rho^2, not 1), then averaged: radii when the fronts agree in
@@ -474,7 +484,7 @@ fn update_curved(t: &UpdTri, ta: f64, tb: f64, ka: f64, kb: f64, kg: f64) -> (f6
         // Plane wave.
         match solve_plane(t, ta, tb) {
             Some((tc, _, _)) => tc,
-            None => return edge,
+            None => return edge(),
         }
     } else {
         let (ra, rb) = if rho > 0.0 {
@@ -483,7 +493,7 @@ fn update_curved(t: &UpdTri, ta: f64, tb: f64, ka: f64, kb: f64, kg: f64) -> (f6
             (-rho - 0.5 * dt, -rho + 0.5 * dt)
         };
         if !(ra >= 0.0 && rb >= 0.0) {
-            return edge;
+            return edge();
         }
         // Centre p with |p - a| = ra, |p - b| = rb: behind ab (away from c = 0) for a source,
         // ahead of it (c's side) for a focus.
@@ -491,7 +501,7 @@ fn update_curved(t: &UpdTri, ta: f64, tb: f64, ka: f64, kb: f64, kg: f64) -> (f6
         let y2 = ra * ra - x * x;
         // Tolerate rounding when the centre lies on ab (a source next to both a and b).
         if y2 < -1e-10 * (ra * ra + rb * rb) {
-            return edge;
+            return edge();
         }
         let y = y2.max(0.0).sqrt();
         let (ux, uy) = (ex / l, ey / l);
@@ -500,13 +510,13 @@ fn update_curved(t: &UpdTri, ta: f64, tb: f64, ka: f64, kb: f64, kg: f64) -> (f6
         let (px, py) = (ax + x * ux + side * y * uy, x * uy - side * y * ux);
         let pl = (px * px + py * py).sqrt();
         if pl.is_nan() || pl <= 0.0 {
-            return edge;
+            return edge();
         }
         // The characteristic through c must cross ab: the centre (a source, or a focus c has
         // passed) seen from c, or the direction away from a focus ahead, lies in the corner.
         if rho > 0.0 {
             if !in_cone(ax, bx, by, px, py, tol) {
-                return edge;
+                return edge();
             }
             ta - ra + pl
         } else if in_cone(ax, bx, by, -px, -py, tol) {
@@ -514,13 +524,13 @@ fn update_curved(t: &UpdTri, ta: f64, tb: f64, ka: f64, kb: f64, kg: f64) -> (f6
         } else if in_cone(ax, bx, by, px, py, tol) {
             ta + ra + pl
         } else {
-            return edge;
+            return edge();
         }
     };
     // As in the point-source update, a circle may reach `c` before `a` or `b` (strongly
     // obtuse corners that could not be split); the value is still the front's.
-    if tc.is_nan() || tc >= edge.0 {
-        return edge;
+    if tc.is_nan() || tc >= edge_t {
+        return edge();
     }
     (tc, advance(kmid, kg, tc - tm))
 }
@@ -642,17 +652,20 @@ impl FastMarching {
                 let t = &self.tris[ti as usize];
                 let (ta, tb) = (dist[t.a as usize], dist[t.b as usize]);
                 if curved {
-                    let kg = (self.gauss[c as usize]
-                        + self.gauss[t.a as usize]
-                        + self.gauss[t.b as usize])
-                        / 3.0;
+                    let kg = t.kg;
                     let (ka, kb) = (kap[t.a as usize], kap[t.b as usize]);
                     let (cand, kc) = if done[t.a as usize] && done[t.b as usize] {
                         update_curved(t, ta, tb, ka, kb, kg)
-                    } else if t.a == u {
-                        (ta + t.la, advance(ka, kg, t.la))
                     } else {
-                        (tb + t.lb, advance(kb, kg, t.lb))
+                        let (tu, ku, lu) = if t.a == u {
+                            (ta, ka, t.la)
+                        } else {
+                            (tb, kb, t.lb)
+                        };
+                        if tu + lu >= dist[c as usize] {
+                            continue;
+                        }
+                        (tu + lu, advance(ku, kg, lu))
                     };
                     if cand < dist[c as usize] {
                         dist[c as usize] = cand;
@@ -726,6 +739,7 @@ mod tests {
             lb: 1.0,
             bx: 0.0,
             by: 1.0,
+            kg: 0.0,
         };
         let time = |x: f64, y: f64| (3.0 - x - y) / 2f64.sqrt();
         let got = update_plane(&t, time(1.0, 0.0), time(0.0, 1.0));
@@ -745,6 +759,7 @@ mod tests {
             lb: DVec2::new(0.3, 0.9).length(),
             bx: 0.3,
             by: 0.9,
+            kg: 0.0,
         };
         let s = DVec2::new(2.0, 1.5);
         let ta = (s - DVec2::new(1.0, 0.0)).length();
@@ -782,6 +797,7 @@ mod tests {
             lb: DVec2::new(0.3, 0.9).length(),
             bx: 0.3,
             by: 0.9,
+            kg: 0.0,
         };
         let (pa, pb) = (DVec2::new(1.0, 0.0), DVec2::new(0.3, 0.9));
         // Diverging from a source behind ab: the point-source update.
@@ -898,14 +914,13 @@ mod tests {
         for _ in 0..60 {
             let q = mesh.position(v).normalize();
             println!(
-                "v{v}: lat {:+.1} lon {:+.1} T {:.4} err {:+.2e} kappa {:+.3e} (sphere {:+.3e}) K {:.3}",
+                "v{v}: lat {:+.1} lon {:+.1} T {:.4} err {:+.2e} kappa {:+.3e} (sphere {:+.3e})",
                 q.z.asin().to_degrees(),
                 q.y.atan2(q.x).to_degrees(),
                 d[v as usize],
                 d[v as usize] - g[v as usize],
                 kap[v as usize],
                 1.0 / g[v as usize].tan(),
-                fm.gauss[v as usize]
             );
             if v == src {
                 break;
@@ -925,7 +940,7 @@ mod tests {
                 if !(d[a] < d[v as usize] && d[b] < d[v as usize]) {
                     continue;
                 }
-                let kg = (fm.gauss[v as usize] + fm.gauss[a] + fm.gauss[b]) / 3.0;
+                let kg = t.kg;
                 let (tc, kc) = update_curved(t, d[a], d[b], kap[a], kap[b], kg);
                 let edge = edge_curved(t, d[a], d[b], kap[a], kap[b], kg).0;
                 let (tx, kx) = update_curved(t, g[a], g[b], 1.0 / g[a].tan(), 1.0 / g[b].tan(), kg);
