@@ -263,3 +263,68 @@ fn curved_front_converges_on_icospheres() {
         prev = mae;
     }
 }
+
+/// Height field `z = f(x, y)` on an `n` x `n` grid of the unit square, alternating diagonals.
+fn height_field(n: usize, f: impl Fn(f64, f64) -> f64) -> TriMesh {
+    let h = 1.0 / n as f64;
+    let mut p = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (i as f64 * h, j as f64 * h);
+            p.push(DVec3::new(x, y, f(x, y)));
+        }
+    }
+    let idx = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+    let mut t = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            if (i + j) % 2 == 0 {
+                t.push([idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)]);
+                t.push([idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)]);
+            } else {
+                t.push([idx(i, j), idx(i + 1, j), idx(i, j + 1)]);
+                t.push([idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1)]);
+            }
+        }
+    }
+    TriMesh::new(p, t).unwrap()
+}
+
+#[test]
+fn curved_surfaces_against_the_exact_polyhedral_distance() {
+    // Open meshes with positive and negative Gaussian curvature (a bump and a saddle), with
+    // boundary: the curved-front rule against the exact solver, beside the other rules.
+    let cases: [(&str, Box<dyn Fn(f64, f64) -> f64>); 2] = [
+        (
+            "bump",
+            Box::new(|x: f64, y: f64| {
+                0.4 * (-((x - 0.5).powi(2) + (y - 0.5).powi(2)) * 12.0).exp()
+            }),
+        ),
+        (
+            "saddle",
+            Box::new(|x: f64, y: f64| 0.8 * (x - 0.5) * (y - 0.5)),
+        ),
+    ];
+    for (name, f) in cases {
+        let m = height_field(32, f);
+        let src = [Source::Vertex(3 * 33 + 4)];
+        let exact = geodesic::ExactGeodesic::new(&m)
+            .unwrap()
+            .distances(&src, &SolveOptions::default())
+            .unwrap();
+        let e = |rule| errors(&solve(&m, rule, &src), &exact);
+        let (c, p, w) = (
+            e(FmmUpdate::CurvedFront),
+            e(FmmUpdate::PointSource),
+            e(FmmUpdate::PlaneWave),
+        );
+        println!("{name}: curved {c:?}, point {p:?}, plane {w:?}");
+        assert!(c.0.is_finite() && c.1.is_finite());
+        assert!(
+            c.0 < p.0 && c.0 < w.0,
+            "{name}: MAE curved {c:?} point {p:?} plane {w:?}"
+        );
+        assert!(c.1 < w.1, "{name}: max curved {c:?} plane {w:?}");
+    }
+}
