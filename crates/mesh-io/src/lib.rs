@@ -269,39 +269,27 @@ impl LoadedMesh {
     }
 }
 
-/// A fast non-cryptographic hasher (FxHash-style) for the exact-duplicate search.
-#[derive(Default)]
-struct FxHasher(u64);
-
-impl std::hash::Hasher for FxHasher {
-    fn write(&mut self, bytes: &[u8]) {
-        for b in bytes {
-            self.write_u64(*b as u64);
-        }
-    }
-    fn write_u64(&mut self, v: u64) {
-        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
-    }
-    fn write_usize(&mut self, v: usize) {
-        self.write_u64(v as u64);
-    }
-    fn finish(&self) -> u64 {
-        self.0
-    }
-}
-
-type FxBuild = std::hash::BuildHasherDefault<FxHasher>;
-
 /// For each vertex, the index of the first vertex within `tol` of it (itself if none).
 fn weld_map(p: &[DVec3], tol: f64) -> Vec<u32> {
     let mut remap: Vec<u32> = (0..p.len() as u32).collect();
     if tol == 0.0 {
-        let mut seen: HashMap<[u64; 3], u32, FxBuild> =
-            HashMap::with_capacity_and_hasher(p.len(), FxBuild::default());
-        for (i, q) in p.iter().enumerate() {
+        // Sort (coordinates, index) and give every run of equal coordinates its first index:
+        // cache-friendly, unlike a hash table of half a million random probes.
+        let mut keyed: Vec<([u64; 3], u32)> = p
+            .iter()
+            .enumerate()
             // +0.0 and -0.0 are the same point.
-            let key = [q.x + 0.0, q.y + 0.0, q.z + 0.0].map(f64::to_bits);
-            remap[i] = *seen.entry(key).or_insert(i as u32);
+            .map(|(i, q)| ([q.x + 0.0, q.y + 0.0, q.z + 0.0].map(f64::to_bits), i as u32))
+            .collect();
+        keyed.sort_unstable();
+        let mut start = 0;
+        while start < keyed.len() {
+            let mut end = start + 1;
+            while end < keyed.len() && keyed[end].0 == keyed[start].0 {
+                remap[keyed[end].1 as usize] = keyed[start].1;
+                end += 1;
+            }
+            start = end;
         }
         return remap;
     }
