@@ -294,18 +294,9 @@ fn height_field(n: usize, f: impl Fn(f64, f64) -> f64) -> TriMesh {
 fn curved_surfaces_against_the_exact_polyhedral_distance() {
     // Open meshes with positive and negative Gaussian curvature (a bump and a saddle), with
     // boundary: the curved-front rule against the exact solver, beside the other rules.
-    let cases: [(&str, Box<dyn Fn(f64, f64) -> f64>); 2] = [
-        (
-            "bump",
-            Box::new(|x: f64, y: f64| {
-                0.4 * (-((x - 0.5).powi(2) + (y - 0.5).powi(2)) * 12.0).exp()
-            }),
-        ),
-        (
-            "saddle",
-            Box::new(|x: f64, y: f64| 0.8 * (x - 0.5) * (y - 0.5)),
-        ),
-    ];
+    let bump = |x: f64, y: f64| 0.4 * (-((x - 0.5).powi(2) + (y - 0.5).powi(2)) * 12.0).exp();
+    let saddle = |x: f64, y: f64| 0.8 * (x - 0.5) * (y - 0.5);
+    let cases: [(&str, fn(f64, f64) -> f64); 2] = [("bump", bump), ("saddle", saddle)];
     for (name, f) in cases {
         let m = height_field(32, f);
         let src = [Source::Vertex(3 * 33 + 4)];
