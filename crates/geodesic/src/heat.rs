@@ -27,7 +27,7 @@ mod factor;
 
 use crate::{GeodesicError, GeodesicSolver, Method, SolveOptions, Source, TriMesh};
 use factor::Factor;
-use faer::sparse::Triplet;
+use faer::sparse::{Pair, Triplet};
 use glam::DVec3;
 
 /// Per-face data of the gradient and divergence operators (internal vertex numbering).
@@ -124,8 +124,8 @@ impl HeatMethod {
         }
         // Cotan Laplacian, lower triangle (row >= col), original numbering.
         let mut lap: Vec<Triplet<u32, u32, f64>> = Vec::with_capacity(tris.len() * 6);
-        // Edges of non-degenerate faces, (min, max), for the boundary.
-        let mut edges: Vec<(u32, u32)> = Vec::with_capacity(tris.len() * 3);
+        // Edges of non-degenerate faces as `min << 32 | max`, for the boundary.
+        let mut edges: Vec<u64> = Vec::with_capacity(tris.len() * 3);
         for t3 in tris {
             let [i, j, k] = t3.map(|v| v as usize);
             let (pi, pj, pk) = (pos[i], pos[j], pos[k]);
@@ -154,7 +154,7 @@ impl HeatMethod {
                 lap.push(Triplet::new(a.max(b), a.min(b), -wgt));
                 lap.push(Triplet::new(a, a, wgt));
                 lap.push(Triplet::new(b, b, wgt));
-                edges.push((a.min(b), a.max(b)));
+                edges.push((u64::from(a.min(b)) << 32) | u64::from(a.max(b)));
             }
             for &v in &[i, j, k] {
                 mass[v] += dbl_area / 6.0;
@@ -210,8 +210,8 @@ impl HeatMethod {
                 f += 1;
             }
             if f - e == 1 {
-                is_boundary[edges[e].0 as usize] = true;
-                is_boundary[edges[e].1 as usize] = true;
+                is_boundary[(edges[e] >> 32) as usize] = true;
+                is_boundary[(edges[e] & 0xffff_ffff) as usize] = true;
             }
             e = f;
         }
@@ -220,44 +220,48 @@ impl HeatMethod {
         // All matrices share one pattern (the Laplacian's plus the diagonal), hence one
         // symbolic analysis; rows and columns replaced by the identity keep their positions
         // as explicit zeros (dropped again when the factor is copied out).
-        let mut trip: Vec<Triplet<u32, u32, f64>> = lap.clone();
-        for v in 0..n as u32 {
-            trip.push(Triplet::new(v, v, 0.0));
-        }
+        let nl = lap.len();
+        let idx: Vec<Pair<u32, u32>> = lap
+            .iter()
+            .map(|e| Pair::new(e.row, e.col))
+            .chain((0..n as u32).map(|v| Pair::new(v, v)))
+            .collect();
+        let pattern = factor::Pattern::new(n, &idx)?;
         // Heat matrix M + tL; untouched vertices get an identity row.
-        for (e, l) in trip.iter_mut().zip(&lap) {
-            e.val = t * l.val;
+        let mut vals = vec![0.0f64; nl + n];
+        for (x, l) in vals.iter_mut().zip(&lap) {
+            *x = t * l.val;
         }
         for v in 0..n {
-            trip[lap.len() + v].val = if touched[v] { mass[v] } else { 1.0 };
+            vals[nl + v] = if touched[v] { mass[v] } else { 1.0 };
         }
-        let heat_mat = factor::lower_matrix(n, &trip, "heat")?;
+        let heat_mat = pattern.matrix(&vals, "heat")?;
         let symbolic = factor::analyse(&heat_mat)?;
         let heat = Factor::new(&symbolic, &heat_mat, "heat")?;
         drop(heat_mat);
         let heat_dirichlet = if has_boundary {
-            // Boundary rows and columns become the identity (the diagonal triplets come last).
-            let mut d = trip.clone();
-            for (idx, e) in d.iter_mut().enumerate() {
+            // Boundary rows and columns become the identity (the diagonal entries come last).
+            let mut d = vals.clone();
+            for (k, (x, e)) in d.iter_mut().zip(&idx).enumerate() {
                 if is_boundary[e.row as usize] || is_boundary[e.col as usize] {
-                    e.val = if idx >= lap.len() { 1.0 } else { 0.0 };
+                    *x = if k >= nl { 1.0 } else { 0.0 };
                 }
             }
-            let m = factor::lower_matrix(n, &d, "Dirichlet heat")?;
+            let m = pattern.matrix(&d, "Dirichlet heat")?;
             Some(Factor::new(&symbolic, &m, "Dirichlet heat")?)
         } else {
             None
         };
         // Poisson matrix: L with the rows/columns of pinned and untouched vertices replaced by
         // the identity.
-        for (e, l) in trip.iter_mut().zip(&lap) {
+        for (x, l) in vals.iter_mut().zip(&lap) {
             let (r, c) = (l.row as usize, l.col as usize);
-            e.val = if is_pin[r] || is_pin[c] { 0.0 } else { l.val };
+            *x = if is_pin[r] || is_pin[c] { 0.0 } else { l.val };
         }
         for v in 0..n {
-            trip[lap.len() + v].val = if is_pin[v] || !touched[v] { 1.0 } else { 0.0 };
+            vals[nl + v] = if is_pin[v] || !touched[v] { 1.0 } else { 0.0 };
         }
-        let pois_mat = factor::lower_matrix(n, &trip, "Poisson")?;
+        let pois_mat = pattern.matrix(&vals, "Poisson")?;
         let poisson = Factor::new(&symbolic, &pois_mat, "Poisson")?;
         drop(pois_mat);
 

@@ -19,19 +19,34 @@ use faer::sparse::linalg::cholesky::{
     factorize_symbolic_cholesky, CholeskySymbolicParams, SymbolicCholesky, SymbolicCholeskyRaw,
     SymmetricOrdering,
 };
-use faer::sparse::{SparseColMat, Triplet};
+use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
 use faer::Side;
 
-/// Square sparse symmetric matrix (lower triangle, original vertex numbering) built from
-/// triplets; duplicates are summed and explicit zeros are kept as structural entries, so that
-/// matrices assembled from the same triplet positions share one symbolic analysis.
-pub(crate) fn lower_matrix(
-    n: usize,
-    trip: &[Triplet<u32, u32, f64>],
-    what: &str,
-) -> Result<SparseColMat<u32, f64>, GeodesicError> {
-    SparseColMat::<u32, f64>::try_new_from_triplets(n, n, trip)
-        .map_err(|e| GeodesicError::Numerical(format!("building the {what} matrix: {e:?}")))
+/// Sparsity pattern (lower triangle, original vertex numbering) shared by several matrices:
+/// sorted once, then filled with each matrix's values (duplicates summed; explicit zeros stay
+/// structural entries, so all the matrices share one symbolic analysis).
+pub(crate) struct Pattern {
+    symbolic: SymbolicSparseColMat<u32>,
+    argsort: Argsort<u32>,
+}
+
+impl Pattern {
+    /// The pattern of the `n` x `n` matrix with entries at `idx`.
+    pub(crate) fn new(n: usize, idx: &[Pair<u32, u32>]) -> Result<Self, GeodesicError> {
+        let (symbolic, argsort) = SymbolicSparseColMat::try_new_from_indices(n, n, idx)
+            .map_err(|e| GeodesicError::Numerical(format!("building the sparse pattern: {e:?}")))?;
+        Ok(Self { symbolic, argsort })
+    }
+
+    /// The matrix with value `vals[k]` at entry `idx[k]` of [`Pattern::new`].
+    pub(crate) fn matrix(
+        &self,
+        vals: &[f64],
+        what: &str,
+    ) -> Result<SparseColMat<u32, f64>, GeodesicError> {
+        SparseColMat::new_from_argsort(self.symbolic.clone(), &self.argsort, vals)
+            .map_err(|e| GeodesicError::Numerical(format!("building the {what} matrix: {e:?}")))
+    }
 }
 
 /// Fill-reducing ordering (AMD) and symbolic factorisation of the pattern of `mat`.
@@ -108,8 +123,13 @@ impl Blocks {
         let mut vals: Vec<f64> = Vec::with_capacity(val.len());
         let mut tmp: Vec<(u32, f64)> = Vec::new();
         for j in 0..n {
-            tmp.clear();
             let r = col_ptr[j]..col_ptr[j + 1];
+            if row_idx[r.clone()].is_sorted() {
+                rows.extend_from_slice(&row_idx[r.clone()]);
+                vals.extend_from_slice(&val[r]);
+                continue;
+            }
+            tmp.clear();
             tmp.extend(
                 row_idx[r.clone()]
                     .iter()
