@@ -264,6 +264,9 @@ fn curved_front_converges_on_icospheres() {
     }
 }
 
+/// A height function `z = f(x, y)`.
+type Height = fn(f64, f64) -> f64;
+
 /// Height field `z = f(x, y)` on an `n` x `n` grid of the unit square, alternating diagonals.
 fn height_field(n: usize, f: impl Fn(f64, f64) -> f64) -> TriMesh {
     let h = 1.0 / n as f64;
@@ -296,7 +299,7 @@ fn curved_surfaces_against_the_exact_polyhedral_distance() {
     // boundary: the curved-front rule against the exact solver, beside the other rules.
     let bump = |x: f64, y: f64| 0.4 * (-((x - 0.5).powi(2) + (y - 0.5).powi(2)) * 12.0).exp();
     let saddle = |x: f64, y: f64| 0.8 * (x - 0.5) * (y - 0.5);
-    let cases: [(&str, fn(f64, f64) -> f64); 2] = [("bump", bump), ("saddle", saddle)];
+    let cases: [(&str, Height); 2] = [("bump", bump), ("saddle", saddle)];
     for (name, f) in cases {
         let m = height_field(32, f);
         let src = [Source::Vertex(3 * 33 + 4)];
