@@ -68,12 +68,49 @@ pub struct Pairing {
     pub ambiguous_b: usize,
 }
 
+/// `(key, index)` for every key, sorted by key then index: an LSD radix sort on bytes (stable,
+/// so equal keys keep index order), skipping the byte positions where all keys agree (packed
+/// descriptor keys use few of their 64 bits). Already sorted input is detected in one pass.
+fn sort_by_key_then_index(keys: &[u64]) -> Vec<(u64, usize)> {
+    let mut v: Vec<(u64, usize)> = keys.iter().copied().zip(0..).collect();
+    if v.windows(2).all(|w| w[0].0 <= w[1].0) || v.len() < 64 {
+        if v.len() < 64 {
+            v.sort_unstable();
+        }
+        return v;
+    }
+    let (or, and) = keys
+        .iter()
+        .fold((0u64, u64::MAX), |(o, a), &k| (o | k, a & k));
+    let varying = or ^ and;
+    let mut tmp = vec![(0u64, 0usize); v.len()];
+    for byte in 0..8 {
+        let shift = 8 * byte;
+        if (varying >> shift) & 0xff == 0 {
+            continue;
+        }
+        let mut count = [0usize; 257];
+        for &(k, _) in &v {
+            count[((k >> shift) & 0xff) as usize + 1] += 1;
+        }
+        for d in 0..256 {
+            count[d + 1] += count[d];
+        }
+        for &e in &v {
+            let d = ((e.0 >> shift) & 0xff) as usize;
+            tmp[count[d]] = e;
+            count[d] += 1;
+        }
+        std::mem::swap(&mut v, &mut tmp);
+    }
+    v
+}
+
 /// Pairs two key lists: keys present exactly once in each list form a pair; keys repeated
 /// within a list are ambiguous and dropped.
 pub fn pair_by_keys(keys_a: &[u64], keys_b: &[u64]) -> Pairing {
     fn unique_sorted(keys: &[u64]) -> (Vec<(u64, usize)>, usize) {
-        let mut v: Vec<(u64, usize)> = keys.iter().copied().zip(0..).collect();
-        v.sort_unstable();
+        let v = sort_by_key_then_index(keys);
         let mut out = Vec::with_capacity(v.len());
         let mut dropped = 0;
         let mut i = 0;
@@ -395,4 +432,34 @@ fn fit(
         al = align_pairs(a, b, Some(&w), opts.method)?;
     }
     Ok((al, Some(w)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+
+    #[test]
+    fn radix_pairing_sort_equals_a_comparison_sort() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        for (n, bits) in [
+            (10usize, 57u32),
+            (100, 12),
+            (5000, 40),
+            (5000, 57),
+            (3000, 3),
+        ] {
+            let keys: Vec<u64> = (0..n)
+                .map(|_| (rng.random::<u64>() >> (64 - bits)) << 7)
+                .collect();
+            let mut want: Vec<(u64, usize)> = keys.iter().copied().zip(0..).collect();
+            want.sort();
+            assert_eq!(sort_by_key_then_index(&keys), want, "n {n}, bits {bits}");
+            let sorted: Vec<u64> = want.iter().map(|e| e.0).collect();
+            assert_eq!(
+                sort_by_key_then_index(&sorted),
+                sorted.iter().copied().zip(0..).collect::<Vec<_>>()
+            );
+        }
+    }
 }
