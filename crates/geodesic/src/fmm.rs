@@ -1,9 +1,9 @@
 //! Fast marching on triangulated domains (Kimmel & Sethian 1998) with obtuse-angle unfolding.
 //!
 //! Every vertex `c` owns a list of *update triangles* `(c, a, b)`: planar triangles in which the
-//! arrival time of `c` is computed from the times of `a` and `b` by the planar-wave update (the
-//! virtual source at distances `T_a`, `T_b` from `a`, `b`, valid when the ray from it to `c`
-//! crosses the segment `ab`). Acute corners give one update triangle, the face itself. An obtuse
+//! arrival time of `c` is computed from the times of `a` and `b` by one of the [`FmmUpdate`]
+//! rules (by default a circular front whose curvature is carried from vertex to vertex, valid
+//! when the characteristic reaching `c` crosses the segment `ab`). Acute corners give one update triangle, the face itself. An obtuse
 //! corner breaks causality (the front may reach `c` before `a` or `b`), so, as in Kimmel-Sethian,
 //! the neighbouring faces are unfolded across the opposite edge into the plane of the face until
 //! a vertex `w` lands in the *section* of the obtuse angle (the cone bounded by the
@@ -74,8 +74,11 @@ pub enum FmmUpdate {
 
 /// Fast marching distance on a triangle mesh.
 ///
-/// First-order accurate (error O(h) near point sources, smaller elsewhere); exact for a planar
-/// wave on a flat mesh. Obtuse corners are split by unfolding (Kimmel-Sethian), which keeps the
+/// With the default [`FmmUpdate::CurvedFront`] rule: exact from a vertex source on flat and
+/// developable meshes, and on the peers' unit spheres (2.5k-164k vertices) max errors of
+/// 1.2e-3 down to 1.9e-5 against the great-circle distance (`docs/bench-geodesic.md`). With
+/// several sources whose fronts merge (e.g. a row of vertices) it is first order, like the
+/// point-source rule; [`FmmUpdate::PlaneWave`] is exact for plane waves. Obtuse corners are split by unfolding (Kimmel-Sethian), which keeps the
 /// scheme monotone and accurate on meshes with obtuse or stretched triangles. A surface-point
 /// source starts from the three corners of its face with their straight-line distances.
 ///
