@@ -7,7 +7,7 @@
 //! | method | type | what it computes |
 //! |---|---|---|
 //! | [`Method::Exact`] | [`ExactGeodesic`] | exact polyhedral distance (window propagation) |
-//! | [`Method::Fmm`] | [`FastMarching`] | fast marching (Kimmel-Sethian) with obtuse-angle unfolding; first order |
+//! | [`Method::Fmm`] | [`FastMarching`] | fast marching (Kimmel-Sethian) with obtuse-angle unfolding; by default each update models a curved front whose curvature is carried along characteristics ([`FmmUpdate::CurvedFront`]) |
 //! | [`Method::Heat`] | [`HeatMethod`] | heat method with reused sparse Cholesky factorisations; smooth, approximate |
 //! | [`Method::Dijkstra`] | [`Dijkstra`] | shortest paths along mesh edges (the paper's baseline; overestimates) |
 //!
