@@ -87,6 +87,11 @@ fn nms(idx: &SurfaceIndex, mut cand: Vec<(f64, u32)>, radius: f64, max: usize) -
     kept
 }
 
+/// Search radius of the nose-tip refinement, in units of the model's search radius. The pose
+/// predicts the nose tip less well than the eye corners that dominate the fit: with `1.0` the
+/// nose tip was more than 10 mm off on 5 % of 600 test faces instead of 1 %.
+const NOSE_SEARCH: f64 = 2.0;
+
 /// A pose hypothesis (model -> mesh) with its fit.
 #[derive(Debug, Clone, Copy)]
 struct Hypothesis {
@@ -469,7 +474,7 @@ fn refine_all(
         // The nose tip is a strong feature but far from the eyes that dominate the pose: wider
         // search.
         let radius = if name == L::NoseTip {
-            2.0 * p.search_radius
+            NOSE_SEARCH * p.search_radius
         } else {
             p.search_radius
         };
