@@ -36,12 +36,27 @@ pub fn describe(
     check_references(mesh, &topo, refs)?;
     let fields = match opts.max_level {
         Some(m) if m > 0 => region_fields(mesh, &topo, solver, refs, opts.levels, m)?,
-        _ => refs
-            .iter()
-            .map(|r| solver.distances(&[*r], &SolveOptions::default()))
-            .collect::<Result<Vec<_>, _>>()?,
+        _ => solve_all(solver, refs, &vec![None; refs.len()])?,
     };
     describe_fields_with_refs(mesh, &topo, &fields, Some(refs), opts)
+}
+
+/// One field per reference, solved in parallel (rayon; each field is independent, so the result
+/// does not depend on the thread count), with an optional cut-off each.
+fn solve_all(
+    solver: &dyn GeodesicSolver,
+    refs: &[Source],
+    cuts: &[Option<f64>],
+) -> Result<Vec<Vec<f64>>, BipolarError> {
+    use rayon::prelude::*;
+    refs.par_iter()
+        .zip(cuts)
+        .map(|(r, &c)| {
+            solver
+                .distances(&[*r], &SolveOptions { max_distance: c })
+                .map_err(BipolarError::from)
+        })
+        .collect()
 }
 
 /// Distance fields cut off just past the region `levels 1..=max_level`, so that the solver
@@ -81,25 +96,33 @@ fn region_fields(
         LevelSpec::Count(c) => max_level as f64 * d01 / c.max(1) as f64,
         LevelSpec::Step(s) => max_level as f64 * s,
     };
-    let mut d01_guess = (pos[0] - pos[1]).length();
-    let mut fields = Vec::with_capacity(refs.len());
-    for (a, r) in refs.iter().enumerate() {
-        let farthest_ref = (0..refs.len())
+    // First pass, every field at once (in parallel) with a cut from the straight-line guesses
+    // (geodesic >= straight line; 1.25 covers the faces' ratio of about 1.2).
+    let guess = 1.25 * (pos[0] - pos[1]).length();
+    let farthest = |a: usize| {
+        (0..refs.len())
             .map(|b| (pos[a] - pos[b]).length())
-            .fold(0.0f64, f64::max);
-        let mut cut = region(d01_guess * 1.25).max(farthest_ref * 1.25) + margin;
+            .fold(0.0f64, f64::max)
+    };
+    let mut cuts: Vec<f64> = (0..refs.len())
+        .map(|a| region(guess).max(1.25 * farthest(a)) + margin)
+        .collect();
+    let mut fields = solve_all(
+        solver,
+        refs,
+        &cuts.iter().map(|&c| Some(c)).collect::<Vec<_>>(),
+    )?;
+    // Then check each field and solve again, larger, where the cut was too short.
+    let mut d01 = None;
+    for a in 0..refs.len() {
         loop {
-            let opts = SolveOptions {
-                max_distance: Some(cut),
-            };
-            let f = solver.distances(&[*r], &opts)?;
-            let comp = topo.vertex_component[source_vertex(mesh, r) as usize] as usize;
-            let reached = f.iter().filter(|x| x.is_finite()).count();
-            let whole = reached >= comp_size[comp];
+            let f = &fields[a];
+            let comp = topo.vertex_component[source_vertex(mesh, &refs[a]) as usize] as usize;
+            let whole = f.iter().filter(|x| x.is_finite()).count() >= comp_size[comp];
             let mut needed = 0.0f64;
             let mut missing = false;
             for b in refs {
-                let d = field_at(mesh, &f, b)?;
+                let d = field_at(mesh, f, b)?;
                 if d.is_finite() {
                     needed = needed.max(d);
                 } else {
@@ -107,14 +130,19 @@ fn region_fields(
                 }
             }
             if a == 0 && !missing {
-                d01_guess = field_at(mesh, &f, &refs[1])?;
+                d01 = Some(field_at(mesh, f, &refs[1])?);
             }
-            let want = region(d01_guess).max(needed) + margin;
-            if whole || (!missing && want <= cut) {
-                fields.push(f);
+            let want = region(d01.unwrap_or(guess)).max(needed) + margin;
+            if whole || (!missing && want <= cuts[a]) {
                 break;
             }
-            cut = if missing { cut * 2.0 } else { want * 1.05 };
+            cuts[a] = if missing { cuts[a] * 2.0 } else { want * 1.05 };
+            fields[a] = solver.distances(
+                &[refs[a]],
+                &SolveOptions {
+                    max_distance: Some(cuts[a]),
+                },
+            )?;
         }
     }
     Ok(fields)
