@@ -22,9 +22,10 @@ pub struct Args {
     /// Mesh units per model unit (10 for a scan in mm with the default model in cm).
     #[arg(long, default_value_t = 1.0)]
     pub scale: f64,
-    /// Overall confidence below which detection fails.
-    #[arg(long, default_value_t = 0.3)]
-    pub min_confidence: f64,
+    /// Overall confidence below which detection fails (default: the library's,
+    /// `landmarks::DetectOptions::default().min_confidence`, calibrated on training faces).
+    #[arg(long)]
+    pub min_confidence: Option<f64>,
 }
 
 /// Runs the command.
@@ -37,7 +38,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     let opts = DetectOptions {
         mesh_units_per_model_unit: args.scale,
-        min_confidence: args.min_confidence,
+        min_confidence: args
+            .min_confidence
+            .unwrap_or(DetectOptions::default().min_confidence),
         ..DetectOptions::default()
     };
     let lm = detect_with(&loaded.mesh, &model, &opts)
