@@ -36,7 +36,8 @@ const IDX: u32 = !REV;
 const BARY_SNAP: f64 = 1e-12;
 
 /// Geometry of a half-edge `a -> b` of face `(a, b, c)` in its frame: origin at `a`, x towards
-/// `b`, +y into the face.
+/// `b`, +y into the face. Kept to 40 bytes (the per-window rotations are derived in
+/// [`HeGeom::frame`] once per list): `process` starts with a cache miss on it.
 #[derive(Debug, Clone, Copy, Default)]
 struct HeGeom {
     /// |ab|.
@@ -49,12 +50,39 @@ struct HeGeom {
     lac: f64,
     /// |bc|: length of the right child edge.
     lbc: f64,
+}
+
+/// [`HeGeom`] with the rotations into the child edges' frames.
+#[derive(Debug, Clone, Copy)]
+struct Frame {
+    l: f64,
+    cx: f64,
+    cy: f64,
+    lac: f64,
+    lbc: f64,
     /// (cx, cy) / |ac|.
     cos_a: f64,
     sin_a: f64,
     /// (l - cx, -cy) / |bc|.
     ux: f64,
     uy: f64,
+}
+
+impl HeGeom {
+    #[inline]
+    fn frame(&self) -> Frame {
+        Frame {
+            l: self.l,
+            cx: self.cx,
+            cy: self.cy,
+            lac: self.lac,
+            lbc: self.lbc,
+            cos_a: self.cx / self.lac,
+            sin_a: self.cy / self.lac,
+            ux: (self.l - self.cx) / self.lbc,
+            uy: -self.cy / self.lbc,
+        }
+    }
 }
 
 /// What [`ExactGeodesic::new`] found and repaired in the mesh.
@@ -238,10 +266,6 @@ impl ExactGeodesic {
                     cy,
                     lac,
                     lbc,
-                    cos_a: cx / lac,
-                    sin_a: cy / lac,
-                    ux: (l - cx) / lbc,
-                    uy: -cy / lbc,
                 };
                 // Corner angle at a.
                 angle[a as usize] += ab.cross(ac).length().atan2(ab.dot(ac));
@@ -758,29 +782,35 @@ impl<'a> Solve<'a> {
             !(da + w.b1 < w.dist(w.b1) * (1.0 - TAU)
                 || db + (l - w.b0) < w.dist(w.b0) * (1.0 - TAU))
         });
-        // P1: sorted lower-envelope trim.
+        // P1: sorted lower-envelope trim (dead windows are skipped below, not removed).
+        let mut alive = ws.len();
         if self.prune && ws.len() > 1 {
             ws.sort_by(|x, y| x.b0.total_cmp(&y.b0));
             let mut cur = 0;
+            let mut cur_s = ws[0].scale();
             for j in 1..ws.len() {
                 let (lo, hi) = ws.split_at_mut(j);
-                match pair_trim(&mut lo[cur], &mut hi[0]) {
-                    Trim::FirstDead => cur = j,
-                    Trim::SecondDead => {}
+                let s2 = hi[0].scale();
+                match pair_trim(&mut lo[cur], cur_s, &mut hi[0], s2) {
+                    Trim::FirstDead => {
+                        (cur, cur_s) = (j, s2);
+                        alive -= 1;
+                    }
+                    Trim::SecondDead => alive -= 1,
                     Trim::Both => {
                         if hi[0].b1 > lo[cur].b1 {
-                            cur = j;
+                            (cur, cur_s) = (j, s2);
                         }
                     }
                 }
             }
-            ws.retain(|w| !w.is_dead());
         }
-        if ws.is_empty() {
+        if alive == 0 {
             self.recycle(ws);
             return;
         }
         // P2: best window for the apex and the split point.
+        let geo = geo.frame();
         let (cx, cy) = (geo.cx, geo.cy);
         let mut tcs = std::mem::take(&mut self.tc_buf);
         tcs.clear();
@@ -791,6 +821,9 @@ impl<'a> Solve<'a> {
         for w in &ws {
             let tc = w.sx + (-w.sy) * (cx - w.sx) / (cy - w.sy);
             tcs.push(tc);
+            if w.is_dead() {
+                continue;
+            }
             let t = tc.clamp(w.b0, w.b1);
             let dc = if t == tc {
                 w.sigma + ((cx - w.sx) * (cx - w.sx) + (cy - w.sy) * (cy - w.sy)).sqrt()
@@ -815,6 +848,9 @@ impl<'a> Solve<'a> {
         let tl_tw = g.twin[prev(h) as usize];
         let tr_tw = g.twin[next(h) as usize];
         for (i, w) in ws.iter().enumerate() {
+            if w.is_dead() {
+                continue;
+            }
             let tc = tcs[i];
             if tl_tw != NONE {
                 let tl = w.b1.min(tc).min(if p_star.is_nan() { tc } else { p_star });
@@ -842,7 +878,7 @@ impl<'a> Solve<'a> {
 
     /// Child on the left edge a -> c: frame origin a, x towards c.
     #[inline]
-    fn emit_left(&mut self, geo: &HeGeom, tw: u32, w: &Window, t0: f64, t1: f64, apex_end: bool) {
+    fn emit_left(&mut self, geo: &Frame, tw: u32, w: &Window, t0: f64, t1: f64, apex_end: bool) {
         let (cs, sn) = (geo.cos_a, geo.sin_a);
         let ell = geo.lac;
         let sx = w.sx * cs + w.sy * sn;
@@ -868,7 +904,7 @@ impl<'a> Solve<'a> {
 
     /// Child on the right edge c -> b: frame origin c, x towards b.
     #[inline]
-    fn emit_right(&mut self, geo: &HeGeom, tw: u32, w: &Window, t0: f64, t1: f64, apex_end: bool) {
+    fn emit_right(&mut self, geo: &Frame, tw: u32, w: &Window, t0: f64, t1: f64, apex_end: bool) {
         let (ux, uy) = (geo.ux, geo.uy);
         let ell = geo.lbc;
         let (dx, dy) = (w.sx - geo.cx, w.sy - geo.cy);

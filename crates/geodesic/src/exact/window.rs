@@ -54,7 +54,11 @@ impl Window {
         )
     }
 
-    fn scale(&self) -> f64 {
+    /// Size of the window's distance function (`|sigma| + |source|`), the reference of the
+    /// relative tolerances in [`pair_trim`]; depends only on `sigma` and the source, so callers
+    /// compute it once per window and pass it on.
+    #[inline]
+    pub fn scale(&self) -> f64 {
         self.sigma.abs() + (self.sx * self.sx + self.sy * self.sy).sqrt()
     }
 }
@@ -72,8 +76,7 @@ pub(crate) enum Trim {
 
 /// Real roots of `D1(x) = D2(x)` (a superset: squaring may add spurious ones), written into
 /// `out`; returns how many.
-fn equal_distance_roots(w1: &Window, w2: &Window, out: &mut [f64; 2]) -> usize {
-    let scale = w1.scale().max(w2.scale());
+fn equal_distance_roots(w1: &Window, w2: &Window, scale: f64, out: &mut [f64; 2]) -> usize {
     let delta = w2.sigma - w1.sigma;
     let u = w1.sx - w2.sx;
     // |S1|^2 - |S2|^2 written to avoid cancellation.
@@ -126,14 +129,15 @@ fn equal_distance_roots(w1: &Window, w2: &Window, out: &mut [f64; 2]) -> usize {
 ///
 /// A part of a window is removed only when the other window is strictly shorter there (by more
 /// than [`TAU`] relative); windows are never split in the middle. Identical distance functions
-/// whose intervals overlap or touch are merged into `w1`.
-pub(crate) fn pair_trim(w1: &mut Window, w2: &mut Window) -> Trim {
+/// whose intervals overlap or touch are merged into `w1`. `s1` and `s2` are the windows'
+/// [`Window::scale`] (computed once per window by the caller: trimming does not change them).
+pub(crate) fn pair_trim(w1: &mut Window, s1: f64, w2: &mut Window, s2: f64) -> Trim {
     let l = w1.b0.max(w2.b0);
     let r = w1.b1.min(w2.b1);
     if r < l {
         return Trim::Both;
     }
-    let s = 1e-12 * w1.scale();
+    let s = 1e-12 * s1;
     if (w1.sigma - w2.sigma).abs() <= s
         && (w1.sx - w2.sx).abs() <= s
         && (w1.sy - w2.sy).abs() <= s
@@ -149,8 +153,21 @@ pub(crate) fn pair_trim(w1: &mut Window, w2: &mut Window) -> Trim {
     if r <= l {
         return Trim::Both;
     }
+    // Bounding check: when one window's minimum over the overlap exceeds the other's maximum
+    // by a margin, every midpoint test below would say that it loses the whole overlap; the
+    // outcome is then fixed (same result as the exact path, without roots or midpoints).
+    if let Some(out) = dominated_on_overlap(w1, w2, l, r) {
+        return out;
+    }
+    exact_trim(w1, w2, s1.max(s2), l, r)
+}
+
+/// The exact path of [`pair_trim`] on the overlap `[l, r]` (`l < r`): equal-distance roots,
+/// a midpoint test per segment, then the ends are moved past the lost segments. `scale` is the
+/// larger of the two windows' [`Window::scale`].
+fn exact_trim(w1: &mut Window, w2: &mut Window, scale: f64, l: f64, r: f64) -> Trim {
     let mut roots = [0.0; 2];
-    let nr = equal_distance_roots(w1, w2, &mut roots);
+    let nr = equal_distance_roots(w1, w2, scale, &mut roots);
     // Breakpoints l < p1 < p2 < r.
     let mut pts = [l, 0.0, 0.0, r];
     let mut np = 1;
@@ -189,6 +206,65 @@ pub(crate) fn pair_trim(w1: &mut Window, w2: &mut Window) -> Trim {
     trim_ends(w1, &pts, nseg, &lose1, l, r);
     trim_ends(w2, &pts, nseg, &lose2, l, r);
     Trim::Both
+}
+
+/// Minimum of `w`'s distance over `[l, r]` (at the foot of the source, clamped).
+#[inline]
+fn min_on(w: &Window, l: f64, r: f64) -> f64 {
+    let dx = (l - w.sx).max(w.sx - r).max(0.0);
+    w.sigma + (dx * dx + w.sy * w.sy).sqrt()
+}
+
+/// Maximum of `w`'s distance over `[l, r]` (at the end farther from the source: convexity).
+#[inline]
+fn max_on(w: &Window, l: f64, r: f64) -> f64 {
+    let dx = (l - w.sx).abs().max((r - w.sx).abs());
+    w.sigma + (dx * dx + w.sy * w.sy).sqrt()
+}
+
+/// Margin of [`dominated_on_overlap`]: `4 TAU` relative, far above the rounding of the
+/// distance evaluations (a few ulps), so that `min(D1) (1 - 4 TAU) > max(D2)` implies
+/// `D1(m) > D2(m) + TAU max(D1(m), D2(m))` as computed at every midpoint `m` of `[l, r]`.
+const BOUND_MARGIN: f64 = 1.0 - 4.0 * TAU;
+
+/// The result of [`pair_trim`]'s exact path when one window loses the whole overlap `[l, r]`
+/// (`l < r`) by the bound `min(D_loser) (1 - 4 TAU) > max(D_winner)`, or `None` if the bound
+/// decides nothing. Mirrors the exact path: the loser dies when its interval lies inside the
+/// overlap, otherwise its ends lying in the overlap move to the overlap's other end.
+#[inline]
+fn dominated_on_overlap(w1: &mut Window, w2: &mut Window, l: f64, r: f64) -> Option<Trim> {
+    if min_on(w1, l, r) * BOUND_MARGIN > max_on(w2, l, r) {
+        if w1.b0 >= l && w1.b1 <= r {
+            w1.kill();
+            return Some(Trim::FirstDead);
+        }
+        lose_overlap(w1, l, r);
+        return Some(Trim::Both);
+    }
+    if min_on(w2, l, r) * BOUND_MARGIN > max_on(w1, l, r) {
+        if w2.b0 >= l && w2.b1 <= r {
+            w2.kill();
+            return Some(Trim::SecondDead);
+        }
+        lose_overlap(w2, l, r);
+        return Some(Trim::Both);
+    }
+    None
+}
+
+/// [`trim_ends`] when every segment of `[l, r]` is lost (and `w` is not inside `[l, r]`).
+#[inline]
+fn lose_overlap(w: &mut Window, l: f64, r: f64) {
+    let (b0, b1) = (w.b0, w.b1);
+    if b0 >= l {
+        w.b0 = r;
+    }
+    if b1 <= r {
+        w.b1 = l;
+    }
+    if w.b0 > w.b1 {
+        w.kill();
+    }
 }
 
 /// Moves the ends of `w` that lie at `l` (or `r`) past the lost segments touching them.
@@ -234,11 +310,16 @@ mod tests {
         }
     }
 
+    fn trim(a: &mut Window, b: &mut Window) -> Trim {
+        let (sa, sb) = (a.scale(), b.scale());
+        pair_trim(a, sa, b, sb)
+    }
+
     /// After a trim, every point of the original union is still served (within tolerance) by
     /// a surviving window at no more than the original lower envelope.
     fn check_sound(a: Window, b: Window, rng: &mut ChaCha8Rng) {
         let (mut x, mut y) = (a, b);
-        let out = pair_trim(&mut x, &mut y);
+        let out = pair_trim(&mut x, a.scale(), &mut y, b.scale());
         match out {
             Trim::FirstDead => assert!(x.is_dead()),
             Trim::SecondDead => assert!(y.is_dead()),
@@ -298,12 +379,52 @@ mod tests {
         }
     }
 
+    /// The bounding shortcut gives exactly the exact path's result whenever it decides.
+    #[test]
+    fn bound_shortcut_matches_exact_path() {
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let mut decided = 0;
+        for _ in 0..20000 {
+            let mk = |rng: &mut ChaCha8Rng| {
+                let b0: f64 = rng.random_range(0.0..1.0);
+                let b1: f64 = rng.random_range(b0..=1.0);
+                win(
+                    b0,
+                    b1,
+                    rng.random_range(0.0..2.0),
+                    rng.random_range(-3.0..4.0),
+                    -rng.random_range(1e-3..3.0),
+                )
+            };
+            let (a, b) = (mk(&mut rng), mk(&mut rng));
+            let (l, r) = (a.b0.max(b.b0), a.b1.min(b.b1));
+            if r <= l {
+                continue;
+            }
+            let (mut x1, mut y1) = (a, b);
+            let Some(fast) = dominated_on_overlap(&mut x1, &mut y1, l, r) else {
+                continue;
+            };
+            decided += 1;
+            let (mut x2, mut y2) = (a, b);
+            let slow = exact_trim(&mut x2, &mut y2, a.scale().max(b.scale()), l, r);
+            assert_eq!(fast, slow, "{a:?} {b:?}");
+            for (p, q) in [(x1, x2), (y1, y2)] {
+                assert_eq!(p.is_dead(), q.is_dead(), "{a:?} {b:?}");
+                if !p.is_dead() {
+                    assert_eq!((p.b0, p.b1), (q.b0, q.b1), "{a:?} {b:?}");
+                }
+            }
+        }
+        assert!(decided > 1000, "the shortcut decided only {decided} pairs");
+    }
+
     #[test]
     fn linear_branch_equal_sigma() {
         // Two sources with equal sigma: the bisector x = 0.5 splits the edge.
         let mut a = win(0.0, 1.0, 0.0, 0.0, -1.0);
         let mut b = win(0.0, 1.0, 0.0, 1.0, -1.0);
-        assert_eq!(pair_trim(&mut a, &mut b), Trim::Both);
+        assert_eq!(trim(&mut a, &mut b), Trim::Both);
         assert!((a.b1 - 0.5).abs() < 1e-12, "{a:?}");
         assert!((b.b0 - 0.5).abs() < 1e-12, "{b:?}");
         assert_eq!(a.b0, 0.0);
@@ -315,7 +436,7 @@ mod tests {
         // sigma differs by 0.2: root where sqrt(x^2+1) = 0.2 + sqrt((x-1)^2+1).
         let mut a = win(0.0, 1.0, 0.0, 0.0, -1.0);
         let mut b = win(0.0, 1.0, 0.2, 1.0, -1.0);
-        assert_eq!(pair_trim(&mut a, &mut b), Trim::Both);
+        assert_eq!(trim(&mut a, &mut b), Trim::Both);
         let x = a.b1;
         let f = |x: f64| (x * x + 1.0).sqrt() - 0.2 - ((x - 1.0) * (x - 1.0) + 1.0).sqrt();
         assert!(f(x).abs() < 1e-12, "root {x}: {}", f(x));
@@ -326,16 +447,16 @@ mod tests {
     fn dominated_window_dies_and_duplicates_merge() {
         let mut a = win(0.2, 0.8, 0.0, 0.5, -1.0);
         let mut b = win(0.0, 1.0, 0.0, 0.5, -0.5);
-        assert_eq!(pair_trim(&mut a, &mut b), Trim::FirstDead);
+        assert_eq!(trim(&mut a, &mut b), Trim::FirstDead);
         assert!(a.is_dead());
         let mut a = win(0.0, 0.5, 1.0, 0.3, -0.4);
         let mut b = win(0.5, 0.9, 1.0, 0.3, -0.4);
-        assert_eq!(pair_trim(&mut a, &mut b), Trim::SecondDead);
+        assert_eq!(trim(&mut a, &mut b), Trim::SecondDead);
         assert_eq!((a.b0, a.b1), (0.0, 0.9));
         // Disjoint windows are left alone.
         let mut a = win(0.0, 0.4, 0.0, 0.0, -1.0);
         let mut b = win(0.5, 0.9, 5.0, 0.3, -0.4);
-        assert_eq!(pair_trim(&mut a, &mut b), Trim::Both);
+        assert_eq!(trim(&mut a, &mut b), Trim::Both);
         assert_eq!((a.b0, a.b1, b.b0, b.b1), (0.0, 0.4, 0.5, 0.9));
     }
 }
