@@ -61,7 +61,7 @@ struct Leaf {
 type Scratch = [[f64; LANES]; LEAF_SIZE / LANES + 1];
 
 /// Queries answered together by [`PointTree::nearest_group`] (at most).
-pub const GROUP: usize = 8;
+pub const GROUP: usize = 32;
 
 /// Exact nearest-neighbour k-d tree over f64 points with tight node bounding boxes.
 #[derive(Debug, Clone)]
