@@ -27,7 +27,7 @@ use crate::{GeodesicError, GeodesicSolver, Method, SolveOptions, Source, Surface
 use glam::DVec3;
 use std::cmp::Ordering;
 use std::collections::{BinaryHeap, VecDeque};
-use window::{pair_trim, Trim, Window, TAU};
+use window::{pair_trim, BoundStats, Trim, Window, TAU};
 
 const NONE: u32 = u32::MAX;
 const REV: u32 = 1 << 31;
@@ -166,6 +166,11 @@ impl PartialOrd for Item {
         Some(self.cmp(o))
     }
 }
+
+/// [`Solve::flags`] bit: the half-edge is in the FIFO.
+const QUEUED: u8 = 1;
+/// [`Solve::flags`] bit: the half-edge's window list is not empty.
+const FILLED: u8 = 2;
 
 const OUTSIDE: u8 = 0;
 const FRONT: u8 = 1;
@@ -446,12 +451,15 @@ pub(crate) struct Solve<'a> {
     emitted: Vec<f64>,
     emit_flag: Vec<bool>,
     lists: Vec<Vec<Window>>,
-    queued: Vec<bool>,
+    /// Per half-edge: [`QUEUED`] (in `fifo`) and [`FILLED`] (its list is not empty), one byte
+    /// so that the queue checks do not load the list headers.
+    flags: Vec<u8>,
     fifo: VecDeque<u32>,
     heap: BinaryHeap<Item>,
     pool: Vec<Vec<Window>>,
     pending_emit: Vec<u32>,
     tc_buf: Vec<f64>,
+    bound_stats: BoundStats,
     draining: bool,
     /// Pairwise trim and apex split enabled (off only in the differential tests' oracle mode,
     /// which keeps just the vertex filter).
@@ -477,12 +485,13 @@ impl<'a> Solve<'a> {
             emitted: vec![f64::NAN; n],
             emit_flag: g.pseudo.clone(),
             lists: (0..nh).map(|_| Vec::new()).collect(),
-            queued: vec![false; nh],
+            flags: vec![0; nh],
             fifo: VecDeque::new(),
             heap: BinaryHeap::new(),
             pool: Vec::new(),
             pending_emit: Vec::new(),
             tc_buf: Vec::new(),
+            bound_stats: BoundStats::default(),
             draining: false,
             prune: true,
             propagations: 0,
@@ -628,13 +637,15 @@ impl<'a> Solve<'a> {
             }
         }
         list.push(w);
-        if !self.queued[h as usize] {
+        let f = &mut self.flags[h as usize];
+        *f |= FILLED;
+        if *f & QUEUED == 0 {
             let g = self.g;
             if self.draining
                 || self.state[g.tail(h) as usize] == INSIDE
                 || self.state[g.head(h) as usize] == INSIDE
             {
-                self.queued[h as usize] = true;
+                self.flags[h as usize] |= QUEUED;
                 self.fifo.push_back(h);
             }
         }
@@ -675,8 +686,8 @@ impl<'a> Solve<'a> {
     }
 
     fn push_list(&mut self, h: u32) {
-        if !self.queued[h as usize] && !self.lists[h as usize].is_empty() {
-            self.queued[h as usize] = true;
+        if self.flags[h as usize] == FILLED {
+            self.flags[h as usize] = FILLED | QUEUED;
             self.fifo.push_back(h);
         }
     }
@@ -718,7 +729,11 @@ impl<'a> Solve<'a> {
                 continue;
             }
             if let Some(h) = self.fifo.pop_front() {
-                self.queued[h as usize] = false;
+                self.flags[h as usize] &= !QUEUED;
+                if let Some(&h2) = self.fifo.front() {
+                    // Touch the next list's frame early (its load is a cache miss).
+                    std::hint::black_box(self.g.geom[h2 as usize].l);
+                }
                 self.process(h);
                 continue;
             }
@@ -742,10 +757,10 @@ impl<'a> Solve<'a> {
             // Heap exhausted (or beyond the cut-off): drain every list still holding windows.
             self.draining = true;
             let mut any = false;
-            for h in 0..self.lists.len() as u32 {
-                if !self.lists[h as usize].is_empty() && !self.queued[h as usize] {
-                    self.queued[h as usize] = true;
-                    self.fifo.push_back(h);
+            for (h, f) in self.flags.iter_mut().enumerate() {
+                if *f == FILLED {
+                    *f = FILLED | QUEUED;
+                    self.fifo.push_back(h as u32);
                     any = true;
                 }
             }
@@ -769,6 +784,7 @@ impl<'a> Solve<'a> {
     /// The triangle step: filters the list of `h` and pushes its windows across face(h).
     fn process(&mut self, h: u32) {
         let mut ws = std::mem::take(&mut self.lists[h as usize]);
+        self.flags[h as usize] &= !FILLED;
         if ws.is_empty() {
             return;
         }
@@ -779,19 +795,18 @@ impl<'a> Solve<'a> {
         let l = geo.l;
         // P0: vertex filter.
         ws.retain(|w| {
-            !(da + w.b1 < w.dist(w.b1) * (1.0 - TAU)
-                || db + (l - w.b0) < w.dist(w.b0) * (1.0 - TAU))
+            !(vertex_beats(da + w.b1, w, w.b1) || vertex_beats(db + (l - w.b0), w, w.b0))
         });
         // P1: sorted lower-envelope trim (dead windows are skipped below, not removed).
         let mut alive = ws.len();
         if self.prune && ws.len() > 1 {
-            ws.sort_by(|x, y| x.b0.total_cmp(&y.b0));
+            sort_by_start(&mut ws);
             let mut cur = 0;
             let mut cur_s = ws[0].scale();
             for j in 1..ws.len() {
                 let (lo, hi) = ws.split_at_mut(j);
                 let s2 = hi[0].scale();
-                match pair_trim(&mut lo[cur], cur_s, &mut hi[0], s2) {
+                match pair_trim(&mut lo[cur], cur_s, &mut hi[0], s2, &mut self.bound_stats) {
                     Trim::FirstDead => {
                         (cur, cur_s) = (j, s2);
                         alive -= 1;
@@ -957,6 +972,39 @@ impl<'a> Solve<'a> {
         self.propagations += 1;
         let origin = Origin::Window(w.id);
         self.add_window(tw & IDX, child, origin);
+    }
+}
+
+/// The vertex filter's test `p < D(x) (1 - TAU)` (a vertex path of length `p` beats the window
+/// at `x`), with the same result as evaluating it directly but usually without the square
+/// root: when `p / (1 - TAU) - sigma` exceeds `|S - x|` by more than `1e-13 p` (checked by
+/// squaring, far above the few ulps of rounding in either evaluation), the test is false.
+#[inline]
+fn vertex_beats(p: f64, w: &Window, x: f64) -> bool {
+    const K: f64 = 1.0 / (1.0 - TAU);
+    let dx = x - w.sx;
+    let a = dx * dx + w.sy * w.sy;
+    let t = p * K - w.sigma - 1e-13 * p;
+    if t > 0.0 && t * t > a {
+        return false;
+    }
+    p < w.dist(x) * (1.0 - TAU)
+}
+
+/// Stable sort of a window list by start (`total_cmp`): insertion sort for the short lists of
+/// a solve (same order as `sort_by`, which is stable too), `sort_by` for long ones.
+#[inline]
+fn sort_by_start(ws: &mut [Window]) {
+    if ws.len() > 24 {
+        ws.sort_by(|x, y| x.b0.total_cmp(&y.b0));
+        return;
+    }
+    for i in 1..ws.len() {
+        let mut j = i;
+        while j > 0 && ws[j - 1].b0.total_cmp(&ws[j].b0) == Ordering::Greater {
+            ws.swap(j - 1, j);
+            j -= 1;
+        }
     }
 }
 

@@ -63,6 +63,25 @@ impl Window {
     }
 }
 
+/// Success counters of [`pair_trim`]'s bounding shortcut, which only pays off when it often
+/// decides (about 30 % of the overlapping pairs on a paper-set face, 0.4 % on an icosphere):
+/// while it decides less than 1 pair in 8 it is only tried on 1 call in 32. This changes only
+/// the speed, never a result (the shortcut's outcome equals the exact path's).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct BoundStats {
+    calls: u32,
+    tries: u32,
+    hits: u32,
+}
+
+impl BoundStats {
+    #[inline]
+    fn enabled(&mut self) -> bool {
+        self.calls = self.calls.wrapping_add(1);
+        self.hits.saturating_mul(8) >= self.tries || self.calls % 32 == 0
+    }
+}
+
 /// Outcome of [`pair_trim`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Trim {
@@ -130,8 +149,15 @@ fn equal_distance_roots(w1: &Window, w2: &Window, scale: f64, out: &mut [f64; 2]
 /// A part of a window is removed only when the other window is strictly shorter there (by more
 /// than [`TAU`] relative); windows are never split in the middle. Identical distance functions
 /// whose intervals overlap or touch are merged into `w1`. `s1` and `s2` are the windows'
-/// [`Window::scale`] (computed once per window by the caller: trimming does not change them).
-pub(crate) fn pair_trim(w1: &mut Window, s1: f64, w2: &mut Window, s2: f64) -> Trim {
+/// [`Window::scale`] (computed once per window by the caller: trimming does not change them);
+/// `bs` steers the bounding shortcut (speed only).
+pub(crate) fn pair_trim(
+    w1: &mut Window,
+    s1: f64,
+    w2: &mut Window,
+    s2: f64,
+    bs: &mut BoundStats,
+) -> Trim {
     let l = w1.b0.max(w2.b0);
     let r = w1.b1.min(w2.b1);
     if r < l {
@@ -156,8 +182,12 @@ pub(crate) fn pair_trim(w1: &mut Window, s1: f64, w2: &mut Window, s2: f64) -> T
     // Bounding check: when one window's minimum over the overlap exceeds the other's maximum
     // by a margin, every midpoint test below would say that it loses the whole overlap; the
     // outcome is then fixed (same result as the exact path, without roots or midpoints).
-    if let Some(out) = dominated_on_overlap(w1, w2, l, r) {
-        return out;
+    if bs.enabled() {
+        bs.tries = bs.tries.saturating_add(1);
+        if let Some(out) = dominated_on_overlap(w1, w2, l, r) {
+            bs.hits = bs.hits.saturating_add(1);
+            return out;
+        }
     }
     exact_trim(w1, w2, s1.max(s2), l, r)
 }
@@ -312,14 +342,20 @@ mod tests {
 
     fn trim(a: &mut Window, b: &mut Window) -> Trim {
         let (sa, sb) = (a.scale(), b.scale());
-        pair_trim(a, sa, b, sb)
+        pair_trim(a, sa, b, sb, &mut BoundStats::default())
     }
 
     /// After a trim, every point of the original union is still served (within tolerance) by
     /// a surviving window at no more than the original lower envelope.
     fn check_sound(a: Window, b: Window, rng: &mut ChaCha8Rng) {
         let (mut x, mut y) = (a, b);
-        let out = pair_trim(&mut x, a.scale(), &mut y, b.scale());
+        let out = pair_trim(
+            &mut x,
+            a.scale(),
+            &mut y,
+            b.scale(),
+            &mut BoundStats::default(),
+        );
         match out {
             Trim::FirstDead => assert!(x.is_dead()),
             Trim::SecondDead => assert!(y.is_dead()),
