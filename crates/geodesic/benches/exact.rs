@@ -1,6 +1,8 @@
 #![allow(missing_docs)] // criterion_group! generates an undocumented function
 //! Criterion benches of the exact geodesic solver: setup and one solve on the level-5
-//! icosphere (10,242 vertices) and on a paper-set face (skipped when the data is absent).
+//! icosphere (10,242 vertices), one solve on the level-6 icosphere (40,962 vertices), and
+//! solves on a paper-set face (skipped when the data is absent), among them the two fields of
+//! `bipolar describe` (vertex 1507, uncut and cut at 11.8 cm).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use geodesic::{ExactGeodesic, GeodesicSolver, SolveOptions, Source, TriMesh};
@@ -49,6 +51,13 @@ fn bench(c: &mut Criterion) {
                 .unwrap()
         })
     });
+    let ico6 = ExactGeodesic::new(&icosphere(6)).unwrap();
+    g.bench_function("solve/ico6", |b| {
+        b.iter(|| {
+            ico6.distances(&[Source::Vertex(black_box(0))], &SolveOptions::default())
+                .unwrap()
+        })
+    });
     let shared = std::env::var("BIPOLAR_SHARED")
         .map(PathBuf::from)
         .unwrap_or_else(|_| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"));
@@ -60,6 +69,23 @@ fn bench(c: &mut Criterion) {
                 b.iter(|| {
                     s.distances(&[Source::Vertex(black_box(3000))], &SolveOptions::default())
                         .unwrap()
+                })
+            });
+            g.bench_function("solve_v1507/face_id1_neutral", |b| {
+                b.iter(|| {
+                    s.distances(&[Source::Vertex(black_box(1507))], &SolveOptions::default())
+                        .unwrap()
+                })
+            });
+            g.bench_function("solve_v1507_cutoff_11.8cm/face_id1_neutral", |b| {
+                b.iter(|| {
+                    s.distances(
+                        &[Source::Vertex(black_box(1507))],
+                        &SolveOptions {
+                            max_distance: Some(11.8),
+                        },
+                    )
+                    .unwrap()
                 })
             });
             g.bench_function("solve_cutoff_5cm/face_id1_neutral", |b| {
