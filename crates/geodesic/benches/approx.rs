@@ -8,67 +8,8 @@
 use criterion::{criterion_main, Criterion};
 use geodesic::{Dijkstra, FastMarching, GeodesicSolver, HeatMethod, SolveOptions, Source, TriMesh};
 use glam::DVec3;
-use std::collections::HashMap;
+use meshcore::shapes::icosphere;
 use std::path::PathBuf;
-
-fn icosphere(level: usize) -> TriMesh {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut v: Vec<DVec3> = [
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ]
-    .iter()
-    .map(|a| DVec3::from_array(*a).normalize())
-    .collect();
-    let mut f: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..level {
-        let mut mid = HashMap::new();
-        let mut nf = Vec::with_capacity(f.len() * 4);
-        for [a, b, c] in f {
-            let mut m = |x: u32, y: u32| -> u32 {
-                *mid.entry((x.min(y), x.max(y))).or_insert_with(|| {
-                    v.push((v[x as usize] + v[y as usize]).normalize());
-                    (v.len() - 1) as u32
-                })
-            };
-            let (ab, bc, ca) = (m(a, b), m(b, c), m(c, a));
-            nf.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        f = nf;
-    }
-    TriMesh::new(v, f).unwrap()
-}
 
 /// Minimal OBJ reader (`v` and `f` lines, polygons fan-split) so the bench does not depend on
 /// another crate.

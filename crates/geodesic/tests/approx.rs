@@ -7,7 +7,7 @@ use geodesic::{
     HeatMethod, Method, SolveOptions, Source, SurfacePoint, TriMesh,
 };
 use glam::{DAffine3, DQuat, DVec3};
-use meshcore::shapes::{icosphere, uv_sphere};
+use meshcore::shapes::{cylinder, icosphere, uv_sphere};
 use proptest::prelude::*;
 use std::f64::consts::PI;
 
@@ -42,30 +42,6 @@ fn grid(nx: usize, ny: usize, sx: f64, sy: f64, alternate: bool) -> TriMesh {
         }
     }
     TriMesh::new(p, t).unwrap()
-}
-
-/// Open cylinder of radius `r` and height `h` (`na` segments around, `nh` rows).
-fn cylinder(r: f64, h: f64, na: usize, nh: usize) -> TriMesh {
-    let mut v = Vec::new();
-    for j in 0..=nh {
-        for i in 0..na {
-            let a = 2.0 * PI * i as f64 / na as f64;
-            v.push(DVec3::new(
-                r * a.cos(),
-                r * a.sin(),
-                h * j as f64 / nh as f64,
-            ));
-        }
-    }
-    let idx = |i: usize, j: usize| (j * na + i % na) as u32;
-    let mut f = Vec::new();
-    for j in 0..nh {
-        for i in 0..na {
-            f.push([idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)]);
-            f.push([idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)]);
-        }
-    }
-    TriMesh::new(v, f).unwrap()
 }
 
 fn great_circle(mesh: &TriMesh, src: u32) -> Vec<f64> {

@@ -5,108 +5,8 @@
 
 use geodesic::{FastMarching, FmmUpdate, GeodesicSolver, SolveOptions, Source, TriMesh};
 use glam::DVec3;
+use meshcore::shapes::{icosphere, uv_sphere};
 use std::f64::consts::PI;
-
-fn icosphere(level: usize) -> TriMesh {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut v: Vec<DVec3> = [
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ]
-    .iter()
-    .map(|a| DVec3::from_array(*a).normalize())
-    .collect();
-    let mut f: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..level {
-        let mut mid = std::collections::HashMap::new();
-        let mut nf = Vec::with_capacity(f.len() * 4);
-        let mut m = |a: u32, b: u32, v: &mut Vec<DVec3>| -> u32 {
-            *mid.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                v.push((v[a as usize] + v[b as usize]).normalize());
-                (v.len() - 1) as u32
-            })
-        };
-        for [a, b, c] in f {
-            let ab = m(a, b, &mut v);
-            let bc = m(b, c, &mut v);
-            let ca = m(c, a, &mut v);
-            nf.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        f = nf;
-    }
-    TriMesh::new(v, f).unwrap()
-}
-
-/// UV sphere as `make_meshes.py` builds `uv10k` (north pole, `rings - 1` rings of `seg`
-/// vertices, south pole).
-fn uv_sphere(rings: usize, seg: usize) -> TriMesh {
-    let mut v = vec![DVec3::Z];
-    for i in 1..rings {
-        let th = PI * i as f64 / rings as f64;
-        for j in 0..seg {
-            let ph = 2.0 * PI * j as f64 / seg as f64;
-            v.push(DVec3::new(
-                th.sin() * ph.cos(),
-                th.sin() * ph.sin(),
-                th.cos(),
-            ));
-        }
-    }
-    v.push(-DVec3::Z);
-    let south = (v.len() - 1) as u32;
-    let ring = |i: usize, j: usize| (1 + (i - 1) * seg + j % seg) as u32;
-    let mut f = Vec::new();
-    for j in 0..seg {
-        f.push([0, ring(1, j), ring(1, j + 1)]);
-    }
-    for i in 1..rings - 1 {
-        for j in 0..seg {
-            let (p, q, r, s) = (
-                ring(i, j),
-                ring(i, j + 1),
-                ring(i + 1, j),
-                ring(i + 1, j + 1),
-            );
-            f.push([p, r, s]);
-            f.push([p, s, q]);
-        }
-    }
-    for j in 0..seg {
-        f.push([south, ring(rings - 1, j + 1), ring(rings - 1, j)]);
-    }
-    TriMesh::new(v, f).unwrap()
-}
 
 fn solve(mesh: &TriMesh, rule: FmmUpdate, src: &[Source]) -> Vec<f64> {
     FastMarching::with_update(mesh, rule)
@@ -217,26 +117,7 @@ fn cylinder_unrolled_is_nearly_exact() {
     // plane. The polygonal cylinder is shorter around than the round one; compare with the
     // unrolled polygon (chord length per segment).
     let (na, nh, r, h) = (64usize, 48usize, 1.0, 3.0);
-    let mut v = Vec::new();
-    for j in 0..=nh {
-        for i in 0..na {
-            let a = 2.0 * PI * i as f64 / na as f64;
-            v.push(DVec3::new(
-                r * a.cos(),
-                r * a.sin(),
-                h * j as f64 / nh as f64,
-            ));
-        }
-    }
-    let idx = |i: usize, j: usize| (j * na + i % na) as u32;
-    let mut f = Vec::new();
-    for j in 0..nh {
-        for i in 0..na {
-            f.push([idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)]);
-            f.push([idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)]);
-        }
-    }
-    let m = TriMesh::new(v, f).unwrap();
+    let m = meshcore::shapes::cylinder(r, h, na, nh);
     let chord = 2.0 * r * (PI / na as f64).sin();
     let d = solve(&m, FmmUpdate::CurvedFront, &[Source::Vertex(0)]);
     let mut worst: f64 = 0.0;
@@ -245,7 +126,8 @@ fn cylinder_unrolled_is_nearly_exact() {
             // Unrolled position: min(i, na - i) chords around, z up.
             let k = i.min(na - i) as f64;
             let exact = ((k * chord).powi(2) + (h * j as f64 / nh as f64).powi(2)).sqrt();
-            worst = worst.max((d[idx(i, j) as usize] - exact).abs());
+            // Vertex (i, j) of the generated cylinder is j * na + i.
+            worst = worst.max((d[j * na + i] - exact).abs());
         }
     }
     assert!(worst < 1e-9, "max error {worst}");

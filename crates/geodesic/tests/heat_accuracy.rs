@@ -17,74 +17,15 @@ use faer::sparse::{SparseColMat, Triplet};
 use faer::Side;
 use geodesic::{GeodesicSolver, HeatMethod, SolveOptions, Source, SurfacePoint, TriMesh};
 use glam::DVec3;
+use meshcore::shapes::icosphere;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::collections::HashMap;
 
-/// Unit icosphere with `level` midpoint subdivisions (vertices on the sphere).
-fn icosphere(level: usize) -> TriMesh {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut v: Vec<DVec3> = [
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ]
-    .iter()
-    .map(|a| DVec3::from_array(*a).normalize())
-    .collect();
-    let mut f: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..level {
-        let mut mid = HashMap::new();
-        let mut nf = Vec::with_capacity(f.len() * 4);
-        for [a, b, c] in f {
-            let mut m = |x: u32, y: u32| -> u32 {
-                *mid.entry((x.min(y), x.max(y))).or_insert_with(|| {
-                    v.push((v[x as usize] + v[y as usize]).normalize());
-                    (v.len() - 1) as u32
-                })
-            };
-            let (ab, bc, ca) = (m(a, b), m(b, c), m(c, a));
-            nf.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        f = nf;
-    }
-    TriMesh::new(v, f).unwrap()
-}
-
 /// Icosphere with every vertex moved tangentially by up to `amount` mean edge lengths
 /// (seeded) and re-projected onto the unit sphere.
 fn jittered_icosphere(level: usize, amount: f64, seed: u64) -> TriMesh {
-    let m = icosphere(level);
+    let m = icosphere(level as u32);
     let h = m.mean_edge_length();
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let p = m
@@ -389,7 +330,7 @@ fn icosphere_errors_against_the_sphere_stay_at_their_measured_level() {
         (4, 0, 0.03008, 0.01363),
         (4, 1000, 0.03273, 0.01399),
     ] {
-        let m = icosphere(level as usize);
+        let m = icosphere(level);
         let d = solve(&m, &[Source::Vertex(src)]);
         let (mx, mean) = diff(&d, &sphere_distance(&m, src));
         println!("ico{level} source {src}: max error {mx:.4e}, mean {mean:.4e}");

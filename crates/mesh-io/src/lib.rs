@@ -279,7 +279,12 @@ fn weld_map(p: &[DVec3], tol: f64) -> Vec<u32> {
             .iter()
             .enumerate()
             // +0.0 and -0.0 are the same point.
-            .map(|(i, q)| ([q.x + 0.0, q.y + 0.0, q.z + 0.0].map(f64::to_bits), i as u32))
+            .map(|(i, q)| {
+                (
+                    [q.x + 0.0, q.y + 0.0, q.z + 0.0].map(f64::to_bits),
+                    i as u32,
+                )
+            })
             .collect();
         keyed.sort_unstable();
         let mut start = 0;

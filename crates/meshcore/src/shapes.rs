@@ -190,6 +190,32 @@ pub fn uv_sphere(n_lat: usize, n_lon: usize) -> TriMesh {
     TriMesh::new(pos, tris).expect("uv sphere is valid")
 }
 
+/// Open cylinder of radius `r` and height `h` about the z axis (`na` segments around, `nh`
+/// rows of squares split along one diagonal), outward normals, bottom ring at z = 0.
+pub fn cylinder(r: f64, h: f64, na: usize, nh: usize) -> TriMesh {
+    let (na, nh) = (na.max(3), nh.max(1));
+    let mut v = Vec::with_capacity(na * (nh + 1));
+    for j in 0..=nh {
+        for i in 0..na {
+            let a = std::f64::consts::TAU * i as f64 / na as f64;
+            v.push(DVec3::new(
+                r * a.cos(),
+                r * a.sin(),
+                h * j as f64 / nh as f64,
+            ));
+        }
+    }
+    let idx = |i: usize, j: usize| (j * na + i % na) as u32;
+    let mut f = Vec::with_capacity(2 * na * nh);
+    for j in 0..nh {
+        for i in 0..na {
+            f.push([idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)]);
+            f.push([idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)]);
+        }
+    }
+    TriMesh::new(v, f).expect("a generated cylinder is a valid mesh")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -220,6 +246,26 @@ mod tests {
                 assert!(n.dot(a + b + c) > 0.0, "face {f} points inwards");
             }
         }
+    }
+
+    #[test]
+    fn cylinder_is_open_with_outward_normals() {
+        let m = cylinder(1.5, 2.0, 12, 3);
+        assert_eq!(m.n_vertices(), 12 * 4);
+        let t = Topology::new(&m);
+        assert_eq!(t.boundary_loops.len(), 2);
+        for f in 0..m.n_faces() as u32 {
+            let [a, b, c] = m.triangles()[f as usize].map(|v| m.position(v));
+            let radial = (a + b + c) * DVec3::new(1.0, 1.0, 0.0);
+            assert!(
+                (b - a).cross(c - a).dot(radial) > 0.0,
+                "face {f} points inwards"
+            );
+        }
+        assert!(m
+            .positions()
+            .iter()
+            .all(|p| ((p.x * p.x + p.y * p.y).sqrt() - 1.5).abs() < 1e-12));
     }
 
     #[test]
