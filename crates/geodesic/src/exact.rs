@@ -730,10 +730,6 @@ impl<'a> Solve<'a> {
             }
             if let Some(h) = self.fifo.pop_front() {
                 self.flags[h as usize] &= !QUEUED;
-                if let Some(&h2) = self.fifo.front() {
-                    // Touch the next list's frame early (its load is a cache miss).
-                    std::hint::black_box(self.g.geom[h2 as usize].l);
-                }
                 self.process(h);
                 continue;
             }
