@@ -560,6 +560,27 @@ fn finite(v: &[f64]) -> Vec<f64> {
     v.iter().copied().filter(|x| x.is_finite()).collect()
 }
 /// Mean of the finite values (NaN if none).
+/// One line of figures 9 and 17: over the perturbation grid `(radius %, direction, distance)`,
+/// the distances at each radius reduced by `agg` (mean or max over the directions).
+fn radius_series(
+    label: &str,
+    grid: &[(f64, f64, f64)],
+    agg: fn(&[f64]) -> f64,
+    dashed: bool,
+) -> Series {
+    Series {
+        label: label.into(),
+        points: RADII_PCT
+            .iter()
+            .map(|&p| {
+                let at: Vec<f64> = grid.iter().filter(|g| g.0 == p).map(|g| g.2).collect();
+                (p, agg(&at))
+            })
+            .collect(),
+        dashed,
+    }
+}
+
 fn mean(v: &[f64]) -> f64 {
     let f = finite(v);
     if f.is_empty() {
@@ -924,43 +945,8 @@ fn write_report(
             &series,
         )?;
         let by_r = vec![
-            Series {
-                label: "mean over directions".into(),
-                points: RADII_PCT
-                    .iter()
-                    .map(|&p| {
-                        (
-                            p,
-                            mean(
-                                &res.grid_bip
-                                    .iter()
-                                    .filter(|g| g.0 == p)
-                                    .map(|g| g.2)
-                                    .collect::<Vec<_>>(),
-                            ),
-                        )
-                    })
-                    .collect(),
-                dashed: false,
-            },
-            Series {
-                label: "max over directions".into(),
-                points: RADII_PCT
-                    .iter()
-                    .map(|&p| {
-                        (
-                            p,
-                            max(&res
-                                .grid_bip
-                                .iter()
-                                .filter(|g| g.0 == p)
-                                .map(|g| g.2)
-                                .collect::<Vec<_>>()),
-                        )
-                    })
-                    .collect(),
-                dashed: true,
-            },
+            radius_series("mean over directions", &res.grid_bip, mean, false),
+            radius_series("max over directions", &res.grid_bip, max, true),
         ];
         let f9 = format!("fig9_radius_{}.svg", res.name);
         line_plot(
@@ -1165,80 +1151,10 @@ fn write_report(
     let mut rows = Vec::new();
     for res in results {
         let series = vec![
-            Series {
-                label: "bipolar (q moved), mean".into(),
-                points: RADII_PCT
-                    .iter()
-                    .map(|&p| {
-                        (
-                            p,
-                            mean(
-                                &res.grid_bip
-                                    .iter()
-                                    .filter(|g| g.0 == p)
-                                    .map(|g| g.2)
-                                    .collect::<Vec<_>>(),
-                            ),
-                        )
-                    })
-                    .collect(),
-                dashed: false,
-            },
-            Series {
-                label: "single pole (nose moved), mean".into(),
-                points: RADII_PCT
-                    .iter()
-                    .map(|&p| {
-                        (
-                            p,
-                            mean(
-                                &res.grid_pol
-                                    .iter()
-                                    .filter(|g| g.0 == p)
-                                    .map(|g| g.2)
-                                    .collect::<Vec<_>>(),
-                            ),
-                        )
-                    })
-                    .collect(),
-                dashed: false,
-            },
-            Series {
-                label: "bipolar, max".into(),
-                points: RADII_PCT
-                    .iter()
-                    .map(|&p| {
-                        (
-                            p,
-                            max(&res
-                                .grid_bip
-                                .iter()
-                                .filter(|g| g.0 == p)
-                                .map(|g| g.2)
-                                .collect::<Vec<_>>()),
-                        )
-                    })
-                    .collect(),
-                dashed: true,
-            },
-            Series {
-                label: "single pole, max".into(),
-                points: RADII_PCT
-                    .iter()
-                    .map(|&p| {
-                        (
-                            p,
-                            max(&res
-                                .grid_pol
-                                .iter()
-                                .filter(|g| g.0 == p)
-                                .map(|g| g.2)
-                                .collect::<Vec<_>>()),
-                        )
-                    })
-                    .collect(),
-                dashed: true,
-            },
+            radius_series("bipolar (q moved), mean", &res.grid_bip, mean, false),
+            radius_series("single pole (nose moved), mean", &res.grid_pol, mean, false),
+            radius_series("bipolar, max", &res.grid_bip, max, true),
+            radius_series("single pole, max", &res.grid_pol, max, true),
         ];
         let f = format!("fig17_pole_vs_bipolar_{}.svg", res.name);
         line_plot(
