@@ -20,30 +20,8 @@ fn shared_dir() -> PathBuf {
 
 /// A UV sphere of radius 5 (model units, about a face's size) with `n` latitude bands.
 fn uv_sphere(n: usize) -> TriMesh {
-    let m = 2 * n;
-    let mut pos = vec![DVec3::new(0.0, 0.0, 5.0)];
-    for i in 1..n {
-        let th = std::f64::consts::PI * i as f64 / n as f64;
-        for j in 0..m {
-            let ph = std::f64::consts::TAU * j as f64 / m as f64;
-            pos.push(5.0 * DVec3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()));
-        }
-    }
-    pos.push(DVec3::new(0.0, 0.0, -5.0));
-    let last = (pos.len() - 1) as u32;
-    let ring = |i: usize, j: usize| (1 + (i - 1) * m + j % m) as u32;
-    let mut tri = Vec::new();
-    for j in 0..m {
-        tri.push([0, ring(1, j), ring(1, j + 1)]);
-        tri.push([last, ring(n - 1, j + 1), ring(n - 1, j)]);
-    }
-    for i in 1..n - 1 {
-        for j in 0..m {
-            tri.push([ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)]);
-            tri.push([ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)]);
-        }
-    }
-    TriMesh::new(pos, tri).expect("valid sphere")
+    meshcore::shapes::uv_sphere(n, 2 * n)
+        .transformed(&meshcore::DAffine3::from_scale(DVec3::splat(5.0)))
 }
 
 fn bench(c: &mut Criterion) {

@@ -165,31 +165,10 @@ fn face_seen_from_behind_is_not_found() {
     }
 }
 
-/// Icosphere-like UV sphere.
+/// UV sphere of radius `r` (the shared generator, scaled).
 fn sphere(r: f64, n_lat: usize, n_lon: usize) -> TriMesh {
-    let mut p = vec![DVec3::new(0.0, 0.0, r)];
-    for i in 1..n_lat {
-        let th = std::f64::consts::PI * i as f64 / n_lat as f64;
-        for j in 0..n_lon {
-            let ph = std::f64::consts::TAU * j as f64 / n_lon as f64;
-            p.push(r * DVec3::new(th.sin() * ph.cos(), th.sin() * ph.sin(), th.cos()));
-        }
-    }
-    p.push(DVec3::new(0.0, 0.0, -r));
-    let s = p.len() as u32 - 1;
-    let idx = |i: usize, j: usize| (1 + (i - 1) * n_lon + j % n_lon) as u32;
-    let mut t = Vec::new();
-    for j in 0..n_lon {
-        t.push([0, idx(1, j), idx(1, j + 1)]);
-        t.push([s, idx(n_lat - 1, j + 1), idx(n_lat - 1, j)]);
-    }
-    for i in 1..n_lat - 1 {
-        for j in 0..n_lon {
-            t.push([idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)]);
-            t.push([idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)]);
-        }
-    }
-    TriMesh::new(p, t).unwrap()
+    meshcore::shapes::uv_sphere(n_lat, n_lon)
+        .transformed(&meshcore::DAffine3::from_scale(DVec3::splat(r)))
 }
 
 /// A bumpy height field (Gaussian bumps and dimples), not a face.
