@@ -22,7 +22,7 @@ use bipolar::{
 use glam::DVec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use meshcore::{FaceLocator, Topology, TriMesh};
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -65,9 +65,9 @@ fn meshes() -> anyhow::Result<Vec<SphereMesh>> {
 }
 
 /// Analytic representation: key -> (position, cos).
-fn analytic(rule: SelectionRule, n: u32, max_level: u32) -> HashMap<Key, (DVec3, f64)> {
+fn analytic(rule: SelectionRule, n: u32, max_level: u32) -> BTreeMap<Key, (DVec3, f64)> {
     let step = std::f64::consts::FRAC_PI_2 / n as f64;
-    let mut out = HashMap::new();
+    let mut out = BTreeMap::new();
     let side_of = |p: DVec3| -> i8 {
         // Away-from-r direction: -(r - (r.p) p); away from q likewise.
         let ar = -(DVec3::Z - p.z * p);
@@ -174,7 +174,7 @@ struct Row {
     ms: f64,
 }
 
-fn compare(d: &Descriptor, truth: &HashMap<Key, (DVec3, f64)>) -> (usize, f64, f64, f64, f64) {
+fn compare(d: &Descriptor, truth: &BTreeMap<Key, (DVec3, f64)>) -> (usize, f64, f64, f64, f64) {
     let mut a = Vec::new();
     let mut b = Vec::new();
     let mut pos = 0.0;
@@ -356,105 +356,75 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     std::fs::write(out_dir.join("results.csv"), &csv)?;
 
-    // Plots.
+    // Plots: one line per tangent method over the rows a filter selects.
     let mut plots = Vec::new();
+    let mut plot = |file: String,
+                    title: String,
+                    x_label: &str,
+                    y_label: &str,
+                    keep: &dyn Fn(&Row) -> bool,
+                    xy: fn(&Row) -> (f64, f64)|
+     -> anyhow::Result<()> {
+        let series = methods
+            .iter()
+            .map(|&m| viz::Series {
+                name: method_name(m).to_string(),
+                points: rows
+                    .iter()
+                    .filter(|r| keep(r) && r.method == method_name(m))
+                    .map(xy)
+                    .collect(),
+            })
+            .collect();
+        viz::line_plot(
+            out_dir.join(&file),
+            &viz::PlotSpec {
+                title,
+                x_label: x_label.into(),
+                y_label: y_label.into(),
+                series,
+                log_y: true,
+                ..viz::PlotSpec::default()
+            },
+        )?;
+        plots.push(file);
+        Ok(())
+    };
     for rule in ["isoangle", "filter"] {
         for sm in [&meshes[1], &meshes[4]] {
-            let series = methods
-                .iter()
-                .map(|&m| viz::Series {
-                    name: method_name(m).to_string(),
-                    points: rows
-                        .iter()
-                        .filter(|r| {
-                            r.mesh == sm.name && r.rule == rule && r.method == method_name(m)
-                        })
-                        .map(|r| (r.levels as f64, r.distance))
-                        .collect(),
-                })
-                .collect();
-            let file = format!(
-                "distance_vs_levels_{rule}_{}.svg",
-                sm.name.split(' ').next().unwrap_or("mesh")
-            );
-            viz::line_plot(
-                out_dir.join(&file),
-                &viz::PlotSpec {
-                    title: format!(
-                        "Shape distance to the analytic representation ({rule}, {})",
-                        sm.name
-                    ),
-                    x_label: "levels N between the poles".into(),
-                    y_label: "normalised shape distance".into(),
-                    series,
-                    log_y: true,
-                    ..viz::PlotSpec::default()
-                },
+            plot(
+                format!(
+                    "distance_vs_levels_{rule}_{}.svg",
+                    sm.name.split(' ').next().unwrap_or("mesh")
+                ),
+                format!(
+                    "Shape distance to the analytic representation ({rule}, {})",
+                    sm.name
+                ),
+                "levels N between the poles",
+                "normalised shape distance",
+                &|r| r.mesh == sm.name && r.rule == rule,
+                |r| (r.levels as f64, r.distance),
             )?;
-            plots.push(file);
         }
     }
-    {
-        // Distance vs mesh resolution (icospheres), N = 8, iso-angle rule.
-        let series = methods
-            .iter()
-            .map(|&m| viz::Series {
-                name: method_name(m).to_string(),
-                points: rows
-                    .iter()
-                    .filter(|r| {
-                        r.mesh.starts_with("ico")
-                            && r.levels == 8
-                            && r.rule == "isoangle"
-                            && r.method == method_name(m)
-                    })
-                    .map(|r| (r.mean_edge, r.distance))
-                    .collect(),
-            })
-            .collect();
-        let file = "distance_vs_edge_isoangle_N8.svg".to_string();
-        viz::line_plot(
-            out_dir.join(&file),
-            &viz::PlotSpec {
-                title: "Shape distance vs mesh resolution (icospheres, N = 8, iso-angle)".into(),
-                x_label: "mean edge length".into(),
-                y_label: "normalised shape distance".into(),
-                series,
-                log_y: true,
-                ..viz::PlotSpec::default()
-            },
-        )?;
-        plots.push(file);
-        let series = methods
-            .iter()
-            .map(|&m| viz::Series {
-                name: method_name(m).to_string(),
-                points: rows
-                    .iter()
-                    .filter(|r| {
-                        r.mesh.starts_with("ico")
-                            && r.levels == 8
-                            && r.rule == "all"
-                            && r.method == method_name(m)
-                    })
-                    .map(|r| (r.mean_edge, r.cos_err))
-                    .collect(),
-            })
-            .collect();
-        let file = "cos_error_vs_edge_grid_N8.svg".to_string();
-        viz::line_plot(
-            out_dir.join(&file),
-            &viz::PlotSpec {
-                title: "Mean |cos| error at grid intersections vs mesh resolution (N = 8)".into(),
-                x_label: "mean edge length".into(),
-                y_label: "mean cos error".into(),
-                series,
-                log_y: true,
-                ..viz::PlotSpec::default()
-            },
-        )?;
-        plots.push(file);
-    }
+    // Against mesh resolution (icospheres), N = 8.
+    plot(
+        "distance_vs_edge_isoangle_N8.svg".into(),
+        "Shape distance vs mesh resolution (icospheres, N = 8, iso-angle)".into(),
+        "mean edge length",
+        "normalised shape distance",
+        &|r| r.mesh.starts_with("ico") && r.levels == 8 && r.rule == "isoangle",
+        |r| (r.mean_edge, r.distance),
+    )?;
+    plot(
+        "cos_error_vs_edge_grid_N8.svg".into(),
+        "Mean |cos| error at grid intersections vs mesh resolution (N = 8)".into(),
+        "mean edge length",
+        "mean cos error",
+        &|r| r.mesh.starts_with("ico") && r.levels == 8 && r.rule == "all",
+        |r| (r.mean_edge, r.cos_err),
+    )?;
 
     // Renders: level curves and points on ico4, N = 8, iso-angle, each method.
     let mut renders = Vec::new();
