@@ -273,7 +273,27 @@ fn visit(
 }
 
 /// Parses a `.gltf` or `.glb` file; `base` resolves external buffer files.
+///
+/// The `gltf` crate (1.4) can panic while validating some malformed files (it indexes the
+/// accessor list with an index it has not checked yet); that panic is caught here and turned
+/// into an error, so a corrupt file never takes the caller down.
 pub(crate) fn read_gltf(
+    bytes: &[u8],
+    file: &str,
+    base: Option<&Path>,
+) -> Result<LoadedMesh, IoError> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        read_gltf_unguarded(bytes, file, base)
+    }))
+    .unwrap_or_else(|_| {
+        Err(IoError::whole(
+            file,
+            "invalid glTF: the file is malformed (the gltf crate's validation failed on it)",
+        ))
+    })
+}
+
+fn read_gltf_unguarded(
     bytes: &[u8],
     file: &str,
     base: Option<&Path>,

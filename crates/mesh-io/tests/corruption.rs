@@ -137,3 +137,13 @@ fn binary_truncations_are_errors() {
         }
     }
 }
+
+/// A glTF whose POSITION names an accessor that does not exist made the gltf crate's
+/// validation panic (index out of bounds), found by the proptest above; now a clear error.
+#[test]
+fn gltf_with_a_dangling_accessor_is_an_error_not_a_panic() {
+    let json =
+        br#"{"asset":{"version":"2.0"},"meshes":[{"primitives":[{"attributes":{"POSITION":5}}]}]}"#;
+    let err = read_mesh_from_bytes(json, Format::Gltf).unwrap_err();
+    assert!(err.to_string().contains("invalid glTF"), "{err}");
+}
