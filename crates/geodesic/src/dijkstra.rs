@@ -118,11 +118,7 @@ impl GeodesicSolver for Dijkstra {
         sources: &[Source],
         opts: &SolveOptions,
     ) -> Result<Vec<f64>, GeodesicError> {
-        let cut = match opts.max_distance {
-            Some(c) if c.is_nan() || c <= 0.0 => return Err(GeodesicError::InvalidCutoff(c)),
-            Some(c) => c,
-            None => f64::INFINITY,
-        };
+        let cut = opts.cutoff()?;
         let mut dist = vec![f64::INFINITY; self.positions.len()];
         let mut heap = BinaryHeap::new();
         for (v, d) in seeds(&self.positions, &self.triangles, sources)? {

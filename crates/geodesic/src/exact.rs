@@ -358,7 +358,7 @@ impl ExactGeodesic {
         sources: &[Source],
         opts: &SolveOptions,
     ) -> Result<(Vec<f64>, u64), GeodesicError> {
-        let cut = check_cutoff(opts)?;
+        let cut = opts.cutoff()?;
         let mut s = Solve::new(self, cut, false);
         s.seed(sources)?;
         s.run();
@@ -413,14 +413,6 @@ fn prev(h: u32) -> u32 {
         h + 2
     } else {
         h - 1
-    }
-}
-
-fn check_cutoff(opts: &SolveOptions) -> Result<f64, GeodesicError> {
-    match opts.max_distance {
-        Some(c) if c.is_nan() || c <= 0.0 => Err(GeodesicError::InvalidCutoff(c)),
-        Some(c) => Ok(c),
-        None => Ok(f64::INFINITY),
     }
 }
 

@@ -712,11 +712,7 @@ impl GeodesicSolver for FastMarching {
         sources: &[Source],
         opts: &SolveOptions,
     ) -> Result<Vec<f64>, GeodesicError> {
-        let cut = match opts.max_distance {
-            Some(c) if c.is_nan() || c <= 0.0 => return Err(GeodesicError::InvalidCutoff(c)),
-            Some(c) => c,
-            None => f64::INFINITY,
-        };
+        let cut = opts.cutoff()?;
         let (mut dist, _) = self.march(sources, cut)?;
         if cut.is_finite() {
             dist.iter_mut()

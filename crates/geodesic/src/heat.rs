@@ -366,11 +366,7 @@ impl GeodesicSolver for HeatMethod {
         sources: &[Source],
         opts: &SolveOptions,
     ) -> Result<Vec<f64>, GeodesicError> {
-        let cut = match opts.max_distance {
-            Some(c) if c.is_nan() || c <= 0.0 => return Err(GeodesicError::InvalidCutoff(c)),
-            Some(c) => c,
-            None => f64::INFINITY,
-        };
+        let cut = opts.cutoff()?;
         let n = self.positions.len();
         let weights = self.source_weights(sources)?;
         // 1. Heat flow (internal numbering). The right-hand side is zero before the smallest

@@ -45,6 +45,18 @@ pub struct SolveOptions {
     pub max_distance: Option<f64>,
 }
 
+impl SolveOptions {
+    /// The validated cut-off: `max_distance`, or `+inf` without one. A NaN or non-positive
+    /// cut-off is [`GeodesicError::InvalidCutoff`]. Every solver checks its options here.
+    pub fn cutoff(&self) -> Result<f64, GeodesicError> {
+        match self.max_distance {
+            Some(c) if c.is_nan() || c <= 0.0 => Err(GeodesicError::InvalidCutoff(c)),
+            Some(c) => Ok(c),
+            None => Ok(f64::INFINITY),
+        }
+    }
+}
+
 /// The available methods.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Method {

@@ -2,7 +2,7 @@
 //! distance) keeps every emitted window with its parent, and the path is unfolded backwards
 //! from the target through that chain of windows, pseudo-source vertices and edges.
 
-use super::{check_cutoff, classify_point, ExactGeodesic, Origin, Pred, Record, Seed, Solve, NONE};
+use super::{classify_point, ExactGeodesic, Origin, Pred, Record, Seed, Solve, NONE};
 use crate::{GeodesicError, SolveOptions, Source, SurfacePoint};
 use glam::DVec3;
 
@@ -34,7 +34,7 @@ impl ExactGeodesic {
             Seed::Degenerate { face, pos } => (face, [f64::NAN; 3], pos),
         };
         // Pass 1: vertex distances give an upper bound for the target.
-        let mut first = Solve::new(self, check_cutoff(&SolveOptions::default())?, false);
+        let mut first = Solve::new(self, SolveOptions::default().cutoff()?, false);
         first.seed(sources)?;
         first.run();
         let tri = self.tris[face as usize];
