@@ -109,7 +109,15 @@ fn main() {
     let only_plain = args.get(5).is_some_and(|s| s == "plain" || s == "once");
     // "once": one run of the plain row, no brute-force check (for profilers).
     let once = args.get(5).is_some_and(|s| s == "once");
-    let reps = if once { 1 } else { 5 };
+    // `REPS=N` in the environment: medians of N calls instead of 5 (noisy machines).
+    let reps = if once {
+        1
+    } else {
+        std::env::var("REPS")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(5)
+    };
     println!("| N | rot | set | method | ms (median of {reps}) | CPU ms (median) | iters | rot err (deg) | NN-RMSE | corr-RMSE |");
     println!("|---|---|---|---|---|---|---|---|---|---|");
     for deg in degs {
@@ -121,6 +129,18 @@ fn main() {
         let po = PrepareOptions::default();
         let a = PreparedSet::new(&tgt, &po, Which::A).unwrap();
         let b = PreparedSet::new(&src, &po, Which::B).unwrap();
+        // One-off preparation of the target (trees, subsample, neighbour graph), which the ICP
+        // rows below reuse (as a distance matrix does); Open3D builds its k-d tree inside each
+        // registration call, so compare it with the ICP row plus this one.
+        let (prep_ms, _) = median_ms(reps, || {
+            let p = PreparedSet::new(&tgt, &po, Which::A).unwrap();
+            p.graph().len()
+        });
+        let (graph_ms, _) = median_ms(reps, || nn::NeighbourGraph::new(a.point_tree()).len());
+        a.graph();
+        println!(
+            "<!-- prepare target: {prep_ms:.2} ms, of which neighbour graph {graph_ms:.2} ms -->"
+        );
         let row = |name: &str, ms: f64, iters: String, r: DMat3| {
             if once {
                 println!("{name}: {ms:.2} ms, {iters} iterations");
@@ -171,6 +191,12 @@ fn main() {
             ms,
             res.iterations.to_string(),
             res.rotation,
+        );
+        println!(
+            "<!-- tree queries: {} of {} pair searches ({:.1} %) -->",
+            res.tree_queries,
+            res.pair_searches,
+            100.0 * res.tree_queries as f64 / res.pair_searches.max(1) as f64
         );
         if only_plain {
             continue;

@@ -22,7 +22,7 @@ use serde::Serialize;
 
 use crate::error::{ShapeDistError, Which};
 use crate::linalg::{axis_angle, kabsch_rotation, solve_sym, sym_eigen3};
-use crate::nn::{dist2, PointTree, GROUP};
+use crate::nn::{dist2, NeighbourGraph, PointTree, GROUP};
 use crate::points::{centred, check_spread, outer, principal_axes, radius, validate};
 
 /// Below this many source points the correspondence search runs on one thread (rayon's
@@ -38,8 +38,9 @@ const NONE: u32 = u32::MAX;
 
 /// A point set prepared for repeated comparisons: centred, with k-d trees (the exact
 /// nearest-neighbour [`PointTree`] of the ICP loop, and kiddo's tree for the k nearest
-/// neighbours of the normals), a random subsample (and its tree) for the coarse global
-/// search, and lazily estimated normals.
+/// neighbours of the normals), the exact neighbour graph that lets most ICP correspondences
+/// skip the tree ([`NeighbourGraph`]), a random subsample (and its tree and graph) for the
+/// coarse global search, and lazily estimated normals.
 #[derive(Debug)]
 pub struct PreparedSet {
     points: Vec<DVec3>,
@@ -47,8 +48,10 @@ pub struct PreparedSet {
     radius: f64,
     tree: ImmutableKdTree<f64, 3>,
     nn: PointTree,
+    graph: OnceLock<NeighbourGraph>,
     sub_points: Vec<DVec3>,
     sub_nn: PointTree,
+    sub_graph: OnceLock<NeighbourGraph>,
     normals_k: usize,
     normals: OnceLock<Vec<DVec3>>,
 }
@@ -104,11 +107,13 @@ impl PreparedSet {
         Ok(Self {
             radius: radius(&pts),
             nn: PointTree::new(&pts),
+            graph: OnceLock::new(),
             points: pts,
             centroid: c,
             tree,
             sub_points,
             sub_nn,
+            sub_graph: OnceLock::new(),
             normals_k: opts.normals_k.max(3),
             normals: OnceLock::new(),
         })
@@ -158,6 +163,17 @@ impl PreparedSet {
                 })
                 .collect()
         })
+    }
+
+    /// The exact neighbour graph of the centred points (built on first use: when the set is
+    /// the target of an ICP run).
+    pub fn graph(&self) -> &NeighbourGraph {
+        self.graph.get_or_init(|| NeighbourGraph::new(&self.nn))
+    }
+
+    fn sub_graph(&self) -> &NeighbourGraph {
+        self.sub_graph
+            .get_or_init(|| NeighbourGraph::new(&self.sub_nn))
     }
 
     /// The exact nearest-neighbour tree of the centred points (its leaf order is the order in
@@ -228,6 +244,12 @@ pub struct IcpResult {
     pub converged: bool,
     /// Iterations run on the subsamples first (see [`IcpOptions::coarse_iterations`]).
     pub coarse_iterations: usize,
+    /// Nearest-neighbour answers the run needed on all points (source points times
+    /// correspondence passes, the final evaluation included).
+    pub pair_searches: usize,
+    /// How many of them needed a tree query; the others kept their partner because the point
+    /// had not left its safe radius (exact: the same partner a query would find).
+    pub tree_queries: usize,
 }
 
 fn check_icp_options(o: &IcpOptions) -> Result<(), ShapeDistError> {
@@ -245,42 +267,84 @@ fn check_icp_options(o: &IcpOptions) -> Result<(), ShapeDistError> {
     Ok(())
 }
 
+/// Graph moves allowed per point and iteration before falling back to a tree query.
+const MAX_STEPS: usize = 8;
+
+/// Iterations in which a point whose graph walk was not certified goes straight to the tree
+/// (far from the target surface the certificate rarely holds, and the walk would be wasted).
+const BACKOFF: u8 = 3;
+
 /// Correspondence search over one chunk of source points: for each (transformed) source
 /// point, the exact nearest target point `(squared distance, index)`, the lexicographic
-/// minimum as [`crate::nn::nearest_brute_force`] defines it. The search is seeded with the
-/// previous partner (`warm`: `out` holds the previous correspondences) and with the partner of
-/// the preceding source point (the source is in a spatially coherent order); both only bound
-/// the search, the result is the same exact minimum. With `accumulate`, also returns the
-/// sums of all pairs (fused pass of the untrimmed point-to-point step).
+/// minimum as [`crate::nn::nearest_brute_force`] defines it.
+///
+/// With `warm` (`out` holds the previous correspondences) and a target neighbour graph, a
+/// point first walks the graph from its previous partner ([`NeighbourGraph::descend`]); where
+/// the walk ends with a certificate, that is the exact answer without a tree query. The
+/// other points are answered by the tree, in groups, seeded with the walk's end (or, without
+/// a previous partner, the partner of the preceding source point: the source is in a
+/// spatially coherent order). Seeds only bound the search, the result is the same exact
+/// minimum. With `accumulate`, also returns the sums of all pairs (fused pass of the
+/// untrimmed point-to-point step). The second return value counts the tree queries.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 fn correspond_chunk(
     tree: &PointTree,
+    graph: Option<&NeighbourGraph>,
     tgt: &[DVec3],
     src: &[DVec3],
     r: DMat3,
     t: DVec3,
     out: &mut [(f64, u32)],
+    skip: &mut [u8],
     warm: bool,
     accumulate: bool,
-) -> Sums {
+) -> (Sums, usize) {
     let mut s = Sums::ZERO;
     let mut prev = NONE;
+    let mut queries = 0;
     let mut ps = [DVec3::ZERO; GROUP];
-    for (o, b) in out.chunks_mut(GROUP).zip(src.chunks(GROUP)) {
-        let g = o.len().min(b.len());
+    let mut seeds = [(f64::INFINITY, NONE); GROUP];
+    let mut slot = [0usize; GROUP];
+    for ((o, sk), b) in out
+        .chunks_mut(GROUP)
+        .zip(skip.chunks_mut(GROUP))
+        .zip(src.chunks(GROUP))
+    {
+        let g = o.len().min(b.len()).min(sk.len());
+        let mut nq = 0;
         for k in 0..g {
             let p = r * b[k] + t;
-            ps[k] = p;
-            // Seed: the previous partner, else the partner of the preceding point.
             let j = if warm && o[k].1 != NONE { o[k].1 } else { prev };
-            o[k] = if j == NONE {
-                (f64::INFINITY, NONE)
-            } else {
-                (dist2(tgt[j as usize], p), j)
+            let walk = warm && o[k].1 != NONE && sk[k] == 0;
+            if sk[k] > 0 {
+                sk[k] -= 1;
+            }
+            let seed = match (graph, walk) {
+                (Some(gr), true) => {
+                    let (found, certain) = gr.descend(p, j, MAX_STEPS);
+                    if certain {
+                        o[k] = found;
+                        continue;
+                    }
+                    sk[k] = BACKOFF;
+                    found
+                }
+                _ if j == NONE => (f64::INFINITY, NONE),
+                _ => (dist2(tgt[j as usize], p), j),
             };
+            ps[nq] = p;
+            seeds[nq] = seed;
+            slot[nq] = k;
+            nq += 1;
         }
-        tree.nearest_group(&ps[..g], &mut o[..g]);
+        if nq > 0 {
+            tree.nearest_group(&ps[..nq], &mut seeds[..nq]);
+            for m in 0..nq {
+                o[slot[m]] = seeds[m];
+            }
+            queries += nq;
+        }
         prev = o[g - 1].1;
         if accumulate {
             for k in 0..g {
@@ -288,38 +352,44 @@ fn correspond_chunk(
             }
         }
     }
-    s
+    (s, queries)
 }
 
 /// Correspondences of all source points (see [`correspond_chunk`]); returns the sums of all
-/// pairs when `accumulate` (added chunk by chunk in order: deterministic).
+/// pairs when `accumulate` (added chunk by chunk in order: deterministic) and the number of
+/// tree queries.
 #[allow(clippy::too_many_arguments)]
 fn correspond(
     tree: &PointTree,
+    graph: Option<&NeighbourGraph>,
     tgt: &[DVec3],
     src: &[DVec3],
     r: DMat3,
     t: DVec3,
     out: &mut [(f64, u32)],
+    skip: &mut [u8],
     parallel: bool,
     warm: bool,
     accumulate: bool,
-) -> Sums {
-    let run = |(o, s): (&mut [(f64, u32)], &[DVec3])| {
-        correspond_chunk(tree, tgt, s, r, t, o, warm, accumulate)
-    };
+) -> (Sums, usize) {
+    type Part<'a> = ((&'a mut [(f64, u32)], &'a mut [u8]), &'a [DVec3]);
+    let run =
+        |((o, k), s): Part<'_>| correspond_chunk(tree, graph, tgt, s, r, t, o, k, warm, accumulate);
+    let add = |x: (Sums, usize), y: (Sums, usize)| (x.0.add(y.0), x.1 + y.1);
     if parallel {
-        let parts: Vec<Sums> = out
+        let parts: Vec<(Sums, usize)> = out
             .par_chunks_mut(CHUNK)
+            .zip(skip.par_chunks_mut(CHUNK))
             .zip(src.par_chunks(CHUNK))
             .map(run)
             .collect();
-        parts.into_iter().fold(Sums::ZERO, Sums::add)
+        parts.into_iter().fold((Sums::ZERO, 0), add)
     } else {
         out.chunks_mut(CHUNK)
+            .zip(skip.chunks_mut(CHUNK))
             .zip(src.chunks(CHUNK))
             .map(run)
-            .fold(Sums::ZERO, Sums::add)
+            .fold((Sums::ZERO, 0), add)
     }
 }
 
@@ -380,6 +450,7 @@ impl Sums {
 fn icp_core(
     tgt_pts: &[DVec3],
     tree: &PointTree,
+    graph: Option<&NeighbourGraph>,
     normals: Option<&[DVec3]>,
     src: &[DVec3],
     init: DMat3,
@@ -395,23 +466,28 @@ fn icp_core(
     let mut r = init;
     let mut t = init_t;
     let mut corr = vec![(f64::INFINITY, NONE); src.len()];
+    let mut skip = vec![0u8; src.len()];
+    let mut queries = 0;
     let mut scratch = Vec::new();
     let mut prev_rmse = f64::INFINITY;
     let mut rmse = f64::INFINITY;
     let mut iterations = 0;
     let mut converged = false;
     while iterations < o.max_iterations {
-        let all = correspond(
+        let (all, nq) = correspond(
             tree,
+            graph,
             tgt_pts,
             src,
             r,
             t,
             &mut corr,
+            &mut skip,
             parallel,
             iterations > 0,
             fused,
         );
+        queries += nq;
         iterations += 1;
         // Statistics of the kept pairs at the current pose.
         let (thr, kept) = if fused {
@@ -439,7 +515,10 @@ fn icp_core(
     }
     if !converged {
         // Report the error at the returned pose.
-        let all = correspond(tree, tgt_pts, src, r, t, &mut corr, parallel, true, fused);
+        let (all, nq) = correspond(
+            tree, graph, tgt_pts, src, r, t, &mut corr, &mut skip, parallel, true, fused,
+        );
+        queries += nq;
         let kept = if fused {
             all
         } else {
@@ -455,6 +534,8 @@ fn icp_core(
         rmse,
         converged,
         coarse_iterations: 0,
+        pair_searches: src.len() * (iterations + usize::from(!converged)),
+        tree_queries: queries,
     }
 }
 
@@ -583,6 +664,7 @@ pub fn icp(
         let c = icp_core(
             &a.sub_points,
             &a.sub_nn,
+            Some(a.sub_graph()),
             None,
             b.sub_nn.leaf_order_points(),
             init,
@@ -599,6 +681,7 @@ pub fn icp(
     let mut res = icp_core(
         &a.points,
         &a.nn,
+        Some(a.graph()),
         normals,
         b.nn.leaf_order_points(),
         r0,
@@ -737,6 +820,7 @@ pub fn global_icp(
                 icp_core(
                     &a.sub_points,
                     &a.sub_nn,
+                    Some(a.sub_graph()),
                     None,
                     b.sub_nn.leaf_order_points(),
                     r0,
@@ -767,6 +851,7 @@ pub fn global_icp(
             let w = icp_core(
                 &a.points,
                 &a.nn,
+                Some(a.graph()),
                 Some(a.normals()),
                 b.nn.leaf_order_points(),
                 r,
@@ -786,6 +871,7 @@ pub fn global_icp(
         finals.push(icp_core(
             &a.points,
             &a.nn,
+            Some(a.graph()),
             normals,
             b.nn.leaf_order_points(),
             r,

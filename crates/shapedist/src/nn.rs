@@ -28,6 +28,7 @@
 #![allow(clippy::needless_range_loop)] // lane loops index several arrays in step
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 /// Maximum points per leaf (measured best among 4 to 64 on 10k-point surfaces).
 pub const LEAF_SIZE: usize = 32;
@@ -326,6 +327,167 @@ impl PointTree {
     }
 
     fn group(&self, qs: &[DVec3], best: &mut [(f64, u32)]) {
+        let g = qs.len().min(best.len()).min(GROUP);
+        let (qs, best) = (&qs[..g], &mut best[..g]);
+        if self.root == NONE || g == 0 {
+            return;
+        }
+        // The queries and their bounds as structure of arrays, padded to a whole group with
+        // a bound below zero (never within any box), so that the per-leaf box tests below run
+        // over fixed-length arrays (the compiler turns them into vector code).
+        let mut qx = [0.0f64; GROUP];
+        let mut qy = [0.0f64; GROUP];
+        let mut qz = [0.0f64; GROUP];
+        let mut bd = [-1.0f64; GROUP];
+        let (mut glo, mut ghi) = (qs[0], qs[0]);
+        let mut centre = DVec3::ZERO;
+        for (i, &q) in qs.iter().enumerate() {
+            glo = glo.min(q);
+            ghi = ghi.max(q);
+            centre += q;
+            (qx[i], qy[i], qz[i]) = (q.x, q.y, q.z);
+            bd[i] = best[i].0;
+        }
+        let centre = (centre / g as f64).to_array();
+        let bound = |bd: &[f64; GROUP]| bd.iter().fold(0.0f64, |m, &b| max(m, b));
+        let mut bnd = bound(&bd);
+        if box_box_dist2(self.root_box.0, self.root_box.1, glo, ghi) > bnd {
+            return;
+        }
+        let (gl, gh) = (glo.to_array(), ghi.to_array());
+        let mut buf: Scratch = [[0.0; LANES]; LEAF_SIZE / LANES + 1];
+        let mut stack: [(u32, f64); 64] = [(0, 0.0); 64];
+        let mut hit = [false; GROUP];
+        let mut sp = 0usize;
+        let mut cur = self.root;
+        loop {
+            if cur & LEAF_BIT != 0 {
+                if let Some(lf) = self.leaves.get((cur & !LEAF_BIT) as usize) {
+                    // Same formula as `box_dist2`, one query per lane.
+                    for i in 0..GROUP {
+                        let gx = max(max(lf.lo.x - qx[i], qx[i] - lf.hi.x), 0.0);
+                        let gy = max(max(lf.lo.y - qy[i], qy[i] - lf.hi.y), 0.0);
+                        let gz = max(max(lf.lo.z - qz[i], qz[i] - lf.hi.z), 0.0);
+                        hit[i] = gx * gx + gy * gy + gz * gz <= bd[i];
+                    }
+                    for i in 0..g {
+                        if hit[i] {
+                            let q = DVec3::new(qx[i], qy[i], qz[i]);
+                            self.scan_leaf(lf.a as usize, lf.b as usize, q, &mut best[i], &mut buf);
+                            bd[i] = best[i].0;
+                        }
+                    }
+                    bnd = bound(&bd);
+                }
+            } else if let Some(n) = self.inner.get(cur as usize) {
+                let d = child_box_dist2(n, gl, gh);
+                let o = child_dist2(n, centre);
+                let (f, s) = if o[0] <= o[1] { (0, 1) } else { (1, 0) };
+                if d[s] <= bnd && sp < stack.len() {
+                    stack[sp] = (n.child[s], d[s]);
+                    sp += 1;
+                }
+                if d[f] <= bnd {
+                    cur = n.child[f];
+                    continue;
+                }
+            }
+            loop {
+                if sp == 0 {
+                    return;
+                }
+                sp -= 1;
+                let (c, dc) = stack[sp];
+                if dc <= bnd {
+                    cur = c;
+                    break;
+                }
+            }
+        }
+    }
+
+    /// Every point within `r2[i]` (squared, inclusive) of `qs[i]`, as `(squared distance,
+    /// original index)` appended to `out[i]` (unordered), for a group of at most [`GROUP`]
+    /// nearby queries in one traversal.
+    fn collect_within(&self, qs: &[DVec3], r2: &[f64], out: &mut [Vec<(f64, u32)>]) {
+        let g = qs.len().min(r2.len()).min(out.len()).min(GROUP);
+        if self.root == NONE || g == 0 {
+            return;
+        }
+        let (qs, r2) = (&qs[..g], &r2[..g]);
+        let (mut glo, mut ghi) = (qs[0], qs[0]);
+        for &q in qs {
+            glo = glo.min(q);
+            ghi = ghi.max(q);
+        }
+        let bnd = r2.iter().fold(0.0f64, |m, &b| max(m, b));
+        let (gl, gh) = (glo.to_array(), ghi.to_array());
+        let mut stack: [u32; 64] = [0; 64];
+        let mut sp = 0usize;
+        let mut cur = self.root;
+        if box_box_dist2(self.root_box.0, self.root_box.1, glo, ghi) > bnd {
+            return;
+        }
+        loop {
+            if cur & LEAF_BIT != 0 {
+                if let Some(lf) = self.leaves.get((cur & !LEAF_BIT) as usize) {
+                    let blocks = &self.blocks[lf.a as usize / LANES..lf.b as usize / LANES];
+                    let pids = &self.pids[lf.a as usize..lf.b as usize];
+                    for (i, q) in qs.iter().enumerate() {
+                        if box_dist2(lf.lo, lf.hi, *q) > r2[i] {
+                            continue;
+                        }
+                        for (blk, ps) in blocks.iter().zip(pids.chunks_exact(LANES)) {
+                            for l in 0..LANES {
+                                let (dx, dy, dz) =
+                                    (blk[0][l] - q.x, blk[1][l] - q.y, blk[2][l] - q.z);
+                                let d = dx * dx + dy * dy + dz * dz;
+                                if d <= r2[i] && ps[l] != NONE {
+                                    out[i].push((d, ps[l]));
+                                }
+                            }
+                        }
+                    }
+                }
+            } else if let Some(n) = self.inner.get(cur as usize) {
+                let d = child_box_dist2(n, gl, gh);
+                if d[1] <= bnd && sp < stack.len() {
+                    stack[sp] = n.child[1];
+                    sp += 1;
+                }
+                if d[0] <= bnd {
+                    cur = n.child[0];
+                    continue;
+                }
+            }
+            if sp == 0 {
+                return;
+            }
+            sp -= 1;
+            cur = stack[sp];
+        }
+    }
+
+    /// The `K` nearest neighbours of each query of a group (at most [`GROUP`] at a time, like
+    /// [`Self::nearest_group`]): on return `best[i]` holds the `K` smallest
+    /// `(squared distance, original index)` over all points in lexicographic order, with
+    /// distinct indices (padded with `(inf, u32::MAX)` where the tree has fewer points). On
+    /// entry `best[i]` must hold candidates: a seed in the same form (each `d2` the [`dist2`]
+    /// of the query and that point, ordered, distinct indices, the rest `(inf, u32::MAX)`).
+    ///
+    /// The `K`-th distance is what makes a candidate list reusable: a query that has moved by
+    /// `delta` still has its nearest neighbour among the `K` candidates whenever the best of
+    /// them is nearer than `d_K - delta` (triangle inequality; see the ICP loop).
+    pub fn nearest_k_group<const K: usize>(&self, qs: &[DVec3], best: &mut [[(f64, u32); K]]) {
+        if K == 0 {
+            return;
+        }
+        for (q, b) in qs.chunks(GROUP).zip(best.chunks_mut(GROUP)) {
+            self.group_k(q, b);
+        }
+    }
+
+    fn group_k<const K: usize>(&self, qs: &[DVec3], best: &mut [[(f64, u32); K]]) {
         let g = qs.len().min(best.len());
         let (qs, best) = (&qs[..g], &mut best[..g]);
         if self.root == NONE || g == 0 {
@@ -339,7 +501,8 @@ impl PointTree {
             centre += q;
         }
         let centre = (centre / g as f64).to_array();
-        let bound = |best: &[(f64, u32)]| best.iter().fold(0.0f64, |m, b| max(m, b.0));
+        // A subtree is needed while its box is within some query's K-th distance.
+        let bound = |best: &[[(f64, u32); K]]| best.iter().fold(0.0f64, |m, b| max(m, b[K - 1].0));
         let mut bnd = bound(best);
         if box_box_dist2(self.root_box.0, self.root_box.1, glo, ghi) > bnd {
             return;
@@ -353,8 +516,8 @@ impl PointTree {
             if cur & LEAF_BIT != 0 {
                 if let Some(lf) = self.leaves.get((cur & !LEAF_BIT) as usize) {
                     for (q, b) in qs.iter().zip(best.iter_mut()) {
-                        if box_dist2(lf.lo, lf.hi, *q) <= b.0 {
-                            self.scan_leaf(lf.a as usize, lf.b as usize, *q, b, &mut buf);
+                        if box_dist2(lf.lo, lf.hi, *q) <= b[K - 1].0 {
+                            self.scan_leaf_k(lf.a as usize, lf.b as usize, *q, b, &mut buf);
                         }
                     }
                     bnd = bound(best);
@@ -382,6 +545,44 @@ impl PointTree {
                     cur = c;
                     break;
                 }
+            }
+        }
+    }
+
+    /// `K`-nearest scan of the padded leaf `[a, b)` (see [`Self::scan_leaf`]): the lane
+    /// distances first, then only the points within the current `K`-th distance are inserted.
+    #[inline(always)]
+    fn scan_leaf_k<const K: usize>(
+        &self,
+        a: usize,
+        b: usize,
+        q: DVec3,
+        best: &mut [(f64, u32); K],
+        buf: &mut Scratch,
+    ) {
+        let blocks = &self.blocks[a / LANES..b / LANES];
+        let mut m = [f64::INFINITY; LANES];
+        for (blk, o) in blocks.iter().zip(buf.iter_mut()) {
+            for l in 0..LANES {
+                let (dx, dy, dz) = (blk[0][l] - q.x, blk[1][l] - q.y, blk[2][l] - q.z);
+                let d = dx * dx + dy * dy + dz * dz;
+                o[l] = d;
+                m[l] = if d < m[l] { d } else { m[l] };
+            }
+        }
+        let dm = m
+            .iter()
+            .fold(f64::INFINITY, |u, &v| if v < u { v } else { u });
+        if dm > best[K - 1].0 {
+            return;
+        }
+        for (ds, ps) in buf.iter().zip(self.pids[a..b].chunks_exact(LANES)) {
+            for l in 0..LANES {
+                let (d, id) = (ds[l], ps[l]);
+                if d > best[K - 1].0 || id == NONE {
+                    continue;
+                }
+                insert_k(best, d, id);
             }
         }
     }
@@ -419,6 +620,241 @@ impl PointTree {
             *best = (dm, id);
         }
     }
+}
+
+/// Neighbours per point in a [`NeighbourGraph`] (measured on the ICP peers' 10k-point patch,
+/// 50 point-to-point iterations: see `docs/bench-shapedist.md`).
+pub const GRAPH_K: usize = 16;
+
+/// The exact `K`-nearest-neighbour graph of the points of a [`PointTree`], for answering the
+/// nearest-neighbour query of a point that has moved a little without a tree query.
+///
+/// The certificate: let `a` be a point at distance `d` from the query `p`, and let its
+/// neighbours be sorted by distance from `a`, the `l`-th at `r_l(a)`. Every point that is not
+/// among the first `l` neighbours lies at least `r_{l+1}(a)` from `a`, so at least
+/// `r_{l+1}(a) - d` from `p` (triangle inequality). Hence if `a` precedes its first `l`
+/// neighbours in the lexicographic order of `(squared distance, index)` and `2 d < r_{l+1}(a)`,
+/// `a` is the exact nearest neighbour of `p` among all points, with no other point tied.
+/// [`Self::descend`] walks the graph, checking the neighbours nearest first and stopping as
+/// soon as the certificate holds (a query close to the surface needs only a few). The
+/// thresholds `r_l^2` are stored as `f32` rounded down after a relative shrink of `1e-6`, far
+/// above the rounding of the comparison, so the evaluated squared distances keep the strict
+/// order and the answer is bit for bit the tree's (and brute force's).
+///
+/// Storage is in the tree's leaf order (neighbours of nearby points are nearby in memory).
+#[derive(Debug, Clone)]
+pub struct NeighbourGraph {
+    /// Points in leaf order (a copy of the tree's).
+    pts: Vec<DVec3>,
+    /// Original index of each leaf-order point.
+    ids: Vec<u32>,
+    /// Leaf-order position of each original index.
+    pos: Vec<u32>,
+    /// The `K` nearest other points of each point, as leaf-order positions (nearest first;
+    /// padded with the point itself when the set has fewer points).
+    nbr: Vec<[u32; GRAPH_K]>,
+    /// `th[l]`: lower bound of `r_{l+1}^2` (`l = 0..=K`; infinity past the last other point).
+    th: Vec<[f32; GRAPH_K + 1]>,
+}
+
+/// Per-thread buffers of the graph build: the points found per query, the group distances.
+type Buffers = (Vec<Vec<(f64, u32)>>, Vec<f64>);
+
+/// `v` shrunk by a relative `1e-6` and rounded down to `f32` (a lower bound of `v`).
+fn lower_f32(v: f64) -> f32 {
+    if v.is_infinite() {
+        return f32::INFINITY;
+    }
+    let v = v * (1.0 - 1e-6);
+    if v >= f32::MAX as f64 {
+        return f32::MAX;
+    }
+    let f = v as f32;
+    if f as f64 > v && f > 0.0 {
+        f32::from_bits(f.to_bits() - 1)
+    } else {
+        f
+    }
+}
+
+impl NeighbourGraph {
+    /// Builds the graph of the points of `tree` (exact `K + 2`-nearest queries, the point
+    /// itself dropped, the last one only for the final threshold).
+    pub fn new(tree: &PointTree) -> Self {
+        let pts = tree.leaf_order_points().to_vec();
+        let ids = tree.leaf_order_ids().to_vec();
+        let n = pts.len().min(ids.len());
+        let mut pos = vec![NONE; n];
+        for (k, &i) in ids.iter().enumerate() {
+            if let Some(p) = pos.get_mut(i as usize) {
+                *p = k as u32;
+            }
+        }
+        let mut nbr = vec![[0u32; GRAPH_K]; n];
+        let mut th = vec![[f32::INFINITY; GRAPH_K + 1]; n];
+        // Per group of consecutive leaf-order points (close together): a radius guessed from
+        // the local density (the 4th nearest point of the group, scaled as on a surface),
+        // every point within it from the tree, and, if that is fewer than K + 2 points (the
+        // point itself included), again with the (K + 2)-th distance within the group (sure
+        // to hold K + 2 points); then the K + 2 smallest. Groups are independent: in parallel,
+        // with the same result on any number of threads.
+        let cmp = |x: &(f64, u32), y: &(f64, u32)| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1));
+        const PROBE: usize = 4;
+        let scale = 1.2 * (GRAPH_K + 2) as f64 / PROBE as f64;
+        let (pts_ref, ids_ref, pos_ref) = (&pts, &ids, &pos);
+        nbr.par_chunks_mut(GROUP)
+            .zip(th.par_chunks_mut(GROUP))
+            .enumerate()
+            .for_each_init(
+                || (vec![Vec::new(); GROUP], Vec::with_capacity(GROUP)),
+                |(found, local): &mut Buffers, (c, (nb, tt))| {
+                    let lo = c * GROUP;
+                    let qs = &pts_ref[lo..(lo + GROUP).min(n)];
+                    let g = qs.len().min(nb.len());
+                    let mut r2 = [f64::INFINITY; GROUP];
+                    let mut sure = [f64::INFINITY; GROUP];
+                    for k in 0..g {
+                        if g >= GRAPH_K + 2 {
+                            local.clear();
+                            local.extend(qs.iter().map(|&p| dist2(p, qs[k])));
+                            let (_, kth, rest) =
+                                local.select_nth_unstable_by(PROBE, f64::total_cmp);
+                            let guess = *kth * scale;
+                            let (_, s, _) = rest
+                                .select_nth_unstable_by(GRAPH_K + 1 - PROBE - 1, f64::total_cmp);
+                            (r2[k], sure[k]) = (guess.min(*s), *s);
+                        }
+                        found[k].clear();
+                    }
+                    tree.collect_within(qs, &r2[..g], &mut found[..g]);
+                    for k in 0..g {
+                        if found[k].len() < GRAPH_K + 2 && r2[k] < sure[k] {
+                            found[k].clear();
+                            tree.collect_within(
+                                &qs[k..k + 1],
+                                &sure[k..k + 1],
+                                &mut found[k..k + 1],
+                            );
+                        }
+                    }
+                    for (k, f) in found.iter_mut().enumerate().take(g) {
+                        let me = lo + k;
+                        let keep = (GRAPH_K + 2).min(f.len());
+                        if keep > 0 && keep < f.len() {
+                            f.select_nth_unstable_by(keep - 1, cmp);
+                        }
+                        f.truncate(keep);
+                        f.sort_unstable_by(cmp);
+                        // Exact duplicates are also at 0, in any order: drop the point itself
+                        // wherever it sits.
+                        let mut m = 0;
+                        nb[k] = [me as u32; GRAPH_K];
+                        for &(d, j) in f.iter() {
+                            if j == ids_ref[me] || m > GRAPH_K {
+                                continue;
+                            }
+                            if m < GRAPH_K {
+                                nb[k][m] = pos_ref[j as usize];
+                            }
+                            tt[k][m] = lower_f32(d);
+                            m += 1;
+                        }
+                    }
+                },
+            );
+        Self {
+            pts,
+            ids,
+            pos,
+            nbr,
+            th,
+        }
+    }
+
+    /// Number of points.
+    pub fn len(&self) -> usize {
+        self.pts.len()
+    }
+
+    /// Whether the graph holds no point.
+    pub fn is_empty(&self) -> bool {
+        self.pts.is_empty()
+    }
+
+    /// The neighbours of the point with original index `i` (original indices, nearest
+    /// first).
+    pub fn neighbours(&self, i: u32) -> Vec<u32> {
+        let Some(&p) = self.pos.get(i as usize) else {
+            return Vec::new();
+        };
+        self.nbr[p as usize]
+            .iter()
+            .filter(|&&j| j != p)
+            .map(|&j| self.ids[j as usize])
+            .collect()
+    }
+
+    /// Greedy descent from the point with original index `start` towards `q`: checks the
+    /// neighbours of the current point nearest first and moves to the first one that precedes
+    /// it in the lexicographic order of `(squared distance, original index)`, until the
+    /// certificate of the type's doc holds (or the neighbours are exhausted, or after
+    /// `max_steps` moves). Returns the final `(squared distance, original index)` and whether
+    /// it is certified to be the exact nearest neighbour of `q` among all points; when it is
+    /// not, it is still a valid seed for [`PointTree::nearest_from`].
+    #[inline]
+    pub fn descend(&self, q: DVec3, start: u32, max_steps: usize) -> ((f64, u32), bool) {
+        let Some(&p0) = self.pos.get(start as usize) else {
+            return ((f64::INFINITY, NONE), false);
+        };
+        let mut cur = p0 as usize;
+        let mut dc = dist2(self.pts[cur], q);
+        let mut steps = 0;
+        'walk: loop {
+            let (row, th) = (&self.nbr[cur], &self.th[cur]);
+            for l in 0..GRAPH_K {
+                if 4.0 * dc < th[l] as f64 {
+                    return ((dc, self.ids[cur]), true);
+                }
+                let j = row[l] as usize;
+                let d = dist2(self.pts[j], q);
+                if d < dc || (d == dc && self.ids[j] < self.ids[cur]) {
+                    steps += 1;
+                    if steps > max_steps {
+                        return ((d, self.ids[j]), false);
+                    }
+                    cur = j;
+                    dc = d;
+                    continue 'walk;
+                }
+            }
+            return ((dc, self.ids[cur]), 4.0 * dc < th[GRAPH_K] as f64);
+        }
+    }
+}
+
+/// Inserts `(d, id)` into the ordered list `best` (lexicographic order, distinct indices)
+/// unless `id` is already there or it does not precede the last entry.
+#[inline(always)]
+pub(crate) fn insert_k<const K: usize>(best: &mut [(f64, u32); K], d: f64, id: u32) {
+    if K == 0 || !better(d, id, best[K - 1].0, best[K - 1].1) || best.iter().any(|b| b.1 == id) {
+        return;
+    }
+    let mut i = K - 1;
+    while i > 0 && better(d, id, best[i - 1].0, best[i - 1].1) {
+        best[i] = best[i - 1];
+        i -= 1;
+    }
+    best[i] = (d, id);
+}
+
+/// Brute-force reference of [`PointTree::nearest_k_group`]: the `K` smallest
+/// `(squared distance, index)` in lexicographic order (padded with `(inf, u32::MAX)`).
+pub fn nearest_k_brute_force<const K: usize>(points: &[DVec3], q: DVec3) -> [(f64, u32); K] {
+    let mut best = [(f64::INFINITY, NONE); K];
+    for (i, p) in points.iter().enumerate() {
+        insert_k(&mut best, dist2(*p, q), i as u32);
+    }
+    best
 }
 
 /// Brute-force reference: the lexicographic minimum of `(squared distance, index)`.

@@ -1,6 +1,7 @@
 //! The fast path of ICP against brute force: the exact nearest-neighbour tree (single,
-//! warm-started and grouped queries, ties included) and whole ICP runs against a reference
-//! ICP written with brute-force correspondences.
+//! warm-started and grouped queries, ties included), its K-nearest queries, the neighbour
+//! graph and its certified walk, and whole ICP runs against a reference ICP written with
+//! brute-force correspondences.
 
 mod common;
 
@@ -9,7 +10,9 @@ use proptest::prelude::*;
 use rand::Rng;
 use shapedist::glam::{DMat3, DVec3};
 use shapedist::linalg::kabsch_rotation;
-use shapedist::nn::{dist2, nearest_brute_force, PointTree, GROUP};
+use shapedist::nn::{
+    dist2, nearest_brute_force, nearest_k_brute_force, NeighbourGraph, PointTree, GRAPH_K, GROUP,
+};
 use shapedist::points::outer;
 use shapedist::*;
 
@@ -155,6 +158,137 @@ fn duplicates_spread_over_many_leaves_resolve_to_the_first_copy() {
         assert_eq!(g, [want, want]);
         assert_eq!(tree.nearest(q), want);
     }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    #[test]
+    fn prop_k_nearest_queries_equal_brute_force(
+        seed in 0u64..1_000_000,
+        n in 1usize..300,
+        kind in 0u8..3,
+        far in 0.0f64..2.0,
+    ) {
+        let mut r = rng(seed);
+        let pts = cloud(&mut r, n, kind);
+        let tree = PointTree::new(&pts);
+        let qs: Vec<DVec3> = (0..2 * GROUP + 5)
+            .map(|_| {
+                pts[r.random_range(0..n)]
+                    + DVec3::new(r.random::<f64>() - 0.5, r.random::<f64>() - 0.5, 0.3) * far
+            })
+            .collect();
+        // Seeds: none, or one valid candidate.
+        let mut got: Vec<[(f64, u32); 5]> = qs
+            .iter()
+            .enumerate()
+            .map(|(k, &q)| {
+                let mut b = [(f64::INFINITY, u32::MAX); 5];
+                if k % 2 == 1 {
+                    let j = r.random_range(0..n) as u32;
+                    b[0] = (dist2(pts[j as usize], q), j);
+                }
+                b
+            })
+            .collect();
+        tree.nearest_k_group(&qs, &mut got);
+        for (q, g) in qs.iter().zip(&got) {
+            prop_assert_eq!(*g, nearest_k_brute_force::<5>(&pts, *q));
+        }
+    }
+
+    #[test]
+    fn prop_neighbour_graph_is_the_exact_k_nearest_graph(
+        seed in 0u64..1_000_000,
+        n in 1usize..300,
+        kind in 0u8..3,
+    ) {
+        let mut r = rng(seed);
+        let pts = cloud(&mut r, n, kind);
+        let tree = PointTree::new(&pts);
+        let graph = NeighbourGraph::new(&tree);
+        prop_assert_eq!(graph.len(), n);
+        for (i, &p) in pts.iter().enumerate() {
+            // Brute force: the K + 1 nearest, the point itself dropped (duplicates of it stay).
+            let want: Vec<u32> = nearest_k_brute_force::<{ GRAPH_K + 1 }>(&pts, p)
+                .iter()
+                .filter(|b| b.1 != u32::MAX && b.1 != i as u32)
+                .take(GRAPH_K)
+                .map(|b| b.1)
+                .collect();
+            prop_assert_eq!(graph.neighbours(i as u32), want, "point {}", i);
+        }
+    }
+
+    #[test]
+    fn prop_certified_graph_walks_equal_brute_force(
+        seed in 0u64..1_000_000,
+        n in 1usize..400,
+        kind in 0u8..3,
+        off in 0.0f64..0.3,
+    ) {
+        let mut r = rng(seed);
+        let pts = cloud(&mut r, n, kind);
+        let tree = PointTree::new(&pts);
+        let graph = NeighbourGraph::new(&tree);
+        let mut certified = 0;
+        let trials = 200;
+        for k in 0..trials {
+            let base = pts[r.random_range(0..n)];
+            // Near a point (where walks certify), on the grid also at exact ties.
+            let q = if kind == 2 && k % 3 == 0 {
+                base + DVec3::new(0.5, 0.0, 0.0)
+            } else {
+                base + DVec3::new(
+                    r.random::<f64>() - 0.5,
+                    r.random::<f64>() - 0.5,
+                    r.random::<f64>() - 0.5,
+                ) * off
+            };
+            let start = r.random_range(0..n) as u32;
+            let (got, sure) = graph.descend(q, start, 64);
+            // Always a valid seed: the distance is that of the returned point.
+            prop_assert!(got.1 != u32::MAX);
+            prop_assert_eq!(got.0, dist2(pts[got.1 as usize], q));
+            if sure {
+                certified += 1;
+                prop_assert_eq!(got, nearest_brute_force(&pts, q), "query {:?} from {}", q, start);
+            }
+        }
+        // The certificate is not vacuous: small sets are certified everywhere, near-surface
+        // queries on a patch mostly.
+        if n <= GRAPH_K {
+            prop_assert_eq!(certified, trials);
+        }
+        if kind == 0 && n >= 100 && off < 0.02 {
+            prop_assert!(certified > trials / 2, "{} of {} certified", certified, trials);
+        }
+    }
+}
+
+#[test]
+fn a_walk_is_not_certified_where_a_far_point_is_nearer() {
+    // A dense row of points and one isolated point: from the row, a query right next to the
+    // isolated point must not be certified at a row point (the isolated point is nearer and
+    // is not among the row points' neighbours).
+    let mut pts: Vec<DVec3> = (0..40)
+        .map(|i| DVec3::new(i as f64 * 0.01, 0.0, 0.0))
+        .collect();
+    pts.push(DVec3::new(0.2, 5.0, 0.0));
+    let tree = PointTree::new(&pts);
+    let graph = NeighbourGraph::new(&tree);
+    let q = DVec3::new(0.2, 4.9, 0.0);
+    let (got, sure) = graph.descend(q, 20, 8);
+    let want = nearest_brute_force(&pts, q);
+    assert_eq!(want.1, 40);
+    assert!(!sure || got == want, "certified a wrong answer {got:?}");
+    // Near the row, the walk certifies the right point.
+    let q = DVec3::new(0.101, 0.002, 0.0);
+    let (got, sure) = graph.descend(q, 0, 64);
+    assert!(sure);
+    assert_eq!(got, nearest_brute_force(&pts, q));
+    assert_eq!(got.1, 10);
 }
 
 /// Reference ICP (the same mathematics, brute-force correspondences, sums in input order):
