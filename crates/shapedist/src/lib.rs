@@ -10,7 +10,9 @@
 //!   Distance `d_L2 = min_R ||A - R B||_F / sqrt(||A||_F^2 + ||B||_F^2)` in [0, 1].
 //! * [`icp`] and [`global_icp`] on [`PreparedSet`]s: point-to-point (the paper's definition)
 //!   and point-to-plane ICP with an exact k-d tree ([`nn::PointTree`]: tight boxes, grouped
-//!   warm-started queries, the same answers as brute force), trimmed pairs, convergence test, and a
+//!   warm-started queries, the same answers as brute force) behind a certified walk on the
+//!   target's neighbour graph ([`nn::NeighbourGraph`]: most correspondences near convergence
+//!   without a tree query, still exact), trimmed pairs, convergence test, and a
 //!   multi-start global strategy (principal axes + the 24 cube rotations on a subsample, then
 //!   refinement on all points). [`icp_distance`] returns the normalised symmetric Hausdorff,
 //!   mean and RMS closest-point distances after alignment ([`ClosestPointStats`]).

@@ -835,7 +835,7 @@ impl NeighbourGraph {
 /// Inserts `(d, id)` into the ordered list `best` (lexicographic order, distinct indices)
 /// unless `id` is already there or it does not precede the last entry.
 #[inline(always)]
-pub(crate) fn insert_k<const K: usize>(best: &mut [(f64, u32); K], d: f64, id: u32) {
+fn insert_k<const K: usize>(best: &mut [(f64, u32); K], d: f64, id: u32) {
     if K == 0 || !better(d, id, best[K - 1].0, best[K - 1].1) || best.iter().any(|b| b.1 == id) {
         return;
     }
