@@ -5,7 +5,10 @@
 use crate::facemodel::{self, FaceModel, LANDMARK_NAMES};
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
-use landmarks::{detect_with, DetectOptions, GenericModel, LandmarkName, TrainOptions};
+use landmarks::{
+    detect_with, DetectOptions, GenericModel, LandmarkName, LandmarkRegressor, RegressorOptions,
+    TrainOptions,
+};
 use meshcore::{DVec3, TriMesh};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -53,6 +56,61 @@ pub struct Args {
     /// Also write the trained generic model to this file (how the crate's default model is made).
     #[arg(long)]
     pub write_model: Option<PathBuf>,
+    /// Train the model's landmark regression on this many faces of the training stream of
+    /// `--regressor-seed` (poses fitted by the detector), replacing any it has.
+    #[arg(long)]
+    pub fit_regressor: Option<usize>,
+    /// Seed of the training stream of `--fit-regressor`.
+    #[arg(long, default_value_t = 1)]
+    pub regressor_seed: u64,
+    /// `RegressorOptions::radius` (fraction of the inner-eye distance).
+    #[arg(long)]
+    pub regressor_radius: Option<f64>,
+    /// `RegressorOptions::spacing` (fraction of the inner-eye distance).
+    #[arg(long)]
+    pub regressor_spacing: Option<f64>,
+    /// `RegressorOptions::ridge`.
+    #[arg(long)]
+    pub regressor_ridge: Option<f64>,
+    /// Detect without the model's landmark regression (template search alone).
+    #[arg(long)]
+    pub no_regressor: bool,
+}
+
+/// Seed of the training stream of `seed`.
+fn training_seed(seed: u64) -> u64 {
+    seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0x7472_6169_6e00
+}
+
+/// Trains the landmark regression of `generic` on `n` faces of the training stream of `seed`.
+fn fit_regressor(
+    ict: &FaceModel,
+    generic: &GenericModel,
+    n: usize,
+    seed: u64,
+    opt: &RegressorOptions,
+) -> Result<LandmarkRegressor> {
+    let t0 = Instant::now();
+    let (faces, _) = sample_faces(ict, n, training_seed(seed), true)?;
+    let mut plain = generic.clone();
+    plain.regressor = None;
+    let dopt = DetectOptions::default();
+    let poses: Vec<Option<meshcore::DAffine3>> = faces
+        .par_iter()
+        .map(|(m, _)| detect_with(m, &plain, &dopt).ok().map(|l| l.model_to_mesh))
+        .collect();
+    let samples: Vec<(&TriMesh, [DVec3; 5], meshcore::DAffine3)> = faces
+        .iter()
+        .zip(&poses)
+        .filter_map(|((m, lm), p)| p.map(|p| (m, *lm, p)))
+        .collect();
+    let reg = LandmarkRegressor::train(generic, &samples, opt)?;
+    eprintln!(
+        "trained the landmark regression on {} of {n} faces (training stream of seed {seed}) in {:.1} s",
+        reg.n_training,
+        t0.elapsed().as_secs_f64()
+    );
+    Ok(reg)
 }
 
 /// Per test face: errors (mm), CPU ms, error message, confidence, symmetry, the weakest local
@@ -62,9 +120,17 @@ type Outcome = (Vec<f64>, f64, Option<String>, f64, f64, f64);
 /// Sampled face with the positions of its landmark vertices.
 type Sample = (TriMesh, [DVec3; 5]);
 
-fn sample_faces(model: &FaceModel, n: usize, seed: u64, expressions: bool) -> Result<Vec<Sample>> {
+/// Samples `n` faces; also returns, per face, the blendshapes weighted 0.3 or more (a label of
+/// its expression for the per-face table).
+fn sample_faces(
+    model: &FaceModel,
+    n: usize,
+    seed: u64,
+    expressions: bool,
+) -> Result<(Vec<Sample>, Vec<String>)> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut out = Vec::with_capacity(n);
+    let mut labels = Vec::with_capacity(n);
     for _ in 0..n {
         let id = model.random_identity(&mut rng);
         let ex = if expressions {
@@ -76,8 +142,16 @@ fn sample_faces(model: &FaceModel, n: usize, seed: u64, expressions: bool) -> Re
         let face = model.sample(&id, &ex)?.transformed(&pose);
         let lm = model.landmark_positions(&face)?;
         out.push((face, lm));
+        let strong: Vec<String> = model
+            .expression_names()
+            .iter()
+            .zip(&ex)
+            .filter(|(_, &w)| w >= 0.3)
+            .map(|(name, w)| format!("{name}={w:.2}"))
+            .collect();
+        labels.push(strong.join(" "));
     }
-    Ok(out)
+    Ok((out, labels))
 }
 
 /// Statistics of one landmark's errors (mm).
@@ -128,13 +202,13 @@ pub fn run(args: Args) -> Result<()> {
         .unwrap_or_else(|| root.join("target").join("landmarks-eval"));
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
     // Different streams for training and test faces.
-    let train_seed = args.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0x7472_6169_6e00;
+    let train_seed = training_seed(args.seed);
     let test_seed = args.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0x7465_7374_0000;
-    let generic = if let Some(p) = &args.generic_model {
+    let mut generic = if let Some(p) = &args.generic_model {
         GenericModel::load(p)?
     } else {
         let t0 = Instant::now();
-        let train = sample_faces(&ict, args.train, train_seed, true)?;
+        let (train, _) = sample_faces(&ict, args.train, train_seed, true)?;
         let g = GenericModel::train_with(&train, &TrainOptions::default(), ict.units())?;
         eprintln!(
             "trained the generic model on {} faces in {:.1} s",
@@ -143,20 +217,37 @@ pub fn run(args: Args) -> Result<()> {
         );
         g
     };
+    if let Some(n) = args.fit_regressor {
+        let mut ro = RegressorOptions::default();
+        if let Some(x) = args.regressor_radius {
+            ro.radius = x;
+        }
+        if let Some(x) = args.regressor_spacing {
+            ro.spacing = x;
+        }
+        if let Some(x) = args.regressor_ridge {
+            ro.ridge = x;
+        }
+        generic.regressor = Some(fit_regressor(&ict, &generic, n, args.regressor_seed, &ro)?);
+    }
     if let Some(p) = &args.write_model {
         std::fs::write(p, generic.to_json() + "\n")
             .with_context(|| format!("writing {}", p.display()))?;
         eprintln!("wrote the generic model to {}", p.display());
     }
     std::fs::write(out.join("generic-model.json"), generic.to_json() + "\n")?;
-    let mut test = if args.on_training {
+    let (mut test, mut labels) = if args.on_training {
         sample_faces(&ict, args.train, train_seed, true)?
     } else {
         sample_faces(&ict, args.faces, test_seed, !args.neutral)?
     };
+    // Index of each evaluated face in its stream.
+    let mut face_ids: Vec<usize> = (0..test.len()).collect();
     if let Some(i) = args.only {
         anyhow::ensure!(i < test.len(), "--only {i}: only {} test faces", test.len());
         test = vec![test.swap_remove(i)];
+        labels = vec![labels.swap_remove(i)];
+        face_ids = vec![i];
     }
     let pb = ProgressBar::new(test.len() as u64);
     pb.set_style(
@@ -172,7 +263,8 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(x) = args.min_confidence {
         dopt.min_confidence = x;
     }
-    let results: Vec<Outcome> = test
+    dopt.use_regressor = !args.no_regressor;
+    let (results, rows): (Vec<Outcome>, Vec<String>) = test
         .par_iter()
         .map(|(mesh, gt)| {
             let c0 = thread_cpu_ns();
@@ -190,29 +282,56 @@ pub fn run(args: Args) -> Result<()> {
                         .iter()
                         .map(|&n| (lm.get(n).position - gt[n as usize]).length() * unit_mm)
                         .collect();
+                    // Per-face row: errors of the landmarks predicted by the fitted pose alone
+                    // (before the local refinement), and the error vectors in the canonical
+                    // frame of the model (x: right to left eye, y: up, z: out of the face).
+                    let pose = lm.model_to_mesh;
+                    let inv = pose.inverse();
+                    let mut row = Vec::new();
+                    for &n in &LandmarkName::ALL {
+                        let pred = pose.transform_point3(generic.landmark(n));
+                        row.push(format!("{:.2}", (pred - gt[n as usize]).length() * unit_mm));
+                    }
+                    let od = |p: [DVec3; 5]| (p[3] - p[0]).length() * unit_mm;
+                    row.push(format!("{:.2},{:.2}", od(*gt), od(lm.positions())));
+                    for &n in &LandmarkName::ALL {
+                        let dv = inv.transform_vector3(lm.get(n).position - gt[n as usize]);
+                        row.push(format!(
+                            "{:.2} {:.2} {:.2}",
+                            dv.x * unit_mm,
+                            dv.y * unit_mm,
+                            dv.z * unit_mm
+                        ));
+                    }
                     (
-                        e,
-                        ms,
-                        None,
-                        lm.confidence,
-                        lm.symmetry,
-                        LandmarkName::ALL
-                            .iter()
-                            .map(|&n| lm.get(n).confidence / lm.confidence.max(1e-12))
-                            .fold(1.0, f64::min),
+                        (
+                            e,
+                            ms,
+                            None,
+                            lm.confidence,
+                            lm.symmetry,
+                            LandmarkName::ALL
+                                .iter()
+                                .map(|&n| lm.get(n).confidence / lm.confidence.max(1e-12))
+                                .fold(1.0, f64::min),
+                        ),
+                        row.join(","),
                     )
                 }
                 Err(e) => (
-                    vec![f64::INFINITY; 5],
-                    ms,
-                    Some(e.to_string()),
-                    0.0,
-                    0.0,
-                    0.0,
+                    (
+                        vec![f64::INFINITY; 5],
+                        ms,
+                        Some(e.to_string()),
+                        0.0,
+                        0.0,
+                        0.0,
+                    ),
+                    String::new(),
                 ),
             }
         })
-        .collect();
+        .unzip();
     pb.finish_and_clear();
     let mut per: Vec<Vec<f64>> = vec![Vec::new(); 5];
     for (e, ..) in &results {
@@ -331,6 +450,39 @@ pub fn run(args: Args) -> Result<()> {
         out.join("summary.json"),
         serde_json::to_string_pretty(&summary)? + "\n",
     )?;
+    // One row per face: errors, pose-only errors, canonical error vectors, expression.
+    let mut csv = String::from("face");
+    for n in &names {
+        csv += &format!(",{n}");
+    }
+    for n in &names {
+        csv += &format!(",{n}_pose_only");
+    }
+    csv += ",outer_eye_distance_true,outer_eye_distance_detected";
+    for n in &names {
+        csv += &format!(",{n}_xyz");
+    }
+    csv += ",cpu_ms,confidence,symmetry,local,error,expression\n";
+    for (k, (r, row)) in results.iter().zip(&rows).enumerate() {
+        let errs: Vec<String> = r.0.iter().map(|x| format!("{x:.2}")).collect();
+        let row = if row.is_empty() {
+            vec![String::new(); 12].join(",")
+        } else {
+            row.clone()
+        };
+        csv += &format!(
+            "{},{},{row},{:.1},{:.3},{:.3},{:.3},{},{}\n",
+            face_ids[k],
+            errs.join(","),
+            r.1,
+            r.3,
+            r.4,
+            r.5,
+            r.2.as_deref().unwrap_or("").replace(',', ";"),
+            labels[k]
+        );
+    }
+    std::fs::write(out.join("per-face.csv"), csv)?;
     let series: Vec<(String, Vec<f64>)> = names
         .iter()
         .zip(&per)

@@ -28,6 +28,9 @@ pub struct DetectOptions {
     /// confidence divided by the fit confidence) below which a fitted pose is rejected;
     /// calibrated on training faces. `0` disables the check.
     pub min_local_agreement: f64,
+    /// Place the landmarks with the model's learned regression (when it has one, see
+    /// [`crate::LandmarkRegressor`]) instead of the local template search alone.
+    pub use_regressor: bool,
 }
 
 impl Default for DetectOptions {
@@ -39,6 +42,7 @@ impl Default for DetectOptions {
             max_eye_candidates: 10,
             min_symmetry: 0.5,
             min_local_agreement: 0.85,
+            use_regressor: true,
         }
     }
 }
@@ -428,6 +432,12 @@ pub fn detect_with(
             continue;
         }
         let best = f.h;
+        let out = match &model.regressor {
+            Some(reg) if options.use_regressor => {
+                regressed(&idx, mesh_m, model, reg, &best.t, &out, debug)
+            }
+            _ => out,
+        };
         let out = out.map(|l| Landmark {
             position: mesh.position(l.vertex),
             ..l
@@ -495,6 +505,47 @@ fn refine_all(
         };
     }
     (out, weakest)
+}
+
+/// Landmarks placed by the learned regression of the model for the accepted pose `t`: the
+/// eye corners at the mesh vertex nearest to the regressed point; the nose tip, a strong
+/// feature, keeps its template search `tpl` (on 300 faces of a training stream the regression
+/// placed it within 5 mm less often: 96.7 % against 98.3 %). Confidences are those of the
+/// template search.
+fn regressed(
+    idx: &SurfaceIndex,
+    mesh: &TriMesh,
+    model: &GenericModel,
+    reg: &crate::LandmarkRegressor,
+    t: &Rigid,
+    tpl: &[Landmark; 5],
+    debug: bool,
+) -> [Landmark; 5] {
+    let q = reg.predict(mesh, t);
+    let mut out = *tpl;
+    for name in LandmarkName::ALL {
+        if name == LandmarkName::NoseTip {
+            continue;
+        }
+        let k = name as usize;
+        // An offset beyond what the training faces showed (their poses were kept within half
+        // the inner-eye distance of the truth) is an input the regression has not learned:
+        // the template search stays.
+        let off = q[k] - model.landmark(name);
+        if !(off.is_finite() && off.length() <= 0.5 * model.eye_distance()) {
+            continue;
+        }
+        let v = idx.query(t.apply(q[k])).vertex;
+        if debug {
+            eprintln!(
+                "{name}: regressed to vertex {v} (template search gave {})",
+                tpl[k].vertex
+            );
+        }
+        out[k].vertex = v;
+        out[k].position = idx.pos[v as usize];
+    }
+    out
 }
 
 /// Confidence in `[0, 1]` of a face fit from its inlier share and inlier RMS, relative to the

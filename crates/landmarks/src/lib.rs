@@ -18,10 +18,12 @@ mod detect;
 pub mod geom;
 pub mod io;
 mod model;
+mod regress;
 
 pub use curvature::{curvedness, shape_index, Curvature, CurvatureOptions};
 pub use detect::{detect, detect_with, DetectOptions};
 pub use model::{DetectParams, GenericModel, Template, TrainOptions};
+pub use regress::{LandmarkRegressor, RegressorOptions, RegressorPatch};
 
 use meshcore::{DAffine3, DVec3, MeshError};
 

@@ -5,6 +5,7 @@
 
 use crate::curvature::{vertex_curvatures, CurvatureOptions};
 use crate::geom::{kabsch, Rigid};
+use crate::regress::LandmarkRegressor;
 use crate::{LandmarkError, LandmarkName};
 use meshcore::{DVec3, TriMesh};
 use serde::{Deserialize, Serialize};
@@ -146,21 +147,25 @@ pub struct GenericModel {
     pub patches: Vec<Template>,
     /// Detection parameters.
     pub params: DetectParams,
+    /// Learned landmark offsets from the local depth maps (see [`LandmarkRegressor`]); absent in
+    /// models trained without it, which then use the local template search alone.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub regressor: Option<LandmarkRegressor>,
 }
 
 /// Front-most depth map of a triangle mesh along canonical `z` on a square grid.
-struct DepthMap {
-    x0: f64,
-    y0: f64,
-    h: f64,
-    nx: usize,
-    ny: usize,
-    z: Vec<f64>,
+pub(crate) struct DepthMap {
+    pub(crate) x0: f64,
+    pub(crate) y0: f64,
+    pub(crate) h: f64,
+    pub(crate) nx: usize,
+    pub(crate) ny: usize,
+    pub(crate) z: Vec<f64>,
     n: Vec<DVec3>,
 }
 
 impl DepthMap {
-    fn new(center: (f64, f64), radius: f64, h: f64) -> Self {
+    pub(crate) fn new(center: (f64, f64), radius: f64, h: f64) -> Self {
         let k = (radius / h).ceil() as usize;
         let nx = 2 * k + 1;
         Self {
@@ -177,9 +182,14 @@ impl DepthMap {
     /// Rasterises the triangles of `mesh` moved by `t`, keeping the largest `z` per node.
     fn rasterise(&mut self, mesh: &TriMesh, t: &Rigid) {
         let pos: Vec<DVec3> = mesh.positions().iter().map(|p| t.apply(*p)).collect();
+        self.rasterise_moved(&pos, mesh.triangles());
+    }
+
+    /// [`DepthMap::rasterise`] on positions already moved to the canonical frame.
+    pub(crate) fn rasterise_moved(&mut self, pos: &[DVec3], triangles: &[[u32; 3]]) {
         let xmax = self.x0 + (self.nx - 1) as f64 * self.h;
         let ymax = self.y0 + (self.ny - 1) as f64 * self.h;
-        for tri in mesh.triangles() {
+        for tri in triangles {
             let [a, b, c] = tri.map(|v| pos[v as usize]);
             let lo = a.min(b).min(c);
             let hi = a.max(b).max(c);
@@ -394,6 +404,9 @@ impl GenericModel {
         {
             return bad("non-positive size parameter in the model");
         }
+        if let Some(r) = &self.regressor {
+            r.validate()?;
+        }
         Ok(())
     }
 
@@ -556,6 +569,7 @@ impl GenericModel {
             face,
             patches,
             params,
+            regressor: None,
         };
         model.validate()?;
         // Typical fit quality on the training faces themselves.
