@@ -406,11 +406,24 @@ impl PointTree {
         }
     }
 
-    /// Every point within `r2[i]` (squared, inclusive) of `qs[i]`, as `(squared distance,
-    /// original index)` appended to `out[i]` (unordered), for a group of at most [`GROUP`]
-    /// nearby queries in one traversal.
-    fn collect_within(&self, qs: &[DVec3], r2: &[f64], out: &mut [Vec<(f64, u32)>]) {
-        let g = qs.len().min(r2.len()).min(out.len()).min(GROUP);
+    /// The `M` lexicographically smallest `(squared distance, original index)` among the
+    /// points within `r2[i]` (squared, inclusive) of `qs[i]` into `out[i]` (which must start
+    /// as `(inf, u32::MAX)` entries), and in `count[i]` how many points lie within, for a
+    /// group of at most [`GROUP`] nearby queries in one traversal. Every point is seen once
+    /// per query (the leaves partition the points), so no duplicate check is needed.
+    fn nearest_within<const M: usize>(
+        &self,
+        qs: &[DVec3],
+        r2: &[f64],
+        out: &mut [[(f64, u32); M]],
+        count: &mut [usize],
+    ) {
+        let g = qs
+            .len()
+            .min(r2.len())
+            .min(out.len())
+            .min(count.len())
+            .min(GROUP);
         if self.root == NONE || g == 0 {
             return;
         }
@@ -443,7 +456,16 @@ impl PointTree {
                                     (blk[0][l] - q.x, blk[1][l] - q.y, blk[2][l] - q.z);
                                 let d = dx * dx + dy * dy + dz * dz;
                                 if d <= r2[i] && ps[l] != NONE {
-                                    out[i].push((d, ps[l]));
+                                    count[i] += 1;
+                                    let b = &mut out[i];
+                                    if M > 0 && better(d, ps[l], b[M - 1].0, b[M - 1].1) {
+                                        let mut j = M - 1;
+                                        while j > 0 && better(d, ps[l], b[j - 1].0, b[j - 1].1) {
+                                            b[j] = b[j - 1];
+                                            j -= 1;
+                                        }
+                                        b[j] = (d, ps[l]);
+                                    }
                                 }
                             }
                         }
@@ -657,9 +679,6 @@ pub struct NeighbourGraph {
     th: Vec<[f32; GRAPH_K + 1]>,
 }
 
-/// Per-thread buffers of the graph build: the points found per query, the group distances.
-type Buffers = (Vec<Vec<(f64, u32)>>, Vec<f64>);
-
 /// `v` shrunk by a relative `1e-6` and rounded down to `f32` (a lower bound of `v`).
 fn lower_f32(v: f64) -> f32 {
     if v.is_infinite() {
@@ -698,7 +717,6 @@ impl NeighbourGraph {
         // point itself included), again with the (K + 2)-th distance within the group (sure
         // to hold K + 2 points); then the K + 2 smallest. Groups are independent: in parallel,
         // with the same result on any number of threads.
-        let cmp = |x: &(f64, u32), y: &(f64, u32)| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1));
         const PROBE: usize = 4;
         let scale = 1.2 * (GRAPH_K + 2) as f64 / PROBE as f64;
         let (pts_ref, ids_ref, pos_ref) = (&pts, &ids, &pos);
@@ -706,13 +724,15 @@ impl NeighbourGraph {
             .zip(th.par_chunks_mut(GROUP))
             .enumerate()
             .for_each_init(
-                || (vec![Vec::new(); GROUP], Vec::with_capacity(GROUP)),
-                |(found, local): &mut Buffers, (c, (nb, tt))| {
+                || Vec::with_capacity(GROUP),
+                |local: &mut Vec<f64>, (c, (nb, tt))| {
                     let lo = c * GROUP;
                     let qs = &pts_ref[lo..(lo + GROUP).min(n)];
                     let g = qs.len().min(nb.len());
                     let mut r2 = [f64::INFINITY; GROUP];
                     let mut sure = [f64::INFINITY; GROUP];
+                    let mut found = [[(f64::INFINITY, NONE); GRAPH_K + 2]; GROUP];
+                    let mut count = [0usize; GROUP];
                     for k in 0..g {
                         if g >= GRAPH_K + 2 {
                             local.clear();
@@ -724,33 +744,28 @@ impl NeighbourGraph {
                                 .select_nth_unstable_by(GRAPH_K + 1 - PROBE - 1, f64::total_cmp);
                             (r2[k], sure[k]) = (guess.min(*s), *s);
                         }
-                        found[k].clear();
                     }
-                    tree.collect_within(qs, &r2[..g], &mut found[..g]);
+                    tree.nearest_within(qs, &r2[..g], &mut found[..g], &mut count[..g]);
                     for k in 0..g {
-                        if found[k].len() < GRAPH_K + 2 && r2[k] < sure[k] {
-                            found[k].clear();
-                            tree.collect_within(
+                        if count[k] < GRAPH_K + 2 && r2[k] < sure[k] {
+                            found[k] = [(f64::INFINITY, NONE); GRAPH_K + 2];
+                            count[k] = 0;
+                            tree.nearest_within(
                                 &qs[k..k + 1],
                                 &sure[k..k + 1],
                                 &mut found[k..k + 1],
+                                &mut count[k..k + 1],
                             );
                         }
                     }
-                    for (k, f) in found.iter_mut().enumerate().take(g) {
+                    for (k, f) in found.iter().enumerate().take(g) {
                         let me = lo + k;
-                        let keep = (GRAPH_K + 2).min(f.len());
-                        if keep > 0 && keep < f.len() {
-                            f.select_nth_unstable_by(keep - 1, cmp);
-                        }
-                        f.truncate(keep);
-                        f.sort_unstable_by(cmp);
                         // Exact duplicates are also at 0, in any order: drop the point itself
                         // wherever it sits.
                         let mut m = 0;
                         nb[k] = [me as u32; GRAPH_K];
                         for &(d, j) in f.iter() {
-                            if j == ids_ref[me] || m > GRAPH_K {
+                            if j == NONE || j == ids_ref[me] || m > GRAPH_K {
                                 continue;
                             }
                             if m < GRAPH_K {
