@@ -9,8 +9,10 @@
 //! * [`detect`]: rotation- and translation-invariant detection. Curvature gives nose-tip (convex
 //!   cap) and inner-eye-corner (concave) candidates; their configurations give pose hypotheses;
 //!   the generic face surface is fitted (point-to-plane ICP) to choose and refine the pose;
-//!   each landmark is then refined by a local template search. Inputs that do not fit a face
-//!   (not a face, inverted normals) end with [`LandmarkError::NotFound`].
+//!   each landmark is then refined by a local template search and, when the model has a
+//!   [`LandmarkRegressor`] (the shipped one does), the eye corners are placed by its learned
+//!   regression from the local depth maps. Inputs that do not fit a face (not a face, inverted
+//!   normals) end with [`LandmarkError::NotFound`].
 //! * [`io`]: `.lm3` reader and writer, the ICT `landmarks.json` layout, JSON output.
 
 pub mod curvature;

@@ -365,6 +365,14 @@ impl GenericModel {
         for l in &mut m.landmarks {
             l.iter_mut().for_each(r);
         }
+        if let Some(reg) = &mut m.regressor {
+            let r6 = |x: &mut f64| *x = (*x * 1e6).round() / 1e6;
+            for p in &mut reg.patches {
+                p.mean.iter_mut().for_each(r);
+                p.coef.iter_mut().flatten().for_each(r6);
+                p.intercept.iter_mut().for_each(r6);
+            }
+        }
         serde_json::to_string(&m).unwrap_or_default()
     }
 
