@@ -48,10 +48,10 @@ pub struct PreparedSet {
     radius: f64,
     tree: ImmutableKdTree<f64, 3>,
     nn: PointTree,
-    graph: OnceLock<NeighbourGraph>,
+    graph: NeighbourGraph,
     sub_points: Vec<DVec3>,
     sub_nn: PointTree,
-    sub_graph: OnceLock<NeighbourGraph>,
+    sub_graph: NeighbourGraph,
     normals_k: usize,
     normals: OnceLock<Vec<DVec3>>,
 }
@@ -104,16 +104,22 @@ impl PreparedSet {
             idx.iter().map(|&i| pts[i]).collect()
         };
         let sub_nn = PointTree::new(&sub_points);
+        let nn = PointTree::new(&pts);
+        // Built here rather than lazily: the build runs in parallel, and a lazy cell
+        // initialised from inside a rayon task (a distance matrix) could be re-entered by a
+        // stolen task of the same thread.
+        let graph = NeighbourGraph::new(&nn);
+        let sub_graph = NeighbourGraph::new(&sub_nn);
         Ok(Self {
             radius: radius(&pts),
-            nn: PointTree::new(&pts),
-            graph: OnceLock::new(),
+            nn,
+            graph,
             points: pts,
             centroid: c,
             tree,
             sub_points,
             sub_nn,
-            sub_graph: OnceLock::new(),
+            sub_graph,
             normals_k: opts.normals_k.max(3),
             normals: OnceLock::new(),
         })
@@ -142,11 +148,13 @@ impl PreparedSet {
     /// Unit normals by PCA of the `normals_k` nearest neighbours (computed on first use; the
     /// sign is arbitrary, which point-to-plane does not care about).
     pub fn normals(&self) -> &[DVec3] {
+        // Sequential on purpose: a once cell initialised with rayon inside a rayon task
+        // (a distance matrix) could be re-entered by a task the same thread steals.
         self.normals.get_or_init(|| {
             let k = NonZero::new(self.normals_k.min(self.points.len()).max(1))
                 .unwrap_or(NonZero::<usize>::MIN);
             self.points
-                .par_iter()
+                .iter()
                 .map(|p| {
                     let nn = self.tree.nearest_n::<SquaredEuclidean>(&p.to_array(), k);
                     let m = nn
@@ -165,15 +173,14 @@ impl PreparedSet {
         })
     }
 
-    /// The exact neighbour graph of the centred points (built on first use: when the set is
-    /// the target of an ICP run).
+    /// The exact neighbour graph of the centred points (used when the set is the target of
+    /// an ICP run).
     pub fn graph(&self) -> &NeighbourGraph {
-        self.graph.get_or_init(|| NeighbourGraph::new(&self.nn))
+        &self.graph
     }
 
     fn sub_graph(&self) -> &NeighbourGraph {
-        self.sub_graph
-            .get_or_init(|| NeighbourGraph::new(&self.sub_nn))
+        &self.sub_graph
     }
 
     /// The exact nearest-neighbour tree of the centred points (its leaf order is the order in
