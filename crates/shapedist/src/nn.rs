@@ -326,58 +326,30 @@ impl PointTree {
         }
     }
 
-    fn group(&self, qs: &[DVec3], best: &mut [(f64, u32)]) {
-        let g = qs.len().min(best.len()).min(GROUP);
-        let (qs, best) = (&qs[..g], &mut best[..g]);
-        if self.root == NONE || g == 0 {
+    /// Depth-first walk over the subtrees whose box is within `bnd` (squared) of the group
+    /// box `[glo, ghi]`, the child nearer to `centre` first. `leaf` is called on every leaf
+    /// reached and returns the new bound, which must not grow (the queries' bests only
+    /// improve); subtrees waiting on the stack are dropped once beyond it.
+    #[inline(always)]
+    fn walk_group(
+        &self,
+        glo: DVec3,
+        ghi: DVec3,
+        centre: DVec3,
+        mut bnd: f64,
+        mut leaf: impl FnMut(&Leaf) -> f64,
+    ) {
+        if self.root == NONE || box_box_dist2(self.root_box.0, self.root_box.1, glo, ghi) > bnd {
             return;
         }
-        // The queries and their bounds as structure of arrays, padded to a whole group with
-        // a bound below zero (never within any box), so that the per-leaf box tests below run
-        // over fixed-length arrays (the compiler turns them into vector code).
-        let mut qx = [0.0f64; GROUP];
-        let mut qy = [0.0f64; GROUP];
-        let mut qz = [0.0f64; GROUP];
-        let mut bd = [-1.0f64; GROUP];
-        let (mut glo, mut ghi) = (qs[0], qs[0]);
-        let mut centre = DVec3::ZERO;
-        for (i, &q) in qs.iter().enumerate() {
-            glo = glo.min(q);
-            ghi = ghi.max(q);
-            centre += q;
-            (qx[i], qy[i], qz[i]) = (q.x, q.y, q.z);
-            bd[i] = best[i].0;
-        }
-        let centre = (centre / g as f64).to_array();
-        let bound = |bd: &[f64; GROUP]| bd.iter().fold(0.0f64, |m, &b| max(m, b));
-        let mut bnd = bound(&bd);
-        if box_box_dist2(self.root_box.0, self.root_box.1, glo, ghi) > bnd {
-            return;
-        }
-        let (gl, gh) = (glo.to_array(), ghi.to_array());
-        let mut buf: Scratch = [[0.0; LANES]; LEAF_SIZE / LANES + 1];
+        let (gl, gh, centre) = (glo.to_array(), ghi.to_array(), centre.to_array());
         let mut stack: [(u32, f64); 64] = [(0, 0.0); 64];
-        let mut hit = [false; GROUP];
         let mut sp = 0usize;
         let mut cur = self.root;
         loop {
             if cur & LEAF_BIT != 0 {
                 if let Some(lf) = self.leaves.get((cur & !LEAF_BIT) as usize) {
-                    // Same formula as `box_dist2`, one query per lane.
-                    for i in 0..GROUP {
-                        let gx = max(max(lf.lo.x - qx[i], qx[i] - lf.hi.x), 0.0);
-                        let gy = max(max(lf.lo.y - qy[i], qy[i] - lf.hi.y), 0.0);
-                        let gz = max(max(lf.lo.z - qz[i], qz[i] - lf.hi.z), 0.0);
-                        hit[i] = gx * gx + gy * gy + gz * gz <= bd[i];
-                    }
-                    for i in 0..g {
-                        if hit[i] {
-                            let q = DVec3::new(qx[i], qy[i], qz[i]);
-                            self.scan_leaf(lf.a as usize, lf.b as usize, q, &mut best[i], &mut buf);
-                            bd[i] = best[i].0;
-                        }
-                    }
-                    bnd = bound(&bd);
+                    bnd = leaf(lf);
                 }
             } else if let Some(n) = self.inner.get(cur as usize) {
                 let d = child_box_dist2(n, gl, gh);
@@ -404,6 +376,57 @@ impl PointTree {
                 }
             }
         }
+    }
+
+    /// Box and mean of a group of queries.
+    fn group_box(qs: &[DVec3]) -> (DVec3, DVec3, DVec3) {
+        let (mut glo, mut ghi, mut c) = (qs[0], qs[0], DVec3::ZERO);
+        for &q in qs {
+            glo = glo.min(q);
+            ghi = ghi.max(q);
+            c += q;
+        }
+        (glo, ghi, c / qs.len() as f64)
+    }
+
+    fn group(&self, qs: &[DVec3], best: &mut [(f64, u32)]) {
+        let g = qs.len().min(best.len()).min(GROUP);
+        let (qs, best) = (&qs[..g], &mut best[..g]);
+        if g == 0 {
+            return;
+        }
+        // The queries and their bounds as structure of arrays, padded to a whole group with
+        // a bound below zero (never within any box), so that the per-leaf box tests below run
+        // over fixed-length arrays (the compiler turns them into vector code).
+        let mut qx = [0.0f64; GROUP];
+        let mut qy = [0.0f64; GROUP];
+        let mut qz = [0.0f64; GROUP];
+        let mut bd = [-1.0f64; GROUP];
+        for (i, &q) in qs.iter().enumerate() {
+            (qx[i], qy[i], qz[i]) = (q.x, q.y, q.z);
+            bd[i] = best[i].0;
+        }
+        let (glo, ghi, centre) = Self::group_box(qs);
+        let bound = |bd: &[f64; GROUP]| bd.iter().fold(0.0f64, |m, &b| max(m, b));
+        let mut buf: Scratch = [[0.0; LANES]; LEAF_SIZE / LANES + 1];
+        let mut hit = [false; GROUP];
+        self.walk_group(glo, ghi, centre, bound(&bd), |lf| {
+            // Same formula as `box_dist2`, one query per lane.
+            for i in 0..GROUP {
+                let gx = max(max(lf.lo.x - qx[i], qx[i] - lf.hi.x), 0.0);
+                let gy = max(max(lf.lo.y - qy[i], qy[i] - lf.hi.y), 0.0);
+                let gz = max(max(lf.lo.z - qz[i], qz[i] - lf.hi.z), 0.0);
+                hit[i] = gx * gx + gy * gy + gz * gz <= bd[i];
+            }
+            for i in 0..g {
+                if hit[i] {
+                    let q = DVec3::new(qx[i], qy[i], qz[i]);
+                    self.scan_leaf(lf.a as usize, lf.b as usize, q, &mut best[i], &mut buf);
+                    bd[i] = best[i].0;
+                }
+            }
+            bound(&bd)
+        });
     }
 
     /// The `M` lexicographically smallest `(squared distance, original index)` among the
@@ -424,70 +447,40 @@ impl PointTree {
             .min(out.len())
             .min(count.len())
             .min(GROUP);
-        if self.root == NONE || g == 0 {
+        if g == 0 || M == 0 {
             return;
         }
         let (qs, r2) = (&qs[..g], &r2[..g]);
-        let (mut glo, mut ghi) = (qs[0], qs[0]);
-        for &q in qs {
-            glo = glo.min(q);
-            ghi = ghi.max(q);
-        }
+        let (glo, ghi, centre) = Self::group_box(qs);
         let bnd = r2.iter().fold(0.0f64, |m, &b| max(m, b));
-        let (gl, gh) = (glo.to_array(), ghi.to_array());
-        let mut stack: [u32; 64] = [0; 64];
-        let mut sp = 0usize;
-        let mut cur = self.root;
-        if box_box_dist2(self.root_box.0, self.root_box.1, glo, ghi) > bnd {
-            return;
-        }
-        loop {
-            if cur & LEAF_BIT != 0 {
-                if let Some(lf) = self.leaves.get((cur & !LEAF_BIT) as usize) {
-                    let blocks = &self.blocks[lf.a as usize / LANES..lf.b as usize / LANES];
-                    let pids = &self.pids[lf.a as usize..lf.b as usize];
-                    for (i, q) in qs.iter().enumerate() {
-                        if box_dist2(lf.lo, lf.hi, *q) > r2[i] {
-                            continue;
-                        }
-                        for (blk, ps) in blocks.iter().zip(pids.chunks_exact(LANES)) {
-                            for l in 0..LANES {
-                                let (dx, dy, dz) =
-                                    (blk[0][l] - q.x, blk[1][l] - q.y, blk[2][l] - q.z);
-                                let d = dx * dx + dy * dy + dz * dz;
-                                if d <= r2[i] && ps[l] != NONE {
-                                    count[i] += 1;
-                                    let b = &mut out[i];
-                                    if M > 0 && better(d, ps[l], b[M - 1].0, b[M - 1].1) {
-                                        let mut j = M - 1;
-                                        while j > 0 && better(d, ps[l], b[j - 1].0, b[j - 1].1) {
-                                            b[j] = b[j - 1];
-                                            j -= 1;
-                                        }
-                                        b[j] = (d, ps[l]);
-                                    }
+        self.walk_group(glo, ghi, centre, bnd, |lf| {
+            let blocks = &self.blocks[lf.a as usize / LANES..lf.b as usize / LANES];
+            let pids = &self.pids[lf.a as usize..lf.b as usize];
+            for (i, q) in qs.iter().enumerate() {
+                if box_dist2(lf.lo, lf.hi, *q) > r2[i] {
+                    continue;
+                }
+                for (blk, ps) in blocks.iter().zip(pids.chunks_exact(LANES)) {
+                    for l in 0..LANES {
+                        let (dx, dy, dz) = (blk[0][l] - q.x, blk[1][l] - q.y, blk[2][l] - q.z);
+                        let d = dx * dx + dy * dy + dz * dz;
+                        if d <= r2[i] && ps[l] != NONE {
+                            count[i] += 1;
+                            let b = &mut out[i];
+                            if better(d, ps[l], b[M - 1].0, b[M - 1].1) {
+                                let mut j = M - 1;
+                                while j > 0 && better(d, ps[l], b[j - 1].0, b[j - 1].1) {
+                                    b[j] = b[j - 1];
+                                    j -= 1;
                                 }
+                                b[j] = (d, ps[l]);
                             }
                         }
                     }
                 }
-            } else if let Some(n) = self.inner.get(cur as usize) {
-                let d = child_box_dist2(n, gl, gh);
-                if d[1] <= bnd && sp < stack.len() {
-                    stack[sp] = n.child[1];
-                    sp += 1;
-                }
-                if d[0] <= bnd {
-                    cur = n.child[0];
-                    continue;
-                }
             }
-            if sp == 0 {
-                return;
-            }
-            sp -= 1;
-            cur = stack[sp];
-        }
+            bnd
+        });
     }
 
     /// The `K` nearest neighbours of each query of a group (at most [`GROUP`] at a time, like
@@ -496,78 +489,29 @@ impl PointTree {
     /// distinct indices (padded with `(inf, u32::MAX)` where the tree has fewer points). On
     /// entry `best[i]` must hold candidates: a seed in the same form (each `d2` the [`dist2`]
     /// of the query and that point, ordered, distinct indices, the rest `(inf, u32::MAX)`).
-    ///
-    /// The `K`-th distance is what makes a candidate list reusable: a query that has moved by
-    /// `delta` still has its nearest neighbour among the `K` candidates whenever the best of
-    /// them is nearer than `d_K - delta` (triangle inequality; see the ICP loop).
     pub fn nearest_k_group<const K: usize>(&self, qs: &[DVec3], best: &mut [[(f64, u32); K]]) {
         if K == 0 {
             return;
         }
         for (q, b) in qs.chunks(GROUP).zip(best.chunks_mut(GROUP)) {
-            self.group_k(q, b);
-        }
-    }
-
-    fn group_k<const K: usize>(&self, qs: &[DVec3], best: &mut [[(f64, u32); K]]) {
-        let g = qs.len().min(best.len());
-        let (qs, best) = (&qs[..g], &mut best[..g]);
-        if self.root == NONE || g == 0 {
-            return;
-        }
-        let (mut glo, mut ghi) = (qs[0], qs[0]);
-        let mut centre = DVec3::ZERO;
-        for &q in qs {
-            glo = glo.min(q);
-            ghi = ghi.max(q);
-            centre += q;
-        }
-        let centre = (centre / g as f64).to_array();
-        // A subtree is needed while its box is within some query's K-th distance.
-        let bound = |best: &[[(f64, u32); K]]| best.iter().fold(0.0f64, |m, b| max(m, b[K - 1].0));
-        let mut bnd = bound(best);
-        if box_box_dist2(self.root_box.0, self.root_box.1, glo, ghi) > bnd {
-            return;
-        }
-        let (gl, gh) = (glo.to_array(), ghi.to_array());
-        let mut buf: Scratch = [[0.0; LANES]; LEAF_SIZE / LANES + 1];
-        let mut stack: [(u32, f64); 64] = [(0, 0.0); 64];
-        let mut sp = 0usize;
-        let mut cur = self.root;
-        loop {
-            if cur & LEAF_BIT != 0 {
-                if let Some(lf) = self.leaves.get((cur & !LEAF_BIT) as usize) {
-                    for (q, b) in qs.iter().zip(best.iter_mut()) {
-                        if box_dist2(lf.lo, lf.hi, *q) <= b[K - 1].0 {
-                            self.scan_leaf_k(lf.a as usize, lf.b as usize, *q, b, &mut buf);
-                        }
+            let g = q.len().min(b.len());
+            if g == 0 {
+                continue;
+            }
+            let (q, b) = (&q[..g], &mut b[..g]);
+            let (glo, ghi, centre) = Self::group_box(q);
+            // A subtree is needed while its box is within some query's K-th distance.
+            let bound = |b: &[[(f64, u32); K]]| b.iter().fold(0.0f64, |m, x| max(m, x[K - 1].0));
+            let mut buf: Scratch = [[0.0; LANES]; LEAF_SIZE / LANES + 1];
+            let start = bound(b);
+            self.walk_group(glo, ghi, centre, start, |lf| {
+                for (x, y) in q.iter().zip(b.iter_mut()) {
+                    if box_dist2(lf.lo, lf.hi, *x) <= y[K - 1].0 {
+                        self.scan_leaf_k(lf.a as usize, lf.b as usize, *x, y, &mut buf);
                     }
-                    bnd = bound(best);
                 }
-            } else if let Some(n) = self.inner.get(cur as usize) {
-                let d = child_box_dist2(n, gl, gh);
-                let o = child_dist2(n, centre);
-                let (f, s) = if o[0] <= o[1] { (0, 1) } else { (1, 0) };
-                if d[s] <= bnd && sp < stack.len() {
-                    stack[sp] = (n.child[s], d[s]);
-                    sp += 1;
-                }
-                if d[f] <= bnd {
-                    cur = n.child[f];
-                    continue;
-                }
-            }
-            loop {
-                if sp == 0 {
-                    return;
-                }
-                sp -= 1;
-                let (c, dc) = stack[sp];
-                if dc <= bnd {
-                    cur = c;
-                    break;
-                }
-            }
+                bound(b)
+            });
         }
     }
 
