@@ -72,6 +72,9 @@ pub struct Args {
     /// `RegressorOptions::ridge`.
     #[arg(long)]
     pub regressor_ridge: Option<f64>,
+    /// `RegressorOptions::perturbations` (extra perturbed poses per training face).
+    #[arg(long)]
+    pub regressor_perturbations: Option<usize>,
     /// Detect without the model's landmark regression (template search alone).
     #[arg(long)]
     pub no_regressor: bool,
@@ -227,6 +230,9 @@ pub fn run(args: Args) -> Result<()> {
         }
         if let Some(x) = args.regressor_ridge {
             ro.ridge = x;
+        }
+        if let Some(x) = args.regressor_perturbations {
+            ro.perturbations = x;
         }
         generic.regressor = Some(fit_regressor(&ict, &generic, n, args.regressor_seed, &ro)?);
     }

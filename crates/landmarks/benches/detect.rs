@@ -36,6 +36,15 @@ fn bench(c: &mut Criterion) {
             g.bench_function("detect/face-6706", |b| {
                 b.iter(|| black_box(landmarks::detect(black_box(&face), &model).is_ok()))
             });
+            let plain = landmarks::DetectOptions {
+                use_regressor: false,
+                ..Default::default()
+            };
+            g.bench_function("detect-template-only/face-6706", |b| {
+                b.iter(|| {
+                    black_box(landmarks::detect_with(black_box(&face), &model, &plain).is_ok())
+                })
+            });
             g.bench_function("curvature/face-6706", |b| {
                 b.iter(|| black_box(vertex_curvatures(black_box(&face), &copt).len()))
             });

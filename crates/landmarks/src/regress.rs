@@ -28,6 +28,16 @@ pub struct RegressorOptions {
     pub spacing: f64,
     /// Ridge penalty relative to the mean diagonal of the normal matrix.
     pub ridge: f64,
+    /// Extra training samples per face with the fitted pose moved by a small random rigid
+    /// motion (deterministic).
+    #[serde(default)]
+    pub perturbations: usize,
+    /// Standard deviation of the rotation angle of those motions (degrees).
+    #[serde(default)]
+    pub perturb_angle_deg: f64,
+    /// Standard deviation of each translation coordinate of those motions / d.
+    #[serde(default)]
+    pub perturb_shift: f64,
 }
 
 impl Default for RegressorOptions {
@@ -36,6 +46,9 @@ impl Default for RegressorOptions {
             radius: 0.6,
             spacing: 0.08,
             ridge: 0.1,
+            perturbations: 0,
+            perturb_angle_deg: 2.0,
+            perturb_shift: 0.04,
         }
     }
 }
@@ -147,6 +160,34 @@ fn cholesky_solve(mut a: Vec<f64>, n: usize, mut b: Vec<[f64; 3]>) -> Option<Vec
     Some(b)
 }
 
+/// A deterministic pseudo-random rigid motion: rotation by an angle with standard deviation
+/// `angle` about a random axis through the origin, then a translation with standard deviation
+/// `shift` per coordinate (splitmix64 and Box-Muller on `seed`).
+fn perturbation(seed: u64, angle: f64, shift: f64) -> Rigid {
+    let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0xD1B5_4A32_D192_ED03;
+    let mut uniform = || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        ((z >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    };
+    let mut normal = || {
+        let (u, v) = (uniform(), uniform());
+        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+    };
+    let axis = DVec3::new(normal(), normal(), normal()).normalize_or_zero();
+    let a = angle * normal();
+    let r = if axis == DVec3::ZERO {
+        meshcore::DMat3::IDENTITY
+    } else {
+        meshcore::DMat3::from_axis_angle(axis, a)
+    };
+    let t = DVec3::new(normal(), normal(), normal()) * shift;
+    Rigid { r, t }
+}
+
 fn rigid_of(a: &DAffine3) -> Rigid {
     Rigid {
         r: a.matrix3,
@@ -208,9 +249,25 @@ impl LandmarkRegressor {
             }
             used += 1;
             let canon: Vec<DVec3> = mesh.positions().iter().map(|p| inv.apply(*p)).collect();
-            for (k, p) in patches.iter().enumerate() {
-                xs[k].push(raw_inputs(&patch_depths(&canon, mesh.triangles(), p)));
-                ys[k].push(canon_truth[k] - DVec3::from_array(p.center));
+            // The detected pose, then the same pose moved by small random rigid motions about
+            // the nose tip (canonical origin): the regression then learns to correct pose errors
+            // too, not only the offsets seen under the detector's typical pose error.
+            for j in 0..=opt.perturbations {
+                let delta = if j == 0 {
+                    Rigid::IDENTITY
+                } else {
+                    perturbation(
+                        (used as u64) << 16 | j as u64,
+                        opt.perturb_angle_deg.to_radians(),
+                        opt.perturb_shift * d,
+                    )
+                };
+                let di = delta.inverse();
+                let moved: Vec<DVec3> = canon.iter().map(|p| di.apply(*p)).collect();
+                for (k, p) in patches.iter().enumerate() {
+                    xs[k].push(raw_inputs(&patch_depths(&moved, mesh.triangles(), p)));
+                    ys[k].push(di.apply(canon_truth[k]) - DVec3::from_array(p.center));
+                }
             }
         }
         if used < 10 {
@@ -248,7 +305,7 @@ impl LandmarkRegressor {
                     };
                 }
             }
-            let ymean = ys[k].iter().copied().sum::<DVec3>() / used as f64;
+            let ymean = ys[k].iter().copied().sum::<DVec3>() / ys[k].len() as f64;
             // Normal equations with a ridge.
             let mut a = vec![0.0; m * m];
             let mut b = vec![[0.0; 3]; m];
@@ -418,6 +475,35 @@ mod tests {
             err < 0.1 * base,
             "regression error {err} vs {base} without it"
         );
+    }
+
+    #[test]
+    fn perturbed_poses_enter_the_training_deterministically() {
+        let model = GenericModel::default_model().unwrap();
+        let faces: Vec<(TriMesh, [DVec3; 5])> = (0..12)
+            .map(|s| {
+                let r = 0.02 * s as f64;
+                bumpy(&model, [DVec3::new(r, -r, 0.0); 5])
+            })
+            .collect();
+        let samples: Vec<(&TriMesh, [DVec3; 5], DAffine3)> = faces
+            .iter()
+            .map(|(m, l)| (m, *l, DAffine3::IDENTITY))
+            .collect();
+        let plain = RegressorOptions::default();
+        let perturbed = RegressorOptions {
+            perturbations: 2,
+            ..plain
+        };
+        let a = LandmarkRegressor::train(&model, &samples, &plain).unwrap();
+        let b = LandmarkRegressor::train(&model, &samples, &perturbed).unwrap();
+        let c = LandmarkRegressor::train(&model, &samples, &perturbed).unwrap();
+        assert_eq!(a.n_training, b.n_training);
+        assert_ne!(a.patches, b.patches, "the perturbed samples change the fit");
+        assert_eq!(b, c, "same samples, same regression");
+        let p = perturbation(7, 2f64.to_radians(), 0.1);
+        assert!((p.r.determinant() - 1.0).abs() < 1e-12);
+        assert!(p.t.length() < 1.0 && p != Rigid::IDENTITY);
     }
 
     #[test]
