@@ -8,6 +8,7 @@
 #![allow(clippy::needless_range_loop)] // Dense small linear algebra reads best with indices.
 
 use meshcore::{DVec3, TriMesh};
+use rayon::prelude::*;
 
 /// Principal curvatures and directions at one vertex.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -293,20 +294,25 @@ pub fn vertex_curvatures_with(
 ) -> Vec<Curvature> {
     let pos = mesh.positions();
     let n = pos.len();
-    let mut ball = BallCollector::new(n);
-    let mut nb = Vec::new();
     let radius = options.radius.max(0.0);
     let min_count = options.min_neighbours.max(5) + 1;
+    // Vertices are independent: in parallel, each result computed exactly as on one thread
+    // (the ball collector's state only marks visited vertices), collected in vertex order.
     (0..n as u32)
-        .map(|v| {
-            let p = pos[v as usize];
-            let nrm = normals[v as usize];
-            if nrm == DVec3::ZERO {
-                return flat(DVec3::Z);
-            }
-            ball.collect(adj, pos, v, p, radius, min_count, &mut nb);
-            fit_vertex(pos, p, nrm, &nb, radius).unwrap_or_else(|| flat(nrm))
-        })
+        .into_par_iter()
+        .with_min_len(256)
+        .map_init(
+            || (BallCollector::new(n), Vec::new()),
+            |(ball, nb), v| {
+                let p = pos[v as usize];
+                let nrm = normals[v as usize];
+                if nrm == DVec3::ZERO {
+                    return flat(DVec3::Z);
+                }
+                ball.collect(adj, pos, v, p, radius, min_count, nb);
+                fit_vertex(pos, p, nrm, nb, radius).unwrap_or_else(|| flat(nrm))
+            },
+        )
         .collect()
 }
 

@@ -9,6 +9,7 @@ use crate::geom::{icp, kabsch, score, FitScore, Rigid, SurfaceIndex};
 use crate::model::GenericModel;
 use crate::{Landmark, LandmarkError, LandmarkName, Landmarks};
 use meshcore::{DAffine3, DMat3, DVec3, TriMesh};
+use rayon::prelude::*;
 
 /// Options of [`detect_with`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -313,8 +314,10 @@ pub fn detect_with(
             }
         }
         let coarse: Vec<(DVec3, DVec3)> = face.iter().step_by(3).copied().collect();
+        // Hypotheses, coarse fits and fine fits are independent: in parallel, collected in
+        // order (the same results on any number of threads).
         let mut scored: Vec<Hypothesis> = hyps
-            .iter()
+            .par_iter()
             .map(|t| Hypothesis {
                 t: *t,
                 fit: score(&idx, &coarse, t, 3.0 * tau, 0.3),
@@ -337,7 +340,7 @@ pub fn detect_with(
         // Coarse ICP of the best hypotheses with a wide inlier band, then the nominal band on the
         // best three.
         let mut coarse_fits: Vec<Hypothesis> = scored
-            .iter()
+            .par_iter()
             .map(|h| {
                 let t = icp(&idx, &coarse, &h.t, 8, 3.0 * tau, 0.3);
                 Hypothesis {
@@ -348,16 +351,20 @@ pub fn detect_with(
             .collect();
         coarse_fits.sort_by(|a, b| a.fit.cost.total_cmp(&b.fit.cost));
         let coarse_fits = diverse(coarse_fits, keys, 0.25 * d, 3);
-        for h in &coarse_fits {
-            let t2 = icp(&idx, &face, &h.t, 12, tau, 0.5);
-            let fit = score(&idx, &face, &t2, tau, 0.5);
-            fits.push(Verified {
-                h: Hypothesis { t: t2, fit },
-                conf: fit_confidence(&fit, p.typical_rms, p.typical_inliers),
-                sym: symmetry(&idx, &face, &t2, tau),
-                refined: None,
-            });
-        }
+        let fine: Vec<Verified> = coarse_fits
+            .par_iter()
+            .map(|h| {
+                let t2 = icp(&idx, &face, &h.t, 12, tau, 0.5);
+                let fit = score(&idx, &face, &t2, tau, 0.5);
+                Verified {
+                    h: Hypothesis { t: t2, fit },
+                    conf: fit_confidence(&fit, p.typical_rms, p.typical_inliers),
+                    sym: symmetry(&idx, &face, &t2, tau),
+                    refined: None,
+                }
+            })
+            .collect();
+        fits.extend(fine);
         fits.sort_by(|a, b| a.h.fit.cost.total_cmp(&b.h.fit.cost));
         if debug {
             for f in &fits {
