@@ -526,19 +526,7 @@ impl PointTree {
         best: &mut [(f64, u32); K],
         buf: &mut Scratch,
     ) {
-        let blocks = &self.blocks[a / LANES..b / LANES];
-        let mut m = [f64::INFINITY; LANES];
-        for (blk, o) in blocks.iter().zip(buf.iter_mut()) {
-            for l in 0..LANES {
-                let (dx, dy, dz) = (blk[0][l] - q.x, blk[1][l] - q.y, blk[2][l] - q.z);
-                let d = dx * dx + dy * dy + dz * dz;
-                o[l] = d;
-                m[l] = if d < m[l] { d } else { m[l] };
-            }
-        }
-        let dm = m
-            .iter()
-            .fold(f64::INFINITY, |u, &v| if v < u { v } else { u });
+        let dm = self.leaf_distances(a, b, q, buf);
         if dm > best[K - 1].0 {
             return;
         }
@@ -553,11 +541,10 @@ impl PointTree {
         }
     }
 
-    /// Scans the padded leaf `[a, b)`: the distances four lanes at a time into `buf`
-    /// (scratch) with their minimum, then, only if that minimum can improve on or tie the
-    /// best, the lowest index among the points at the minimum (the tie rule).
+    /// Squared distances of `q` to the points of the padded leaf `[a, b)`, four lanes at a
+    /// time, into `buf`; returns their minimum.
     #[inline(always)]
-    fn scan_leaf(&self, a: usize, b: usize, q: DVec3, best: &mut (f64, u32), buf: &mut Scratch) {
+    fn leaf_distances(&self, a: usize, b: usize, q: DVec3, buf: &mut Scratch) -> f64 {
         let blocks = &self.blocks[a / LANES..b / LANES];
         let mut m = [f64::INFINITY; LANES];
         for (blk, o) in blocks.iter().zip(buf.iter_mut()) {
@@ -568,9 +555,16 @@ impl PointTree {
                 m[l] = if d < m[l] { d } else { m[l] };
             }
         }
-        let dm = m
-            .iter()
-            .fold(f64::INFINITY, |u, &v| if v < u { v } else { u });
+        m.iter()
+            .fold(f64::INFINITY, |u, &v| if v < u { v } else { u })
+    }
+
+    /// Scans the padded leaf `[a, b)`: the distances four lanes at a time into `buf`
+    /// (scratch) with their minimum, then, only if that minimum can improve on or tie the
+    /// best, the lowest index among the points at the minimum (the tie rule).
+    #[inline(always)]
+    fn scan_leaf(&self, a: usize, b: usize, q: DVec3, best: &mut (f64, u32), buf: &mut Scratch) {
+        let dm = self.leaf_distances(a, b, q, buf);
         if dm > best.0 {
             return;
         }
