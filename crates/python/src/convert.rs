@@ -1,0 +1,284 @@
+//! numpy arrays in and out, with every check a caller from Python needs: type and dtype,
+//! shape, index range. Non-contiguous arrays are read through their strides (no copy is
+//! required from the caller); values NaN / infinite are left to the library checks, which name
+//! the offending vertex or point.
+
+use crate::errors;
+use glam::DVec3;
+use numpy::ndarray::{Array1, Array2};
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods,
+    PyUntypedArray, PyUntypedArrayMethods,
+};
+use pyo3::prelude::*;
+
+/// `obj` as a numpy array (`numpy.asarray` for lists, tuples and other array-likes).
+fn as_ndarray<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyUntypedArray>> {
+    if let Ok(a) = obj.cast::<PyUntypedArray>() {
+        return Ok(a.clone());
+    }
+    let py = obj.py();
+    let arr = py
+        .import("numpy")?
+        .call_method1("asarray", (obj,))
+        .map_err(|e| errors::type_error(format!("{what}: cannot be read as an array ({e})")))?;
+    arr.cast_into::<PyUntypedArray>()
+        .map_err(|_| errors::type_error(format!("{what}: cannot be read as an array")))
+}
+
+fn dtype_name(a: &Bound<'_, PyUntypedArray>) -> String {
+    a.dtype()
+        .str()
+        .map(|s| s.to_string())
+        .unwrap_or_else(|_| "?".into())
+}
+
+/// `obj` as a float64 array: real floating and integer dtypes are converted (exactly for
+/// float16/32 and integers below 2^53), anything else (bool, complex, strings, objects) is an
+/// `InputTypeError`.
+pub fn f64_array<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    let a = as_ndarray(obj, what)?;
+    let kind = a.dtype().kind();
+    if !matches!(kind, b'f' | b'i' | b'u') {
+        return Err(errors::type_error(format!(
+            "{what} must be an array of real numbers, got dtype {}",
+            dtype_name(&a)
+        )));
+    }
+    let a = if a.dtype().is_equiv_to(&numpy::dtype::<f64>(obj.py())) {
+        a.into_any()
+    } else {
+        a.call_method1("astype", ("float64",))?
+    };
+    a.cast_into::<PyArrayDyn<f64>>()
+        .map_err(|_| errors::type_error(format!("{what}: expected a float64 array")))
+}
+
+/// `obj` as an int64 array; integer dtypes only (a float array of indices is an
+/// `InputTypeError`, as numpy's own indexing has it). uint64 values above `i64::MAX` are
+/// rejected.
+pub fn i64_array<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyArrayDyn<i64>>> {
+    let a = as_ndarray(obj, what)?;
+    let kind = a.dtype().kind();
+    if !matches!(kind, b'i' | b'u') {
+        return Err(errors::type_error(format!(
+            "{what} must be an array of integers, got dtype {}",
+            dtype_name(&a)
+        )));
+    }
+    if kind == b'u' && a.dtype().itemsize() == 8 {
+        let max = a.call_method0("max");
+        if let Ok(m) = max {
+            let m: u64 = m.extract().unwrap_or(0);
+            if m > i64::MAX as u64 {
+                return Err(errors::index(format!("{what}: value {m} is out of range")));
+            }
+        }
+    }
+    let a = if a.dtype().is_equiv_to(&numpy::dtype::<i64>(obj.py())) {
+        a.into_any()
+    } else {
+        a.call_method1("astype", ("int64",))?
+    };
+    a.cast_into::<PyArrayDyn<i64>>()
+        .map_err(|_| errors::type_error(format!("{what}: expected an int64 array")))
+}
+
+fn shape_str(shape: &[usize]) -> String {
+    let parts: Vec<String> = shape.iter().map(|s| s.to_string()).collect();
+    if parts.len() == 1 {
+        format!("({},)", parts[0])
+    } else {
+        format!("({})", parts.join(", "))
+    }
+}
+
+/// An `(n, 3)` array of real numbers as points (`n` may be 0; callers decide).
+pub fn points(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<DVec3>> {
+    let a = f64_array(obj, what)?;
+    let ro = a.try_readonly().map_err(|e| errors::input(format!("{what}: {e}")))?;
+    let v = ro.as_array();
+    if v.ndim() != 2 || v.shape()[1] != 3 {
+        return Err(errors::input(format!(
+            "{what} must have shape (n, 3), got {}",
+            shape_str(v.shape())
+        )));
+    }
+    let v = v
+        .into_dimensionality::<numpy::ndarray::Ix2>()
+        .map_err(|e| errors::input(format!("{what}: {e}")))?;
+    Ok(v.rows()
+        .into_iter()
+        .map(|r| DVec3::new(r[0], r[1], r[2]))
+        .collect())
+}
+
+/// A single point: shape `(3,)`.
+pub fn point(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<DVec3> {
+    let v = f64_vec(obj, what)?;
+    if v.len() != 3 {
+        return Err(errors::input(format!(
+            "{what} must have 3 coordinates, got {}",
+            v.len()
+        )));
+    }
+    Ok(DVec3::new(v[0], v[1], v[2]))
+}
+
+/// A 1-D array of real numbers.
+pub fn f64_vec(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
+    let a = f64_array(obj, what)?;
+    let ro = a.try_readonly().map_err(|e| errors::input(format!("{what}: {e}")))?;
+    let v = ro.as_array();
+    if v.ndim() != 1 {
+        return Err(errors::input(format!(
+            "{what} must be 1-dimensional, got shape {}",
+            shape_str(v.shape())
+        )));
+    }
+    Ok(v.iter().copied().collect())
+}
+
+/// A 1-D array (or a scalar) of integers, each in `0..=u32::MAX`.
+pub fn u32_vec(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<u32>> {
+    let a = i64_array(obj, what)?;
+    let ro = a.try_readonly().map_err(|e| errors::input(format!("{what}: {e}")))?;
+    let v = ro.as_array();
+    if v.ndim() > 1 {
+        return Err(errors::input(format!(
+            "{what} must be 1-dimensional, got shape {}",
+            shape_str(v.shape())
+        )));
+    }
+    v.iter()
+        .enumerate()
+        .map(|(k, &x)| {
+            u32::try_from(x).map_err(|_| {
+                errors::index(format!("{what}[{k}] = {x} is not a valid index"))
+            })
+        })
+        .collect()
+}
+
+/// A 1-D array of integers as `u64` (negative values rejected).
+pub fn u64_vec(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<u64>> {
+    let a = as_ndarray(obj, what)?;
+    let kind = a.dtype().kind();
+    if !matches!(kind, b'i' | b'u') {
+        return Err(errors::type_error(format!(
+            "{what} must be an array of integers, got dtype {}",
+            dtype_name(&a)
+        )));
+    }
+    if kind == b'u' {
+        let a = a.call_method1("astype", ("uint64",))?;
+        let a = a
+            .cast_into::<PyArrayDyn<u64>>()
+            .map_err(|_| errors::type_error(format!("{what}: expected a uint64 array")))?;
+        let ro = a.try_readonly().map_err(|e| errors::input(format!("{what}: {e}")))?;
+        let v = ro.as_array();
+        if v.ndim() != 1 {
+            return Err(errors::input(format!(
+                "{what} must be 1-dimensional, got shape {}",
+                shape_str(v.shape())
+            )));
+        }
+        return Ok(v.iter().copied().collect());
+    }
+    let a = i64_array(a.as_any(), what)?;
+    let ro = a.try_readonly().map_err(|e| errors::input(format!("{what}: {e}")))?;
+    let v = ro.as_array();
+    if v.ndim() != 1 {
+        return Err(errors::input(format!(
+            "{what} must be 1-dimensional, got shape {}",
+            shape_str(v.shape())
+        )));
+    }
+    v.iter()
+        .enumerate()
+        .map(|(k, &x)| {
+            u64::try_from(x).map_err(|_| errors::input(format!("{what}[{k}] = {x} is negative")))
+        })
+        .collect()
+}
+
+/// An `(m, 3)` array of vertex indices (range against the vertex count is checked by
+/// `TriMesh::new`).
+pub fn triangles(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<[u32; 3]>> {
+    let a = i64_array(obj, what)?;
+    let ro = a.try_readonly().map_err(|e| errors::input(format!("{what}: {e}")))?;
+    let v = ro.as_array();
+    if v.ndim() != 2 || v.shape()[1] != 3 {
+        return Err(errors::input(format!(
+            "{what} must have shape (m, 3), got {}",
+            shape_str(v.shape())
+        )));
+    }
+    let v = v
+        .into_dimensionality::<numpy::ndarray::Ix2>()
+        .map_err(|e| errors::input(format!("{what}: {e}")))?;
+    let mut out = Vec::with_capacity(v.nrows());
+    for (f, r) in v.rows().into_iter().enumerate() {
+        let mut t = [0u32; 3];
+        for k in 0..3 {
+            t[k] = u32::try_from(r[k]).map_err(|_| {
+                errors::index(format!(
+                    "{what}[{f}, {k}] = {} is not a valid vertex index",
+                    r[k]
+                ))
+            })?;
+        }
+        out.push(t);
+    }
+    Ok(out)
+}
+
+/// Points as an `(n, 3)` float64 array.
+pub fn points_out<'py>(py: Python<'py>, p: &[DVec3]) -> Bound<'py, PyArray2<f64>> {
+    let flat: Vec<f64> = p.iter().flat_map(|q| q.to_array()).collect();
+    rows_out(py, flat, 3)
+}
+
+/// A flat row-major buffer as an `(len / cols, cols)` array.
+pub fn rows_out<'py, T: numpy::Element>(
+    py: Python<'py>,
+    flat: Vec<T>,
+    cols: usize,
+) -> Bound<'py, PyArray2<T>> {
+    let n = flat.len().checked_div(cols).unwrap_or(0);
+    // The length is n * cols by construction of every caller, so the shape always fits.
+    Array2::from_shape_vec((n, cols), flat)
+        .unwrap_or_else(|_| Array2::from_shape_vec((0, cols), Vec::new()).unwrap_or_default())
+        .into_pyarray(py)
+}
+
+/// A vector as a 1-D array.
+pub fn vec_out<'py, T: numpy::Element>(py: Python<'py>, v: Vec<T>) -> Bound<'py, PyArray1<T>> {
+    Array1::from_vec(v).into_pyarray(py)
+}
+
+/// A path argument: `str` or any `os.PathLike`.
+pub fn path(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<std::path::PathBuf> {
+    obj.extract::<std::path::PathBuf>()
+        .map_err(|_| errors::type_error(format!("{what} must be a str or os.PathLike path")))
+}
+
+/// Runs `f` on a rayon pool of `threads` threads (`None`: the global pool, one thread per core).
+/// Returns the message of a bad thread count (callers turn it into an exception once they hold
+/// the GIL again).
+pub fn with_threads<R: Send>(
+    threads: Option<usize>,
+    f: impl FnOnce() -> R + Send,
+) -> Result<R, String> {
+    match threads {
+        None => Ok(f()),
+        Some(0) => Err("threads must be at least 1".into()),
+        Some(n) => {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(n)
+                .build()
+                .map_err(|e| e.to_string())?;
+            Ok(pool.install(f))
+        }
+    }
+}

@@ -1,0 +1,294 @@
+//! `describe`: the bipolar descriptor of a mesh with every option of `bipolar describe`.
+
+use crate::convert;
+use crate::descriptor::PyDescriptor;
+use crate::errors;
+use crate::geodesic::PyGeodesicSolver;
+use crate::mesh::mesh_arg;
+use std::time::{Duration, Instant};
+use bipolar::{DescriptorOptions, LevelSpec, SelectionRule, Source, TangentMethod};
+use geodesic::Method;
+use glam::DVec3;
+use meshcore::{FaceLocator, TriMesh};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString};
+
+/// Descriptor options from the arguments of `bipolar describe` (same defaults and rules).
+#[allow(clippy::too_many_arguments)]
+fn options(
+    levels: Option<u32>,
+    step: Option<f64>,
+    max_level: Option<u32>,
+    angles: u32,
+    alpha: f64,
+    rule: &str,
+    tolerance: Option<f64>,
+    tangent: &str,
+) -> PyResult<DescriptorOptions> {
+    let levels = match (levels, step) {
+        (Some(_), Some(_)) => return Err(errors::input("give levels or step, not both")),
+        (_, Some(s)) => LevelSpec::Step(s),
+        (Some(n), None) => LevelSpec::Count(n),
+        (None, None) => LevelSpec::Count(10),
+    };
+    let rule = match rule {
+        "filter" => SelectionRule::Filter {
+            tolerance: tolerance.unwrap_or(alpha / (4.0 * angles.max(1) as f64)),
+        },
+        "isoangle" | "iso-angle" => SelectionRule::IsoAngle,
+        "all" => SelectionRule::All,
+        o => {
+            return Err(errors::input(format!(
+                "unknown rule {o:?} (expected filter, isoangle or all)"
+            )))
+        }
+    };
+    let tangent: TangentMethod = tangent.parse().map_err(errors::input)?;
+    Ok(DescriptorOptions {
+        levels,
+        max_level,
+        angles,
+        alpha,
+        rule,
+        tangent,
+        ..DescriptorOptions::default()
+    })
+}
+
+/// Labelled landmark positions given by the caller: a path (lm3 / JSON, read by
+/// `landmarks::io::read_landmarks`) or a dict `{label: (x, y, z)}`.
+fn given_landmarks(obj: &Bound<'_, PyAny>) -> PyResult<Vec<(String, DVec3)>> {
+    if let Ok(d) = obj.cast::<PyDict>() {
+        let mut out = Vec::new();
+        for (k, v) in d.iter() {
+            let label: String = k
+                .extract()
+                .map_err(|_| errors::type_error("landmark labels must be str"))?;
+            let p = convert::point(&v, &format!("landmarks[{label:?}]"))?;
+            out.push((label, p));
+        }
+        return Ok(out);
+    }
+    let p = convert::path(obj, "landmarks")?;
+    landmarks::io::read_landmarks(&p).map_err(errors::landmarks)
+}
+
+fn snap(mesh: &TriMesh, p: DVec3, what: &str) -> PyResult<Source> {
+    if !p.is_finite() {
+        return Err(errors::input(format!("{what}: {:?} is not finite", p.to_array())));
+    }
+    let (sp, _) = FaceLocator::new(mesh).nearest(p).map_err(errors::mesh)?;
+    Ok(Source::Point(sp))
+}
+
+/// Resolves reference points as `bipolar describe` does: a vertex index; an `(x, y, z)` point
+/// snapped to the nearest surface point; a landmark name looked up in `given` (any spelling
+/// `landmarks::LandmarkName::parse` knows, or equal ignoring case) or, without `given`,
+/// detected with `landmarks::detect` and the default model (once for all names).
+fn references(
+    py: Python<'_>,
+    mesh: &TriMesh,
+    specs: &[(String, Bound<'_, PyAny>)],
+    given: Option<&[(String, DVec3)]>,
+    in_library: &mut Duration,
+) -> PyResult<Vec<Source>> {
+    let mut detected: Option<landmarks::Landmarks> = None;
+    let mut out = Vec::with_capacity(specs.len());
+    for (what, spec) in specs {
+        if spec.is_instance_of::<PyString>() {
+            let s: String = spec.extract()?;
+            let s = s.trim().to_string();
+            let want = landmarks::LandmarkName::parse(&s);
+            if let Some(g) = given {
+                let found = g.iter().find(|(l, _)| {
+                    let l = l.trim();
+                    (want.is_some() && landmarks::LandmarkName::parse(l) == want)
+                        || l.eq_ignore_ascii_case(&s)
+                });
+                let Some((_, p)) = found else {
+                    let labels: Vec<&str> = g.iter().map(|(l, _)| l.as_str()).collect();
+                    return Err(errors::input(format!(
+                        "{what}: landmark {s:?} is not among the given landmarks ({})",
+                        labels.join(", ")
+                    )));
+                };
+                let t = Instant::now();
+                out.push(snap(mesh, *p, what)?);
+                *in_library += t.elapsed();
+                continue;
+            }
+            let Some(name) = want else {
+                return Err(errors::input(format!(
+                    "{what}: {s:?} is not a landmark name (outer-eye-right, outer-eye-left, \
+                     inner-eye-right, inner-eye-left, nose-tip); give a vertex index or (x, y, z)"
+                )));
+            };
+            if detected.is_none() {
+                let t = Instant::now();
+                let model = landmarks::GenericModel::default_model().map_err(errors::landmarks)?;
+                let lm = py
+                    .detach(|| landmarks::detect(mesh, &model))
+                    .map_err(errors::landmarks)?;
+                *in_library += t.elapsed();
+                detected = Some(lm);
+            }
+            if let Some(lm) = &detected {
+                out.push(Source::Vertex(lm.get(name).vertex));
+            }
+            continue;
+        }
+        if let Ok(v) = spec.extract::<i64>() {
+            let n = mesh.n_vertices();
+            if v < 0 || v as u64 >= n as u64 {
+                return Err(errors::index(format!(
+                    "{what}: reference vertex {v} does not exist (the mesh has {n} vertices)"
+                )));
+            }
+            out.push(Source::Vertex(v as u32));
+            continue;
+        }
+        let p = convert::point(spec, what)?;
+        let t = Instant::now();
+        out.push(snap(mesh, p, what)?);
+        *in_library += t.elapsed();
+    }
+    Ok(out)
+}
+
+/// `describe` and the seconds spent in library calls (for the overhead benchmark).
+#[allow(clippy::too_many_arguments)]
+fn describe_impl(
+    py: Python<'_>,
+    mesh: &Bound<'_, PyAny>,
+    ref_a: &Bound<'_, PyAny>,
+    ref_b: &Bound<'_, PyAny>,
+    refs: Option<&Bound<'_, PyAny>>,
+    levels: Option<u32>,
+    step: Option<f64>,
+    max_level: Option<u32>,
+    angles: u32,
+    alpha: f64,
+    rule: &str,
+    tolerance: Option<f64>,
+    tangent: &str,
+    method: &str,
+    landmarks: Option<&Bound<'_, PyAny>>,
+    solver: Option<&Bound<'_, PyGeodesicSolver>>,
+) -> PyResult<(PyDescriptor, f64)> {
+    let opts = options(levels, step, max_level, angles, alpha, rule, tolerance, tangent)?;
+    let m = mesh_arg(mesh)?;
+    let mesh = m.mesh();
+    let given = landmarks.map(given_landmarks).transpose()?;
+    let mut specs = vec![
+        ("ref_a".to_string(), ref_a.clone()),
+        ("ref_b".to_string(), ref_b.clone()),
+    ];
+    if let Some(r) = refs {
+        let items = r
+            .try_iter()
+            .map_err(|_| errors::type_error("refs must be a sequence of reference points"))?;
+        for (k, item) in items.enumerate() {
+            specs.push((format!("refs[{k}]"), item?));
+        }
+    }
+    let mut in_library = Duration::ZERO;
+    let sources = references(py, mesh, &specs, given.as_deref(), &mut in_library)?;
+    let (d, t) = match solver {
+        Some(s) => {
+            let s = s.get();
+            py.detach(|| {
+                let t = Instant::now();
+                (bipolar::describe(mesh, s.solver.as_ref(), &sources, &opts), t.elapsed())
+            })
+        }
+        None => {
+            let method: Method = method.parse().map_err(errors::geodesic)?;
+            py.detach(|| {
+                let t = Instant::now();
+                let d = geodesic::new_solver(mesh, method)
+                    .map_err(bipolar::BipolarError::from)
+                    .and_then(|solver| bipolar::describe(mesh, solver.as_ref(), &sources, &opts));
+                (d, t.elapsed())
+            })
+        }
+    };
+    in_library += t;
+    let d = d.map_err(errors::descriptor)?;
+    Ok((PyDescriptor { d }, in_library.as_secs_f64()))
+}
+
+/// The bipolar descriptor of a mesh (the options of ``bipolar describe``).
+///
+/// ``mesh``: a ``Mesh`` or a path. References ``ref_a``, ``ref_b`` and further ``refs``: a
+/// vertex index, an ``(x, y, z)`` point (snapped to the nearest surface point) or a landmark
+/// name (``"outer-eye-right"``, ...), looked up in ``landmarks`` (a ``.lm3`` / JSON path or a
+/// ``{label: (x, y, z)}`` dict; positions are snapped) or, without it, detected automatically.
+/// ``levels`` (default 10) or ``step``; ``max_level`` limits the region (fields cut off);
+/// ``angles`` K, ``alpha``; ``rule`` ``"isoangle"`` | ``"filter"`` (``tolerance``, default
+/// ``alpha / (4 K)``) | ``"all"``; ``tangent`` ``"gradient"`` | ``"strip"`` | ``"spline"``;
+/// geodesic ``method`` ``"exact"`` | ``"fmm"`` | ``"heat"`` | ``"dijkstra"``, or a prepared
+/// ``solver`` for this mesh (then ``method`` is ignored). The GIL is released while it runs.
+#[pyfunction]
+#[pyo3(signature = (mesh, ref_a, ref_b, *, refs=None, levels=None, step=None, max_level=None,
+                    angles=8, alpha=0.95, rule="isoangle", tolerance=None, tangent="gradient",
+                    method="exact", landmarks=None, solver=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn describe(
+    py: Python<'_>,
+    mesh: &Bound<'_, PyAny>,
+    ref_a: &Bound<'_, PyAny>,
+    ref_b: &Bound<'_, PyAny>,
+    refs: Option<&Bound<'_, PyAny>>,
+    levels: Option<u32>,
+    step: Option<f64>,
+    max_level: Option<u32>,
+    angles: u32,
+    alpha: f64,
+    rule: &str,
+    tolerance: Option<f64>,
+    tangent: &str,
+    method: &str,
+    landmarks: Option<&Bound<'_, PyAny>>,
+    solver: Option<&Bound<'_, PyGeodesicSolver>>,
+) -> PyResult<PyDescriptor> {
+    describe_impl(py, mesh, ref_a, ref_b, refs, levels, step, max_level, angles, alpha, rule, tolerance, tangent, method, landmarks, solver).map(|(d, _)| d)
+}
+
+/// ``describe`` returning ``(descriptor, seconds spent inside the library calls)``: the time
+/// the Rust crates took (references, solver preparation, descriptor), for measuring the
+/// binding's own overhead (python/benchmarks).
+///
+/// ``mesh``: a ``Mesh`` or a path. References ``ref_a``, ``ref_b`` and further ``refs``: a
+/// vertex index, an ``(x, y, z)`` point (snapped to the nearest surface point) or a landmark
+/// name (``"outer-eye-right"``, ...), looked up in ``landmarks`` (a ``.lm3`` / JSON path or a
+/// ``{label: (x, y, z)}`` dict; positions are snapped) or, without it, detected automatically.
+/// ``levels`` (default 10) or ``step``; ``max_level`` limits the region (fields cut off);
+/// ``angles`` K, ``alpha``; ``rule`` ``"isoangle"`` | ``"filter"`` (``tolerance``, default
+/// ``alpha / (4 K)``) | ``"all"``; ``tangent`` ``"gradient"`` | ``"strip"`` | ``"spline"``;
+/// geodesic ``method`` ``"exact"`` | ``"fmm"`` | ``"heat"`` | ``"dijkstra"``, or a prepared
+/// ``solver`` for this mesh (then ``method`` is ignored). The GIL is released while it runs.
+#[pyfunction]
+#[pyo3(signature = (mesh, ref_a, ref_b, *, refs=None, levels=None, step=None, max_level=None,
+                    angles=8, alpha=0.95, rule="isoangle", tolerance=None, tangent="gradient",
+                    method="exact", landmarks=None, solver=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn _describe_profiled(
+    py: Python<'_>,
+    mesh: &Bound<'_, PyAny>,
+    ref_a: &Bound<'_, PyAny>,
+    ref_b: &Bound<'_, PyAny>,
+    refs: Option<&Bound<'_, PyAny>>,
+    levels: Option<u32>,
+    step: Option<f64>,
+    max_level: Option<u32>,
+    angles: u32,
+    alpha: f64,
+    rule: &str,
+    tolerance: Option<f64>,
+    tangent: &str,
+    method: &str,
+    landmarks: Option<&Bound<'_, PyAny>>,
+    solver: Option<&Bound<'_, PyGeodesicSolver>>,
+) -> PyResult<(PyDescriptor, f64)> {
+    describe_impl(py, mesh, ref_a, ref_b, refs, levels, step, max_level, angles, alpha, rule, tolerance, tangent, method, landmarks, solver)
+}

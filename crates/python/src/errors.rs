@@ -1,0 +1,159 @@
+//! Library errors as Python exceptions.
+//!
+//! The exception classes live in `bipolar/errors.py` (a hierarchy with multiple bases, e.g.
+//! `InputError(BipolarError, ValueError)`, which `create_exception!` cannot express). Each
+//! library error enum is mapped here, in one function per crate, to the class that fits; the
+//! message is always the library's own `Display` text.
+
+use pyo3::prelude::*;
+use pyo3::types::PyType;
+
+/// Which exception class of `bipolar.errors` an error becomes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// `InputError` (a `ValueError`).
+    Input,
+    /// `InputTypeError` (a `ValueError` and a `TypeError`).
+    Type,
+    /// `IndexOutOfRangeError` (a `ValueError` and an `IndexError`).
+    Index,
+    /// `FileFormatError` (a `ValueError`).
+    Format,
+    /// `NoDescriptorPointsError` (a `ValueError`).
+    NoPoints,
+    /// `FileError` (an `OSError`).
+    File,
+    /// `LandmarksNotFoundError`.
+    NotFound,
+    /// `ComputationError` (a `RuntimeError`).
+    Computation,
+}
+
+impl Kind {
+    fn class_name(self) -> &'static str {
+        match self {
+            Kind::Input => "InputError",
+            Kind::Type => "InputTypeError",
+            Kind::Index => "IndexOutOfRangeError",
+            Kind::Format => "FileFormatError",
+            Kind::NoPoints => "NoDescriptorPointsError",
+            Kind::File => "FileError",
+            Kind::NotFound => "LandmarksNotFoundError",
+            Kind::Computation => "ComputationError",
+        }
+    }
+}
+
+/// A Python exception of the given kind with `message`.
+pub fn err(kind: Kind, message: impl Into<String>) -> PyErr {
+    let message = message.into();
+    Python::attach(|py| {
+        let class = py
+            .import("bipolar.errors")
+            .and_then(|m| m.getattr(kind.class_name()))
+            .and_then(|c| c.cast_into::<PyType>().map_err(PyErr::from));
+        match class {
+            Ok(c) => PyErr::from_type(c, message),
+            // The package is always installed with its errors module; if it was not importable
+            // the message still reaches the user.
+            Err(_) => pyo3::exceptions::PyValueError::new_err(message),
+        }
+    })
+}
+
+/// `InputError` with `message`.
+pub fn input(message: impl Into<String>) -> PyErr {
+    err(Kind::Input, message)
+}
+
+/// `InputTypeError` with `message`.
+pub fn type_error(message: impl Into<String>) -> PyErr {
+    err(Kind::Type, message)
+}
+
+/// `IndexOutOfRangeError` with `message`.
+pub fn index(message: impl Into<String>) -> PyErr {
+    err(Kind::Index, message)
+}
+
+/// `meshcore::MeshError`.
+pub fn mesh(e: meshcore::MeshError) -> PyErr {
+    use meshcore::MeshError as E;
+    let kind = match e {
+        E::IndexOutOfRange { .. } | E::FaceOutOfRange { .. } | E::VertexOutOfRange { .. } => {
+            Kind::Index
+        }
+        _ => Kind::Input,
+    };
+    err(kind, e.to_string())
+}
+
+/// `mesh_io::IoError`.
+pub fn io(e: mesh_io::IoError) -> PyErr {
+    use mesh_io::IoError as E;
+    let kind = match e {
+        E::Io { .. } => Kind::File,
+        E::Malformed { .. } | E::Unsupported { .. } | E::UnknownFormat { .. } | E::Mesh { .. } => {
+            Kind::Format
+        }
+        E::InvalidInput { .. } => Kind::Input,
+    };
+    err(kind, e.to_string())
+}
+
+fn geodesic_kind(e: &geodesic::GeodesicError) -> Kind {
+    use geodesic::GeodesicError as E;
+    match e {
+        E::Mesh(meshcore::MeshError::IndexOutOfRange { .. })
+        | E::Mesh(meshcore::MeshError::FaceOutOfRange { .. })
+        | E::Mesh(meshcore::MeshError::VertexOutOfRange { .. })
+        | E::SourceOutOfRange { .. } => Kind::Index,
+        E::Mesh(_) | E::NoSource | E::UnknownMethod(_) | E::InvalidCutoff(_) => Kind::Input,
+        E::NotImplemented(_) | E::Numerical(_) => Kind::Computation,
+    }
+}
+
+/// `geodesic::GeodesicError`.
+pub fn geodesic(e: geodesic::GeodesicError) -> PyErr {
+    err(geodesic_kind(&e), e.to_string())
+}
+
+/// `bipolar::BipolarError`.
+pub fn descriptor(e: bipolar::BipolarError) -> PyErr {
+    use bipolar::BipolarError as E;
+    let kind = match &e {
+        E::Mesh(m) => return mesh(m.clone()),
+        E::Geodesic(g) => geodesic_kind(g),
+        E::NoIntersections(_) => Kind::NoPoints,
+        E::Spline(_) => Kind::Computation,
+        // The descriptor files' errors carry the OS failure in the message ("cannot read: ...",
+        // "cannot write: ..."); everything else is a content problem.
+        E::Io { message, .. } => {
+            if message.starts_with("cannot read") || message.starts_with("cannot write") {
+                Kind::File
+            } else {
+                Kind::Format
+            }
+        }
+        _ => Kind::Input,
+    };
+    err(kind, e.to_string())
+}
+
+/// `shapedist::ShapeDistError` (every variant is about the input sets or options).
+pub fn shapedist(e: shapedist::ShapeDistError) -> PyErr {
+    input(e.to_string())
+}
+
+/// `landmarks::LandmarkError`.
+pub fn landmarks(e: landmarks::LandmarkError) -> PyErr {
+    use landmarks::LandmarkError as E;
+    let kind = match &e {
+        E::NotFound { .. } => Kind::NotFound,
+        E::Mesh(m) => return mesh(m.clone()),
+        E::Io { .. } => Kind::File,
+        E::Parse { .. } => Kind::Format,
+        E::InvalidModel(_) | E::InvalidTraining(_) | E::InvalidOption(_) => Kind::Input,
+    };
+    err(kind, e.to_string())
+}

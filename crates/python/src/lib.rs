@@ -1,0 +1,55 @@
+//! Python bindings of the bipolar workspace: the extension module `bipolar._bipolar`.
+//!
+//! This crate only converts (numpy arrays, Python arguments, library errors as exceptions) and
+//! calls the library crates; it has no algorithm of its own. The Python package around it is
+//! `python/bipolar` (re-exports, the `gdist` drop-in, Dask helpers, typed stubs).
+//!
+//! Every call that computes releases the GIL. Nothing panics on user input: arrays are checked
+//! for type, dtype, shape and index range here, values by the libraries.
+
+mod convert;
+mod describe;
+mod descriptor;
+mod distance;
+mod errors;
+mod geodesic;
+mod landmark;
+mod mesh;
+
+use pyo3::prelude::*;
+
+#[pymodule]
+fn _bipolar(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("LANDMARK_NAMES", landmark::names())?;
+    m.add_class::<mesh::PyMesh>()?;
+    m.add_class::<geodesic::PyGeodesicSolver>()?;
+    m.add_class::<descriptor::PyDescriptor>()?;
+    m.add_class::<distance::PyDistanceOptions>()?;
+    m.add_function(wrap_pyfunction!(mesh::read_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::read_mesh_bytes, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::write_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::write_ply, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::read_bnt, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::read_landmarks, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::read_ict_landmarks, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::read_lm2, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::write_lm3, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::icosphere, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::uv_sphere, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::grid_plane, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh::_mesh_from_state, m)?)?;
+    m.add_function(wrap_pyfunction!(describe::describe, m)?)?;
+    m.add_function(wrap_pyfunction!(describe::_describe_profiled, m)?)?;
+    m.add_function(wrap_pyfunction!(descriptor::read_descriptor, m)?)?;
+    m.add_function(wrap_pyfunction!(descriptor::pack_key, m)?)?;
+    m.add_function(wrap_pyfunction!(descriptor::unpack_key, m)?)?;
+    m.add_function(wrap_pyfunction!(descriptor::_descriptor_from_state, m)?)?;
+    m.add_function(wrap_pyfunction!(distance::distance, m)?)?;
+    m.add_function(wrap_pyfunction!(distance::distance_details, m)?)?;
+    m.add_function(wrap_pyfunction!(distance::distance_matrix, m)?)?;
+    m.add_function(wrap_pyfunction!(distance::cross_distances, m)?)?;
+    m.add_function(wrap_pyfunction!(distance::_distance_options_from_dict, m)?)?;
+    m.add_function(wrap_pyfunction!(landmark::detect_landmarks, m)?)?;
+    Ok(())
+}

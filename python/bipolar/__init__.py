@@ -1,0 +1,105 @@
+"""bipolar: the bipolar invariant representation of 3D surfaces, from Python.
+
+Meshes (every format of the Rust mesh-io crate), geodesic distance fields (exact, fast
+marching, heat method, Dijkstra) from a solver prepared once per mesh, the bipolar descriptor
+with every option of ``bipolar describe``, normalised shape distances (keys, ICP, Hausdorff)
+and distance matrices, automatic face landmarks. numpy arrays in and out; the GIL is released
+while Rust computes.
+
+Sub-modules: ``bipolar.gdist`` (drop-in for tvb-gdist), ``bipolar.dask`` (describe many files,
+block distance matrices and 1:N identification on a dask.distributed cluster),
+``bipolar.errors`` (the exception hierarchy).
+
+Example::
+
+    import bipolar
+    face = bipolar.read_mesh("face.obj")
+    d = bipolar.describe(face, 1507, 3721, levels=30, max_level=30)
+    d.points, d.keys, d.cos                     # (n, 3), (n,) uint64, (n,)
+    solver = bipolar.GeodesicSolver(face, "exact")
+    field = solver.distances(1507, max_distance=5.0)
+"""
+
+from __future__ import annotations
+
+from . import errors
+from ._bipolar import (
+    LANDMARK_NAMES,
+    Descriptor,
+    DistanceOptions,
+    GeodesicSolver,
+    Mesh,
+    __version__,
+    cross_distances,
+    describe,
+    detect_landmarks,
+    distance,
+    distance_details,
+    distance_matrix,
+    grid_plane,
+    icosphere,
+    pack_key,
+    read_bnt,
+    read_descriptor,
+    read_ict_landmarks,
+    read_landmarks,
+    read_lm2,
+    read_mesh,
+    read_mesh_bytes,
+    unpack_key,
+    uv_sphere,
+    write_lm3,
+    write_mesh,
+    write_ply,
+)
+from .errors import (
+    BipolarError,
+    ComputationError,
+    FileError,
+    FileFormatError,
+    IndexOutOfRangeError,
+    InputError,
+    InputTypeError,
+    LandmarksNotFoundError,
+    NoDescriptorPointsError,
+)
+
+__all__ = [
+    "LANDMARK_NAMES",
+    "BipolarError",
+    "ComputationError",
+    "Descriptor",
+    "DistanceOptions",
+    "FileError",
+    "FileFormatError",
+    "GeodesicSolver",
+    "IndexOutOfRangeError",
+    "InputError",
+    "InputTypeError",
+    "LandmarksNotFoundError",
+    "Mesh",
+    "NoDescriptorPointsError",
+    "__version__",
+    "cross_distances",
+    "describe",
+    "detect_landmarks",
+    "distance",
+    "distance_details",
+    "distance_matrix",
+    "errors",
+    "grid_plane",
+    "icosphere",
+    "pack_key",
+    "read_bnt",
+    "read_descriptor",
+    "read_ict_landmarks",
+    "read_landmarks",
+    "read_lm2",
+    "read_mesh",
+    "read_mesh_bytes",
+    "unpack_key",
+    "uv_sphere",
+    "write_lm3",
+    "write_mesh",
+    "write_ply",
+]

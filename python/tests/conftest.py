@@ -1,0 +1,56 @@
+"""Shared fixtures: generated meshes and the shared data folder (../shared or $BIPOLAR_SHARED)."""
+
+import os
+import pathlib
+
+import numpy as np
+import pytest
+
+import bipolar
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+
+
+def shared_dir():
+    p = os.environ.get("BIPOLAR_SHARED")
+    return pathlib.Path(p) if p else ROOT.parent / "shared"
+
+
+PAPER_SET = shared_dir() / "faces" / "ict-facekit" / "paper-set"
+
+
+@pytest.fixture(scope="session")
+def face_path():
+    p = PAPER_SET / "id1_neutral.obj"
+    if not p.exists():
+        pytest.skip(f"shared data absent: {p}")
+    return p
+
+
+@pytest.fixture(scope="session")
+def face(face_path):
+    return bipolar.read_mesh(face_path)
+
+
+def bump(n=40, h=0.05, jitter=0.3, seed=3):
+    """A jittered grid bent into a smooth asymmetric bump (no symmetry, so descriptors of
+    rigid copies can only match if the descriptor is invariant)."""
+    g = bipolar.grid_plane(n, h, -0.5 * n * h, jitter, seed)
+    v = g.vertices.copy()
+    x, y = v[:, 0], v[:, 1]
+    v[:, 2] = 0.4 * np.exp(-((x - 0.1) ** 2 + (y + 0.2) ** 2) / 0.3) + 0.1 * x * y
+    return bipolar.Mesh(v, g.triangles)
+
+
+@pytest.fixture(scope="session")
+def bump_mesh():
+    return bump()
+
+
+def rotation(seed=1):
+    rng = np.random.default_rng(seed)
+    q, r = np.linalg.qr(rng.normal(size=(3, 3)))
+    q = q * np.sign(np.diag(r))
+    if np.linalg.det(q) < 0:
+        q[:, 0] = -q[:, 0]
+    return q

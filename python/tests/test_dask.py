@@ -1,0 +1,98 @@
+"""bipolar.dask on a LocalCluster of two worker processes: results identical to one process."""
+
+import numpy as np
+import pytest
+
+import bipolar
+
+distributed = pytest.importorskip("distributed")
+bdask = pytest.importorskip("bipolar.dask")
+
+from conftest import bump, rotation  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def client():
+    cluster = distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    )
+    c = distributed.Client(cluster)
+    yield c
+    c.close()
+    cluster.close()
+
+
+@pytest.fixture(scope="module")
+def mesh_files(tmp_path_factory):
+    d = tmp_path_factory.mktemp("meshes")
+    paths = []
+    for k in range(4):
+        m = bump(n=24, seed=10 + k)
+        r = rotation(k)
+        m = bipolar.Mesh(m.vertices @ r.T, m.triangles)
+        p = d / f"m{k}.ply"
+        bipolar.write_mesh(p, m)
+        paths.append(p)
+    return paths
+
+
+@pytest.fixture(scope="module")
+def descriptors():
+    rng = np.random.default_rng(0)
+    base = rng.normal(size=(120, 3))
+    keys = np.arange(120, dtype=np.uint64) * np.uint64(7)
+    out = []
+    for k in range(11):
+        pts = base + rng.normal(scale=0.02 * (1 + k % 4), size=base.shape)
+        keep = rng.random(120) > 0.1
+        out.append(bipolar.Descriptor.from_arrays(pts[keep] @ rotation(k).T, keys[keep]))
+    return out
+
+
+def test_cluster_has_two_worker_processes(client):
+    info = client.scheduler_info()
+    assert len(info["workers"]) == 2
+    pids = set(client.run(lambda: __import__("os").getpid()).values())
+    assert len(pids) == 2
+
+
+def test_describe_files_equals_single_process(client, mesh_files):
+    got = bdask.describe_files(mesh_files, 0, 575, client=client, levels=8)
+    want = [bipolar.describe(p, 0, 575, levels=8) for p in mesh_files]
+    assert len(got) == 4
+    for g, w in zip(got, want):
+        assert g == w and len(g) > 0
+
+
+@pytest.mark.parametrize("block_size", [1, 3, 4, 11, 50])
+def test_block_matrix_equals_single_process(client, descriptors, block_size):
+    want = bipolar.distance_matrix(descriptors)
+    got = bdask.distance_matrix(descriptors, client=client, block_size=block_size)
+    np.testing.assert_array_equal(got, want)
+
+
+def test_block_matrix_icp_mode_and_default_blocks(client, descriptors):
+    o = bipolar.DistanceOptions(mode="icp", iterations=20)
+    want = bipolar.distance_matrix(descriptors[:5], o)
+    np.testing.assert_array_equal(bdask.distance_matrix(descriptors[:5], o, client=client), want)
+    assert bdask.distance_matrix([], client=client).shape == (0, 0)
+
+
+def test_identify_ranks_the_gallery(client, descriptors):
+    probes, gallery = descriptors[:4], descriptors[4:]
+    labels_g = [k % 4 for k in range(4, 11)]
+    res = bdask.identify(
+        probes, gallery, client=client, block_size=2,
+        probe_labels=[0, 1, 2, 3], gallery_labels=labels_g,
+    )
+    want = bipolar.cross_distances(probes, gallery)
+    np.testing.assert_array_equal(res.distances, want)
+    np.testing.assert_array_equal(res.ranking, np.argsort(want, axis=1, kind="stable"))
+    np.testing.assert_array_equal(res.best, np.argmin(want, axis=1))
+    assert res.ranks.shape == (4,) and np.all(res.ranks >= 1)
+    assert 0.0 <= res.rank1_rate <= 1.0
+
+
+def test_bad_block_size(client, descriptors):
+    with pytest.raises(bipolar.InputError, match="block_size"):
+        bdask.distance_matrix(descriptors, client=client, block_size=0)
