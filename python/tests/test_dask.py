@@ -40,7 +40,7 @@ def mesh_files(tmp_path_factory):
 def descriptors():
     rng = np.random.default_rng(0)
     base = rng.normal(size=(120, 3))
-    keys = np.arange(120, dtype=np.uint64) * np.uint64(7)
+    keys = np.arange(120, dtype=np.uint64) * np.uint64(16)
     out = []
     for k in range(11):
         pts = base + rng.normal(scale=0.02 * (1 + k % 4), size=base.shape)

@@ -83,13 +83,13 @@ def test_solver_path_and_options_agree(bump_mesh, tmp_path, bump_desc):
         dict(method="heat"),
         dict(method="dijkstra"),
         dict(angles=4, alpha=0.8),
-        dict(max_level=6),
+        dict(max_level=9),
         dict(refs=[800]),
     ]:
         d = bipolar.describe(bump_mesh, 0, 1599, levels=12, **kw)
         assert len(d) > 0, kw
-    region = bipolar.describe(bump_mesh, 0, 1599, levels=12, max_level=6)
-    assert region.options["max_level"] == 6
+    region = bipolar.describe(bump_mesh, 0, 1599, levels=12, max_level=9)
+    assert region.options["max_level"] == 9
     assert bipolar.describe(bump_mesh, 0, 1599, levels=12, rule="filter").options["rule"] == {
         "Filter": {"tolerance": 0.95 / 32}
     }
@@ -133,8 +133,9 @@ def test_describe_bad_input(bump_mesh):
         bipolar.describe("/nonexistent.obj", 0, 1)
     with pytest.raises(errors.InputError, match="solver was prepared for"):
         bipolar.describe(bump_mesh, 0, 1, solver=bipolar.GeodesicSolver(bipolar.icosphere(2)))
-    with pytest.raises(errors.NoDescriptorPointsError):
-        bipolar.describe(bump_mesh, 0, 1, levels=1, max_level=1, rule="filter", tolerance=1e-12)
+    # Levels i, j <= 6 of references 12 levels apart cannot meet (i + j >= 12 is needed).
+    with pytest.raises(errors.NoDescriptorPointsError, match="do not intersect"):
+        bipolar.describe(bump_mesh, 0, 1599, levels=12, max_level=5)
 
 
 def test_face_with_detected_landmarks(face_path, face):

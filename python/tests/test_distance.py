@@ -12,7 +12,8 @@ from conftest import rotation
 def random_set(n, seed, nkeys=None):
     rng = np.random.default_rng(seed)
     pts = rng.normal(size=(n, 3)) * np.array([3.0, 2.0, 1.0])
-    keys = rng.permutation(nkeys or 2 * n)[:n].astype(np.uint64)
+    # Multiples of 16 are valid packed keys (side and sign fields zero).
+    keys = rng.permutation(nkeys or 2 * n)[:n].astype(np.uint64) * np.uint64(16)
     return pts, keys
 
 
@@ -90,7 +91,7 @@ def test_distance_bad_input(sets):
     with pytest.raises(errors.InputError, match="unknown mode"):
         bipolar.distance(sets[0], sets[1], mode="l1")
     with pytest.raises(errors.InputError, match="usable shared keys"):
-        other = bipolar.Descriptor.from_arrays(pts, keys + np.uint64(10**6))
+        other = bipolar.Descriptor.from_arrays(pts, keys + np.uint64(16 * 10**6))
         bipolar.distance(sets[0], other)
     with pytest.raises(errors.InputError, match="keys has 9 entries"):
         bipolar.Descriptor.from_arrays(pts, keys[:9])
@@ -102,6 +103,8 @@ def test_distance_bad_input(sets):
         bipolar.Descriptor.from_arrays(pts, keys.astype(np.float64))
     with pytest.raises(errors.InputError, match="negative"):
         bipolar.Descriptor.from_arrays(pts, -np.arange(10))
+    with pytest.raises(errors.InputError, match="not a packed bipolar key"):
+        bipolar.Descriptor.from_arrays(pts, np.arange(10) * 16 + 3)
     with pytest.raises(TypeError, match="not a bipolar.Descriptor"):
         bipolar.distance_matrix([sets[0], "x"])
     with pytest.raises(errors.InputError, match="empty"):

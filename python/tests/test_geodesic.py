@@ -36,7 +36,9 @@ def test_exact_on_the_sphere_converges_to_the_great_circle():
     d = bipolar.GeodesicSolver(m, "exact").distances(0)
     u = m.vertices / np.linalg.norm(m.vertices, axis=1, keepdims=True)
     g = np.arccos(np.clip(u @ u[0], -1, 1))
-    assert np.max(np.abs(d - g)) < 2e-3
+    # The polyhedron lies inside the sphere: an O(h^2) gap, not solver error.
+    assert np.max(np.abs(d - g)) < 3e-3
+    assert np.all(d <= g + 1e-12)
 
 
 def test_surface_point_source_at_a_vertex_equals_the_vertex_source(flat):

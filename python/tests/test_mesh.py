@@ -178,6 +178,21 @@ def test_non_contiguous_arrays_read_through_strides():
         np.testing.assert_array_equal(m.triangles, t)
 
 
+def test_unaligned_arrays_are_read_correctly():
+    # Arrays rebuilt from pickle-5 buffers (as Dask sends them) can be unaligned.
+    v, t = tetra()
+    buf = bytearray(v.nbytes + 1)
+    uv = np.frombuffer(buf, dtype=np.float64, count=v.size, offset=1).reshape(4, 3)
+    assert not uv.flags.aligned
+    uv[...] = v
+    tb = bytearray(t.astype(np.int64).nbytes + 1)
+    ut = np.frombuffer(tb, dtype=np.int64, count=t.size, offset=1).reshape(4, 3)
+    ut[...] = t
+    m = bipolar.Mesh(uv, ut)
+    np.testing.assert_array_equal(m.vertices, v)
+    np.testing.assert_array_equal(m.triangles, t)
+
+
 def test_file_errors():
     with pytest.raises(errors.FileError):
         bipolar.read_mesh("/nonexistent/m.obj")

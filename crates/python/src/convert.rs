@@ -26,6 +26,17 @@ fn as_ndarray<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, P
         .map_err(|_| errors::type_error(format!("{what}: cannot be read as an array")))
 }
 
+/// `a`, or an aligned copy when its data is not aligned for its dtype (arrays rebuilt from
+/// pickle-5 buffers, `np.frombuffer` at odd offsets): ndarray views require alignment.
+fn aligned<'py>(a: Bound<'py, PyAny>) -> PyResult<Bound<'py, PyAny>> {
+    let ok: bool = a.getattr("flags")?.getattr("aligned")?.extract()?;
+    if ok {
+        Ok(a)
+    } else {
+        a.call_method0("copy")
+    }
+}
+
 fn dtype_name(a: &Bound<'_, PyUntypedArray>) -> String {
     a.dtype()
         .str()
@@ -36,7 +47,10 @@ fn dtype_name(a: &Bound<'_, PyUntypedArray>) -> String {
 /// `obj` as a float64 array: real floating and integer dtypes are converted (exactly for
 /// float16/32 and integers below 2^53), anything else (bool, complex, strings, objects) is an
 /// `InputTypeError`.
-pub fn f64_array<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+pub fn f64_array<'py>(
+    obj: &Bound<'py, PyAny>,
+    what: &str,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     let a = as_ndarray(obj, what)?;
     let kind = a.dtype().kind();
     if !matches!(kind, b'f' | b'i' | b'u') {
@@ -50,14 +64,18 @@ pub fn f64_array<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py
     } else {
         a.call_method1("astype", ("float64",))?
     };
-    a.cast_into::<PyArrayDyn<f64>>()
+    aligned(a)?
+        .cast_into::<PyArrayDyn<f64>>()
         .map_err(|_| errors::type_error(format!("{what}: expected a float64 array")))
 }
 
 /// `obj` as an int64 array; integer dtypes only (a float array of indices is an
 /// `InputTypeError`, as numpy's own indexing has it). uint64 values above `i64::MAX` are
 /// rejected.
-pub fn i64_array<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyArrayDyn<i64>>> {
+pub fn i64_array<'py>(
+    obj: &Bound<'py, PyAny>,
+    what: &str,
+) -> PyResult<Bound<'py, PyArrayDyn<i64>>> {
     let a = as_ndarray(obj, what)?;
     let kind = a.dtype().kind();
     if !matches!(kind, b'i' | b'u') {
@@ -80,7 +98,8 @@ pub fn i64_array<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py
     } else {
         a.call_method1("astype", ("int64",))?
     };
-    a.cast_into::<PyArrayDyn<i64>>()
+    aligned(a)?
+        .cast_into::<PyArrayDyn<i64>>()
         .map_err(|_| errors::type_error(format!("{what}: expected an int64 array")))
 }
 
@@ -96,7 +115,9 @@ fn shape_str(shape: &[usize]) -> String {
 /// An `(n, 3)` array of real numbers as points (`n` may be 0; callers decide).
 pub fn points(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<DVec3>> {
     let a = f64_array(obj, what)?;
-    let ro = a.try_readonly().map_err(|e| errors::input(format!("{what}: {e}")))?;
+    let ro = a
+        .try_readonly()
+        .map_err(|e| errors::input(format!("{what}: {e}")))?;
     let v = ro.as_array();
     if v.ndim() != 2 || v.shape()[1] != 3 {
         return Err(errors::input(format!(
@@ -128,7 +149,9 @@ pub fn point(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<DVec3> {
 /// A 1-D array of real numbers.
 pub fn f64_vec(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
     let a = f64_array(obj, what)?;
-    let ro = a.try_readonly().map_err(|e| errors::input(format!("{what}: {e}")))?;
+    let ro = a
+        .try_readonly()
+        .map_err(|e| errors::input(format!("{what}: {e}")))?;
     let v = ro.as_array();
     if v.ndim() != 1 {
         return Err(errors::input(format!(
@@ -142,7 +165,9 @@ pub fn f64_vec(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
 /// A 1-D array (or a scalar) of integers, each in `0..=u32::MAX`.
 pub fn u32_vec(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<u32>> {
     let a = i64_array(obj, what)?;
-    let ro = a.try_readonly().map_err(|e| errors::input(format!("{what}: {e}")))?;
+    let ro = a
+        .try_readonly()
+        .map_err(|e| errors::input(format!("{what}: {e}")))?;
     let v = ro.as_array();
     if v.ndim() > 1 {
         return Err(errors::input(format!(
@@ -153,9 +178,8 @@ pub fn u32_vec(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<u32>> {
     v.iter()
         .enumerate()
         .map(|(k, &x)| {
-            u32::try_from(x).map_err(|_| {
-                errors::index(format!("{what}[{k}] = {x} is not a valid index"))
-            })
+            u32::try_from(x)
+                .map_err(|_| errors::index(format!("{what}[{k}] = {x} is not a valid index")))
         })
         .collect()
 }
@@ -171,11 +195,13 @@ pub fn u64_vec(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<u64>> {
         )));
     }
     if kind == b'u' {
-        let a = a.call_method1("astype", ("uint64",))?;
+        let a = aligned(a.call_method1("astype", ("uint64",))?)?;
         let a = a
             .cast_into::<PyArrayDyn<u64>>()
             .map_err(|_| errors::type_error(format!("{what}: expected a uint64 array")))?;
-        let ro = a.try_readonly().map_err(|e| errors::input(format!("{what}: {e}")))?;
+        let ro = a
+            .try_readonly()
+            .map_err(|e| errors::input(format!("{what}: {e}")))?;
         let v = ro.as_array();
         if v.ndim() != 1 {
             return Err(errors::input(format!(
@@ -186,7 +212,9 @@ pub fn u64_vec(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<u64>> {
         return Ok(v.iter().copied().collect());
     }
     let a = i64_array(a.as_any(), what)?;
-    let ro = a.try_readonly().map_err(|e| errors::input(format!("{what}: {e}")))?;
+    let ro = a
+        .try_readonly()
+        .map_err(|e| errors::input(format!("{what}: {e}")))?;
     let v = ro.as_array();
     if v.ndim() != 1 {
         return Err(errors::input(format!(
@@ -206,7 +234,9 @@ pub fn u64_vec(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<u64>> {
 /// `TriMesh::new`).
 pub fn triangles(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<[u32; 3]>> {
     let a = i64_array(obj, what)?;
-    let ro = a.try_readonly().map_err(|e| errors::input(format!("{what}: {e}")))?;
+    let ro = a
+        .try_readonly()
+        .map_err(|e| errors::input(format!("{what}: {e}")))?;
     let v = ro.as_array();
     if v.ndim() != 2 || v.shape()[1] != 3 {
         return Err(errors::input(format!(
@@ -245,11 +275,15 @@ pub fn rows_out<'py, T: numpy::Element>(
     flat: Vec<T>,
     cols: usize,
 ) -> Bound<'py, PyArray2<T>> {
-    let n = flat.len().checked_div(cols).unwrap_or(0);
-    // The length is n * cols by construction of every caller, so the shape always fits.
-    Array2::from_shape_vec((n, cols), flat)
-        .unwrap_or_else(|_| Array2::from_shape_vec((0, cols), Vec::new()).unwrap_or_default())
-        .into_pyarray(py)
+    let cols = cols.max(1);
+    let n = flat.len() / cols;
+    let mut flat = flat;
+    // Every caller passes n * cols values; a stray tail would be dropped, never a panic.
+    flat.truncate(n * cols);
+    match Array2::from_shape_vec((n, cols), flat) {
+        Ok(a) => a.into_pyarray(py),
+        Err(_) => PyArray2::zeros(py, [0, cols], false),
+    }
 }
 
 /// A vector as a 1-D array.

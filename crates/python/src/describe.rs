@@ -5,13 +5,13 @@ use crate::descriptor::PyDescriptor;
 use crate::errors;
 use crate::geodesic::PyGeodesicSolver;
 use crate::mesh::mesh_arg;
-use std::time::{Duration, Instant};
 use bipolar::{DescriptorOptions, LevelSpec, SelectionRule, Source, TangentMethod};
 use geodesic::Method;
 use glam::DVec3;
 use meshcore::{FaceLocator, TriMesh};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString};
+use std::time::{Duration, Instant};
 
 /// Descriptor options from the arguments of `bipolar describe` (same defaults and rules).
 #[allow(clippy::too_many_arguments)]
@@ -75,7 +75,10 @@ fn given_landmarks(obj: &Bound<'_, PyAny>) -> PyResult<Vec<(String, DVec3)>> {
 
 fn snap(mesh: &TriMesh, p: DVec3, what: &str) -> PyResult<Source> {
     if !p.is_finite() {
-        return Err(errors::input(format!("{what}: {:?} is not finite", p.to_array())));
+        return Err(errors::input(format!(
+            "{what}: {:?} is not finite",
+            p.to_array()
+        )));
     }
     let (sp, _) = FaceLocator::new(mesh).nearest(p).map_err(errors::mesh)?;
     Ok(Source::Point(sp))
@@ -175,7 +178,9 @@ fn describe_impl(
     landmarks: Option<&Bound<'_, PyAny>>,
     solver: Option<&Bound<'_, PyGeodesicSolver>>,
 ) -> PyResult<(PyDescriptor, f64)> {
-    let opts = options(levels, step, max_level, angles, alpha, rule, tolerance, tangent)?;
+    let opts = options(
+        levels, step, max_level, angles, alpha, rule, tolerance, tangent,
+    )?;
     let m = mesh_arg(mesh)?;
     let mesh = m.mesh();
     let given = landmarks.map(given_landmarks).transpose()?;
@@ -198,7 +203,10 @@ fn describe_impl(
             let s = s.get();
             py.detach(|| {
                 let t = Instant::now();
-                (bipolar::describe(mesh, s.solver.as_ref(), &sources, &opts), t.elapsed())
+                (
+                    bipolar::describe(mesh, s.solver.as_ref(), &sources, &opts),
+                    t.elapsed(),
+                )
             })
         }
         None => {
@@ -251,7 +259,11 @@ pub fn describe(
     landmarks: Option<&Bound<'_, PyAny>>,
     solver: Option<&Bound<'_, PyGeodesicSolver>>,
 ) -> PyResult<PyDescriptor> {
-    describe_impl(py, mesh, ref_a, ref_b, refs, levels, step, max_level, angles, alpha, rule, tolerance, tangent, method, landmarks, solver).map(|(d, _)| d)
+    describe_impl(
+        py, mesh, ref_a, ref_b, refs, levels, step, max_level, angles, alpha, rule, tolerance,
+        tangent, method, landmarks, solver,
+    )
+    .map(|(d, _)| d)
 }
 
 /// ``describe`` returning ``(descriptor, seconds spent inside the library calls)``: the time
@@ -290,5 +302,8 @@ pub fn _describe_profiled(
     landmarks: Option<&Bound<'_, PyAny>>,
     solver: Option<&Bound<'_, PyGeodesicSolver>>,
 ) -> PyResult<(PyDescriptor, f64)> {
-    describe_impl(py, mesh, ref_a, ref_b, refs, levels, step, max_level, angles, alpha, rule, tolerance, tangent, method, landmarks, solver)
+    describe_impl(
+        py, mesh, ref_a, ref_b, refs, levels, step, max_level, angles, alpha, rule, tolerance,
+        tangent, method, landmarks, solver,
+    )
 }

@@ -28,7 +28,8 @@ fn json_to_py<'py>(py: Python<'py>, text: &str) -> PyResult<Bound<'py, PyAny>> {
 #[pymethods]
 impl PyDescriptor {
     /// A descriptor from user arrays (e.g. any keyed point set): ``points`` (n, 3), ``keys``
-    /// (n,) unsigned integers; ``cos`` (n,) and ``ambiguous`` (n,) default to 0 and False.
+    /// (n,) packed keys (``Descriptor.keys``, ``pack_key``, or any multiple of 16 below 2**26);
+    /// ``cos`` (n,) and ``ambiguous`` (n,) default to 0 and False.
     /// Points stay in the given order (distances pair them by key, whatever the order).
     #[staticmethod]
     #[pyo3(signature = (points, keys, cos=None, ambiguous=None))]
@@ -45,6 +46,16 @@ impl PyDescriptor {
             return Err(errors::input(format!(
                 "keys has {} entries for {n} points",
                 k.len()
+            )));
+        }
+        if let Some((i, &key)) = k
+            .iter()
+            .enumerate()
+            .find(|(_, &x)| Key::unpack(x).pack() != x)
+        {
+            return Err(errors::input(format!(
+                "keys[{i}] = {key} is not a packed bipolar key (the side and sign fields, bits \
+                 0-3, hold 0, 1 or 2 each; make keys with bipolar.pack_key or use multiples of 16)"
             )));
         }
         if let Some((i, q)) = p.iter().enumerate().find(|(_, q)| !q.is_finite()) {
@@ -128,7 +139,10 @@ impl PyDescriptor {
     /// Barycentric coordinates of each point in its face, shape (n, 3).
     #[getter]
     fn bary<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray2<f64>> {
-        points_out(py, &self.d.points.iter().map(|p| p.bary).collect::<Vec<_>>())
+        points_out(
+            py,
+            &self.d.points.iter().map(|p| p.bary).collect::<Vec<_>>(),
+        )
     }
 
     /// The unpacked key fields as a dict of (n,) arrays: ``a``, ``b`` (reference pair), ``i``,
@@ -227,7 +241,10 @@ impl PyDescriptor {
         )
     }
 
-    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
         let f = py
             .import("bipolar._bipolar")?
             .getattr("_descriptor_from_state")?;
@@ -242,7 +259,9 @@ impl PyDescriptor {
                 self.ambiguous(py).into_any(),
                 self.faces(py).into_any(),
                 self.bary(py).into_any(),
-                bipolar::io::to_json_string(&meta).into_pyobject(py)?.into_any(),
+                bipolar::io::to_json_string(&meta)
+                    .into_pyobject(py)?
+                    .into_any(),
             ],
         )?;
         Ok((f, args))
@@ -272,8 +291,8 @@ pub fn _descriptor_from_state(
     bary: &Bound<'_, PyAny>,
     meta: &str,
 ) -> PyResult<PyDescriptor> {
-    let mut d =
-        bipolar::io::parse_json(meta, std::path::Path::new("<pickle>")).map_err(errors::descriptor)?;
+    let mut d = bipolar::io::parse_json(meta, std::path::Path::new("<pickle>"))
+        .map_err(errors::descriptor)?;
     let p = convert::points(points, "points")?;
     let k = convert::u64_vec(keys, "keys")?;
     let c = convert::f64_vec(cos, "cos")?;
@@ -281,7 +300,10 @@ pub fn _descriptor_from_state(
     let f = convert::u32_vec(faces, "faces")?;
     let b = convert::points(bary, "bary")?;
     let n = p.len();
-    if [k.len(), c.len(), a.len(), f.len(), b.len()].iter().any(|&l| l != n) {
+    if [k.len(), c.len(), a.len(), f.len(), b.len()]
+        .iter()
+        .any(|&l| l != n)
+    {
         return Err(errors::input("inconsistent descriptor state"));
     }
     d.points = (0..n)

@@ -164,7 +164,10 @@ impl PyDistanceOptions {
         Ok(format!("DistanceOptions(**{})", self.as_dict(py)?.repr()?))
     }
 
-    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
         let f = py
             .import("bipolar._bipolar")?
             .getattr("_distance_options_from_dict")?;
@@ -179,7 +182,10 @@ pub fn _distance_options_from_dict(
     d: &Bound<'_, PyDict>,
 ) -> PyResult<Py<PyDistanceOptions>> {
     let cls = py.get_type::<PyDistanceOptions>();
-    Ok(cls.call((), Some(d))?.cast_into::<PyDistanceOptions>()?.unbind())
+    Ok(cls
+        .call((), Some(d))?
+        .cast_into::<PyDistanceOptions>()?
+        .unbind())
 }
 
 /// `options`, or options built from keyword arguments (not both).
@@ -228,7 +234,11 @@ struct Sets {
     prepared: Option<Vec<PreparedSet>>,
 }
 
-fn prepare_sets(ds: &[&bipolar::Descriptor], o: &PyDistanceOptions, which: Which) -> Result<Sets, (usize, ShapeDistError)> {
+fn prepare_sets(
+    ds: &[&bipolar::Descriptor],
+    o: &PyDistanceOptions,
+    which: Which,
+) -> Result<Sets, (usize, ShapeDistError)> {
     let loaded: Vec<Loaded> = ds.iter().map(|d| load(d, o.keep_ambiguous)).collect();
     let prepared = if o.mode == Mode::Keys {
         None
@@ -247,7 +257,11 @@ fn prepare_sets(ds: &[&bipolar::Descriptor], o: &PyDistanceOptions, which: Which
 
 fn rows(r: DMat3) -> [[f64; 3]; 3] {
     let t = r.transpose();
-    [t.x_axis.to_array(), t.y_axis.to_array(), t.z_axis.to_array()]
+    [
+        t.x_axis.to_array(),
+        t.y_axis.to_array(),
+        t.z_axis.to_array(),
+    ]
 }
 
 /// The distance of one pair and, when `details`, the fields `bipolar distance --json` prints.
@@ -261,7 +275,13 @@ fn compare(
 ) -> Result<(f64, Option<serde_json::Value>), ShapeDistError> {
     match o.mode {
         Mode::Keys => {
-            let r = shapedist::keyed_distance(&a.keys, &a.key_points, &b.keys, &b.key_points, &o.keyed)?;
+            let r = shapedist::keyed_distance(
+                &a.keys,
+                &a.key_points,
+                &b.keys,
+                &b.key_points,
+                &o.keyed,
+            )?;
             let v = details.then(|| {
                 json!({
                     "mode": "keys",
@@ -346,16 +366,19 @@ impl Fail {
     }
 }
 
-fn descriptor_list<'py>(obj: &Bound<'py, PyAny>, what: &str) -> PyResult<Vec<Bound<'py, PyDescriptor>>> {
+fn descriptor_list<'py>(
+    obj: &Bound<'py, PyAny>,
+    what: &str,
+) -> PyResult<Vec<Bound<'py, PyDescriptor>>> {
     let it = obj
         .try_iter()
         .map_err(|_| errors::type_error(format!("{what} must be a sequence of Descriptor")))?;
     let mut out = Vec::new();
     for (k, item) in it.enumerate() {
         let item = item?;
-        let d = item.cast::<PyDescriptor>().map_err(|_| {
-            errors::type_error(format!("{what}[{k}] is not a bipolar.Descriptor"))
-        })?;
+        let d = item
+            .cast::<PyDescriptor>()
+            .map_err(|_| errors::type_error(format!("{what}[{k}] is not a bipolar.Descriptor")))?;
         out.push(d.clone());
     }
     Ok(out)
@@ -420,23 +443,24 @@ pub fn distance_matrix<'py>(
     let ds = descriptor_list(descriptors, "descriptors")?;
     let refs: Vec<&bipolar::Descriptor> = ds.iter().map(|d| &d.get().d).collect();
     let n = refs.len();
-    let m = py.detach(|| {
-        convert::with_threads(threads, || {
-            let sets =
-                prepare_sets(&refs, &o, Which::A).map_err(|(i, e)| Fail::Set("descriptors", i, e))?;
-            let idx: Vec<usize> = (0..n).collect();
-            shapedist::pairwise_matrix(&idx, |&i, &j| {
-                let (pa, pb) = match &sets.prepared {
-                    Some(p) => (Some(&p[i]), Some(&p[j])),
-                    None => (None, None),
-                };
-                compare(&sets.loaded[i], &sets.loaded[j], pa, pb, &o, false).map(|(d, _)| d)
+    let m = py
+        .detach(|| {
+            convert::with_threads(threads, || {
+                let sets = prepare_sets(&refs, &o, Which::A)
+                    .map_err(|(i, e)| Fail::Set("descriptors", i, e))?;
+                let idx: Vec<usize> = (0..n).collect();
+                shapedist::pairwise_matrix(&idx, |&i, &j| {
+                    let (pa, pb) = match &sets.prepared {
+                        Some(p) => (Some(&p[i]), Some(&p[j])),
+                        None => (None, None),
+                    };
+                    compare(&sets.loaded[i], &sets.loaded[j], pa, pb, &o, false).map(|(d, _)| d)
+                })
+                .map_err(|e| Fail::Pair(e.i, e.j, e.error))
             })
-            .map_err(|e| Fail::Pair(e.i, e.j, e.error))
+            .map_err(Fail::Threads)?
         })
-        .map_err(Fail::Threads)?
-    })
-    .map_err(Fail::into_py)?;
+        .map_err(Fail::into_py)?;
     Ok(rows_out(py, m.into_iter().flatten().collect(), n))
 }
 
@@ -459,27 +483,30 @@ pub fn cross_distances<'py>(
     let rr: Vec<&bipolar::Descriptor> = r.iter().map(|d| &d.get().d).collect();
     let cc: Vec<&bipolar::Descriptor> = c.iter().map(|d| &d.get().d).collect();
     let (nr, nc) = (rr.len(), cc.len());
-    let flat = py.detach(|| {
-        convert::with_threads(threads, || {
-            let sr = prepare_sets(&rr, &o, Which::A).map_err(|(i, e)| Fail::Set("rows", i, e))?;
-            let sc = prepare_sets(&cc, &o, Which::A).map_err(|(j, e)| Fail::Set("cols", j, e))?;
-            let pairs: Vec<(usize, usize)> =
-                (0..nr).flat_map(|i| (0..nc).map(move |j| (i, j))).collect();
-            pairs
-                .par_iter()
-                .map(|&(i, j)| {
-                    let (pa, pb) = match (&sr.prepared, &sc.prepared) {
-                        (Some(p), Some(q)) => (Some(&p[i]), Some(&q[j])),
-                        _ => (None, None),
-                    };
-                    compare(&sr.loaded[i], &sc.loaded[j], pa, pb, &o, false)
-                        .map(|(d, _)| d)
-                        .map_err(|e| Fail::Pair(i, j, e))
-                })
-                .collect::<Result<Vec<f64>, Fail>>()
+    let flat = py
+        .detach(|| {
+            convert::with_threads(threads, || {
+                let sr =
+                    prepare_sets(&rr, &o, Which::A).map_err(|(i, e)| Fail::Set("rows", i, e))?;
+                let sc =
+                    prepare_sets(&cc, &o, Which::A).map_err(|(j, e)| Fail::Set("cols", j, e))?;
+                let pairs: Vec<(usize, usize)> =
+                    (0..nr).flat_map(|i| (0..nc).map(move |j| (i, j))).collect();
+                pairs
+                    .par_iter()
+                    .map(|&(i, j)| {
+                        let (pa, pb) = match (&sr.prepared, &sc.prepared) {
+                            (Some(p), Some(q)) => (Some(&p[i]), Some(&q[j])),
+                            _ => (None, None),
+                        };
+                        compare(&sr.loaded[i], &sc.loaded[j], pa, pb, &o, false)
+                            .map(|(d, _)| d)
+                            .map_err(|e| Fail::Pair(i, j, e))
+                    })
+                    .collect::<Result<Vec<f64>, Fail>>()
+            })
+            .map_err(Fail::Threads)?
         })
-        .map_err(Fail::Threads)?
-    })
-    .map_err(Fail::into_py)?;
+        .map_err(Fail::into_py)?;
     Ok(rows_out(py, flat, nc))
 }

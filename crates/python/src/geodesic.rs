@@ -2,7 +2,6 @@
 
 use crate::convert::{self, rows_out, vec_out};
 use crate::errors;
-use crate::mesh::PyMesh;
 use geodesic::{GeodesicSolver, Method, SolveOptions, Source};
 use meshcore::SurfacePoint;
 use pyo3::prelude::*;
@@ -31,7 +30,8 @@ pub fn surface_points(
 /// The cut-off argument: None, +inf and values >= 1e100 (tvb-gdist's "infinity") mean none.
 pub fn cutoff(max_distance: Option<f64>) -> SolveOptions {
     SolveOptions {
-        max_distance: max_distance.filter(|c| !(c.is_infinite() && *c > 0.0) && *c < 1e100),
+        // `!(c >= 1e100)` keeps NaN, which the library rejects with its own message.
+        max_distance: max_distance.filter(|c| !(*c >= 1e100)),
     }
 }
 
@@ -162,29 +162,30 @@ impl PyGeodesicSolver {
         let src = convert::u32_vec(sources, "sources")?;
         let opts = cutoff(max_distance);
         let limit = opts.max_distance.unwrap_or(f64::INFINITY);
-        let result = py.detach(|| {
-            convert::with_threads(threads, || {
-                let mut indptr = vec![0i64];
-                let mut indices: Vec<i64> = Vec::new();
-                let mut data: Vec<f64> = Vec::new();
-                for chunk in src.chunks(256) {
-                    let sets: Vec<Vec<Source>> =
-                        chunk.iter().map(|&v| vec![Source::Vertex(v)]).collect();
-                    let fields = geodesic::distances_many(self.solver.as_ref(), &sets, &opts)?;
-                    for f in fields {
-                        for (j, d) in f.into_iter().enumerate() {
-                            if d.is_finite() && d > 0.0 && d <= limit {
-                                indices.push(j as i64);
-                                data.push(d);
+        let result = py
+            .detach(|| {
+                convert::with_threads(threads, || {
+                    let mut indptr = vec![0i64];
+                    let mut indices: Vec<i64> = Vec::new();
+                    let mut data: Vec<f64> = Vec::new();
+                    for chunk in src.chunks(256) {
+                        let sets: Vec<Vec<Source>> =
+                            chunk.iter().map(|&v| vec![Source::Vertex(v)]).collect();
+                        let fields = geodesic::distances_many(self.solver.as_ref(), &sets, &opts)?;
+                        for f in fields {
+                            for (j, d) in f.into_iter().enumerate() {
+                                if d.is_finite() && d > 0.0 && d <= limit {
+                                    indices.push(j as i64);
+                                    data.push(d);
+                                }
                             }
+                            indptr.push(indices.len() as i64);
                         }
-                        indptr.push(indices.len() as i64);
                     }
-                }
-                Ok::<_, geodesic::GeodesicError>((indptr, indices, data))
+                    Ok::<_, geodesic::GeodesicError>((indptr, indices, data))
+                })
             })
-        })
-        .map_err(errors::input)?;
+            .map_err(errors::input)?;
         let (indptr, indices, data) = result.map_err(errors::geodesic)?;
         PyTuple::new(
             py,

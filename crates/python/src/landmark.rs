@@ -61,7 +61,12 @@ pub fn detect_landmarks<'py>(
     out.set_item("inlier_fraction", lm.inlier_fraction)?;
     out.set_item("symmetry", lm.symmetry)?;
     let a = lm.model_to_mesh;
-    let (x, y, z, t) = (a.matrix3.x_axis, a.matrix3.y_axis, a.matrix3.z_axis, a.translation);
+    let (x, y, z, t) = (
+        a.matrix3.x_axis,
+        a.matrix3.y_axis,
+        a.matrix3.z_axis,
+        a.translation,
+    );
     let flat = vec![
         x.x, y.x, z.x, t.x, x.y, y.y, z.y, t.y, x.z, y.z, z.z, t.z, 0.0, 0.0, 0.0, 1.0,
     ];

@@ -3,8 +3,11 @@
 use crate::convert::{self, points_out, rows_out, vec_out};
 use crate::errors;
 use glam::DVec3;
-use mesh_io::{Format, LoadedMesh, PlyEncoding, PlyWriteOptions, RepairSummary, ScalarField, ScalarType};
+use mesh_io::{
+    Format, LoadedMesh, PlyEncoding, PlyWriteOptions, RepairSummary, ScalarField, ScalarType,
+};
 use meshcore::{FaceLocator, TriMesh};
+use numpy::PyArrayMethods;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyTuple};
 use std::path::Path;
@@ -35,7 +38,10 @@ fn summary_dict<'py>(py: Python<'py>, s: RepairSummary) -> PyResult<Bound<'py, P
 }
 
 /// Builds a mesh from arrays (the one place a `TriMesh` is made from Python data).
-pub fn mesh_from_arrays(vertices: &Bound<'_, PyAny>, triangles: &Bound<'_, PyAny>) -> PyResult<TriMesh> {
+pub fn mesh_from_arrays(
+    vertices: &Bound<'_, PyAny>,
+    triangles: &Bound<'_, PyAny>,
+) -> PyResult<TriMesh> {
     let v = convert::points(vertices, "vertices")?;
     let t = convert::triangles(triangles, "triangles")?;
     TriMesh::new(v, t).map_err(errors::mesh)
@@ -146,7 +152,10 @@ impl PyMesh {
     /// For meshes made from a range grid (BNT): per vertex, its sample index row * ncols + col.
     #[getter]
     fn grid_index<'py>(&self, py: Python<'py>) -> Option<Bound<'py, numpy::PyArray1<u32>>> {
-        self.loaded.grid_index.as_ref().map(|g| vec_out(py, g.clone()))
+        self.loaded
+            .grid_index
+            .as_ref()
+            .map(|g| vec_out(py, g.clone()))
     }
 
     /// What the reader noticed and did not repair (degenerate faces, duplicate vertices, ...).
@@ -234,7 +243,9 @@ impl PyMesh {
         let n = self.mesh().n_vertices();
         if let Some(c) = colors {
             let a = convert::i64_array(c, "colors")?;
-            let ro = a.try_readonly().map_err(|e| errors::input(format!("colors: {e}")))?;
+            let ro = a
+                .try_readonly()
+                .map_err(|e| errors::input(format!("colors: {e}")))?;
             let v = ro.as_array();
             let sh = v.shape().to_vec();
             if sh.len() != 2 || sh[0] != n || !(sh[1] == 3 || sh[1] == 4) {
@@ -280,7 +291,9 @@ impl PyMesh {
     #[pyo3(signature = (tol=0.0))]
     fn weld<'py>(&self, py: Python<'py>, tol: f64) -> PyResult<(Self, Bound<'py, PyDict>)> {
         if !(tol.is_finite() && tol >= 0.0) {
-            return Err(errors::input(format!("tol must be finite and >= 0, got {tol}")));
+            return Err(errors::input(format!(
+                "tol must be finite and >= 0, got {tol}"
+            )));
         }
         let mut out = self.clone();
         let s = py.detach(|| out.loaded.weld(tol));
@@ -327,7 +340,10 @@ impl PyMesh {
         )
     }
 
-    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
         let f = py.import("bipolar._bipolar")?.getattr("_mesh_from_state")?;
         let scalars = PyDict::new(py);
         for s in &self.loaded.scalars {
@@ -342,7 +358,8 @@ impl PyMesh {
             [
                 self.vertices(py).into_any(),
                 self.triangles(py).into_any(),
-                self.colors(py).map_or_else(|| py.None().into_bound(py), |c| c.into_any()),
+                self.colors(py)
+                    .map_or_else(|| py.None().into_bound(py), |c| c.into_any()),
                 scalars.into_any(),
             ],
         )?;
@@ -398,7 +415,11 @@ pub fn read_mesh_bytes(py: Python<'_>, data: &[u8], format: &str) -> PyResult<Py
 /// Writes a mesh; the format comes from the extension (obj, ply (binary little endian), stl,
 /// off, glb). Colours and scalars are written where the format can carry them.
 #[pyfunction]
-pub fn write_mesh(py: Python<'_>, path: &Bound<'_, PyAny>, mesh: &Bound<'_, PyMesh>) -> PyResult<()> {
+pub fn write_mesh(
+    py: Python<'_>,
+    path: &Bound<'_, PyAny>,
+    mesh: &Bound<'_, PyMesh>,
+) -> PyResult<()> {
     let p = convert::path(path, "path")?;
     let m = mesh.get();
     py.detach(|| mesh_io::write_mesh(&p, &m.loaded))
@@ -467,16 +488,27 @@ fn labelled<'py>(py: Python<'py>, items: Vec<(String, Vec<f64>)>) -> PyResult<Bo
 /// Reads labelled 3D landmarks: Bosphorus ``.lm3`` by extension, otherwise JSON as written by
 /// ``bipolar landmarks`` or a flat ``{name: [x, y, z]}`` object. Returns ``{label: (3,) array}``.
 #[pyfunction]
-pub fn read_landmarks<'py>(py: Python<'py>, path: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
+pub fn read_landmarks<'py>(
+    py: Python<'py>,
+    path: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyDict>> {
     let p = convert::path(path, "path")?;
     let pts = landmarks::io::read_landmarks(&p).map_err(errors::landmarks)?;
-    labelled(py, pts.into_iter().map(|(l, q)| (l, q.to_array().to_vec())).collect())
+    labelled(
+        py,
+        pts.into_iter()
+            .map(|(l, q)| (l, q.to_array().to_vec()))
+            .collect(),
+    )
 }
 
 /// Reads the ICT FaceKit ``landmarks.json`` layout: ``{face: {name: (3,) array}}`` with the five
 /// landmark names of ``bipolar.LANDMARK_NAMES``.
 #[pyfunction]
-pub fn read_ict_landmarks<'py>(py: Python<'py>, path: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
+pub fn read_ict_landmarks<'py>(
+    py: Python<'py>,
+    path: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyDict>> {
     let p = convert::path(path, "path")?;
     let faces = landmarks::io::read_ict_landmarks(&p).map_err(errors::landmarks)?;
     let out = PyDict::new(py);
@@ -553,12 +585,21 @@ pub fn uv_sphere(py: Python<'_>, n_lat: usize, n_lon: usize) -> PyResult<PyMesh>
 /// vertices jittered by up to ``jitter * h / 2`` per axis (deterministic in ``seed``).
 #[pyfunction]
 #[pyo3(signature = (n, h=1.0, x0=0.0, jitter=0.0, seed=0))]
-pub fn grid_plane(py: Python<'_>, n: usize, h: f64, x0: f64, jitter: f64, seed: u64) -> PyResult<PyMesh> {
+pub fn grid_plane(
+    py: Python<'_>,
+    n: usize,
+    h: f64,
+    x0: f64,
+    jitter: f64,
+    seed: u64,
+) -> PyResult<PyMesh> {
     if n == 0 || n > 3000 {
         return Err(errors::input(format!("n must be in 1..=3000, got {n}")));
     }
     if !(h.is_finite() && h > 0.0 && x0.is_finite() && jitter.is_finite() && jitter >= 0.0) {
-        return Err(errors::input("h must be positive, x0 and jitter finite (jitter >= 0)"));
+        return Err(errors::input(
+            "h must be positive, x0 and jitter finite (jitter >= 0)",
+        ));
     }
     let m = py.detach(|| meshcore::shapes::grid_plane(n, h, x0, jitter, seed, |_| false));
     Ok(PyMesh {
