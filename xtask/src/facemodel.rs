@@ -318,3 +318,80 @@ pub fn read_obj(path: &Path) -> Result<(Vec<DVec3>, Vec<[u32; 3]>)> {
 pub fn read_npy_f32(path: &Path) -> Result<(Vec<usize>, Vec<f32>)> {
     mesh_io::read_npy_f32(path).with_context(|| format!("reading {}", path.display()))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+
+    /// FNV-1a (64 bit) over the little-endian bytes of every vertex coordinate, in vertex order.
+    fn digest(mesh: &TriMesh) -> u64 {
+        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+        for p in mesh.positions() {
+            for c in p.to_array() {
+                for b in c.to_bits().to_le_bytes() {
+                    h ^= u64::from(b);
+                    h = h.wrapping_mul(0x0000_0100_0000_01b3);
+                }
+            }
+        }
+        h
+    }
+
+    #[test]
+    fn pin_sampled_faces() {
+        let dir = default_model_dir();
+        if !dir.is_dir() {
+            eprintln!("skipping: {} not found", dir.display());
+            return;
+        }
+        let model = FaceModel::load(&dir).unwrap();
+        let pinned = [
+            (1u64, 0xc6c4_0fbc_7305_1b7b_u64),
+            (2, 0x17f1_0dfd_dc75_13db),
+            (3, 0x3ace_7802_7c93_f4bb),
+        ];
+        for (seed, want) in pinned {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let id = model.random_identity(&mut rng);
+            let ex = model.random_expression(&mut rng);
+            let pose = random_rigid_motion(&mut rng, 10.0);
+            let face = model.sample(&id, &ex).unwrap().transformed(&pose);
+            assert_eq!(digest(&face), want, "seed {seed}: {:#018x}", digest(&face));
+        }
+        assert_eq!(digest(&model.neutral().unwrap()), 0xd6b5_da21_6777_0c29);
+    }
+
+    #[test]
+    fn pin_obj_reader() {
+        let shared = shared_dir();
+        let mut files = vec![shared.join("faces/ict-facekit/model/neutral.obj")];
+        let ps = shared.join("faces/ict-facekit/paper-set");
+        if !ps.is_dir() {
+            return;
+        }
+        let mut v: Vec<_> = std::fs::read_dir(&ps)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|e| e == "obj"))
+            .collect();
+        v.sort();
+        files.extend(v);
+        for f in files {
+            let a = crate::experiments::data::parse_obj(&std::fs::read_to_string(&f).unwrap())
+                .unwrap();
+            let b = mesh_io::read_mesh(&f).unwrap();
+            assert!(b.warnings.is_empty(), "{:?}", b.warnings);
+            let same_pos = a.positions().len() == b.mesh.positions().len()
+                && a
+                    .positions()
+                    .iter()
+                    .zip(b.mesh.positions())
+                    .all(|(x, y)| x.to_array().map(f64::to_bits) == y.to_array().map(f64::to_bits));
+            assert!(same_pos, "{}", f.display());
+            assert_eq!(a.triangles(), b.mesh.triangles(), "{}", f.display());
+            println!("{}: identical ({} vertices)", f.display(), a.n_vertices());
+        }
+    }
+}
