@@ -1,8 +1,10 @@
-//! Face-set loading: the shared data folder, OBJ meshes and `landmarks.json`.
+//! Face-set loading: a folder of OBJ faces in the ICT topology (such as the paper set,
+//! `<shared>/faces/ict-facekit/paper-set`) and its optional `landmarks.json`.
 
-use anyhow::{bail, Context, Result};
+use crate::FaceModelError;
 use meshcore::{DVec3, TriMesh};
-use std::path::{Path, PathBuf};
+use std::collections::BTreeMap;
+use std::path::Path;
 
 /// Vertex id of the right outer eye corner in the ICT face topology (ground truth).
 pub const RIGHT_EYE_OUTER: u32 = 1507;
@@ -10,40 +12,6 @@ pub const RIGHT_EYE_OUTER: u32 = 1507;
 pub const LEFT_EYE_OUTER: u32 = 3721;
 /// Vertex id of the nose tip.
 pub const NOSE_TIP: u32 = 4857;
-
-/// Root of the workspace (the folder holding the root `Cargo.toml`).
-pub fn workspace_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .map(Path::to_path_buf)
-        .unwrap_or_else(|| PathBuf::from("."))
-}
-
-/// The shared data folder: `$BIPOLAR_SHARED`, else `../shared` relative to the workspace root.
-pub fn shared_dir() -> PathBuf {
-    match std::env::var_os("BIPOLAR_SHARED") {
-        Some(p) if !p.is_empty() => PathBuf::from(p),
-        _ => workspace_root().join("..").join("shared"),
-    }
-}
-
-/// Default folder of the paper set (12 faces + `landmarks.json`).
-pub fn default_paper_set() -> PathBuf {
-    shared_dir()
-        .join("faces")
-        .join("ict-facekit")
-        .join("paper-set")
-}
-
-/// Output folder `name` under the cargo target directory (`$CARGO_TARGET_DIR` if set,
-/// else `<workspace>/target`).
-pub fn default_out_dir(name: &str) -> PathBuf {
-    let target = match std::env::var_os("CARGO_TARGET_DIR") {
-        Some(p) if !p.is_empty() => PathBuf::from(p),
-        _ => workspace_root().join("target"),
-    };
-    target.join(name)
-}
 
 /// Three landmarks of one face: vertex ids (ground truth) and positions.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -72,10 +40,9 @@ impl FaceLandmarks {
 pub struct Face {
     /// File stem, e.g. `id1_neutral`.
     pub name: String,
-    /// Person label (`id1` ...).
+    /// Person label (`id1` ...): the stem before the first `_`.
     pub person: String,
-    /// Expression label (`neutral`, `anger` ...).
-    #[allow(dead_code)] // descriptive; tables use `name`
+    /// Expression label (`neutral`, `anger` ...): the stem after the first `_`.
     pub expression: String,
     /// The mesh (cm).
     pub mesh: TriMesh,
@@ -83,76 +50,22 @@ pub struct Face {
     pub landmarks: FaceLandmarks,
 }
 
-/// Reads a triangle mesh from a file with `mesh-io` (warnings are ignored here).
-pub fn read_mesh(path: &Path) -> Result<TriMesh> {
-    Ok(mesh_io::read_mesh(path)
-        .with_context(|| format!("reading {}", path.display()))?
-        .mesh)
-}
-
-#[allow(dead_code)] // kept as the reference reader of the tests
-/// Minimal OBJ parser: `v x y z` and `f a b c ...` (1-based or negative indices, `a/b/c`
-/// tokens, polygons fan-triangulated). Everything else is ignored.
-pub fn parse_obj(text: &str) -> Result<TriMesh> {
-    let mut pos = Vec::new();
-    let mut tris = Vec::new();
-    for (ln, line) in text.lines().enumerate() {
-        let mut it = line.split_whitespace();
-        match it.next() {
-            Some("v") => {
-                let mut c = [0.0f64; 3];
-                for x in c.iter_mut() {
-                    let tok = it.next().with_context(|| {
-                        format!("line {}: vertex with fewer than 3 coordinates", ln + 1)
-                    })?;
-                    *x = tok
-                        .parse()
-                        .with_context(|| format!("line {}: bad coordinate {tok:?}", ln + 1))?;
-                }
-                pos.push(DVec3::from_array(c));
-            }
-            Some("f") => {
-                let mut idx = Vec::new();
-                for tok in it {
-                    let first = tok.split('/').next().unwrap_or("");
-                    let i: i64 = first
-                        .parse()
-                        .with_context(|| format!("line {}: bad face index {tok:?}", ln + 1))?;
-                    let n = pos.len() as i64;
-                    let k = if i > 0 { i - 1 } else { n + i };
-                    if k < 0 {
-                        bail!("line {}: face index {i} out of range", ln + 1);
-                    }
-                    idx.push(k as u32);
-                }
-                if idx.len() < 3 {
-                    bail!("line {}: face with fewer than 3 vertices", ln + 1);
-                }
-                for k in 1..idx.len() - 1 {
-                    tris.push([idx[0], idx[k], idx[k + 1]]);
-                }
-            }
-            _ => {}
-        }
-    }
-    Ok(TriMesh::new(pos, tris)?)
-}
-
 /// Landmark positions per face from `landmarks.json` (`faces.<name>.<landmark> = [x, y, z]`).
 pub fn read_landmark_positions(
     path: &Path,
-) -> Result<std::collections::BTreeMap<String, std::collections::BTreeMap<String, DVec3>>> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let v: serde_json::Value =
-        serde_json::from_str(&text).with_context(|| format!("parsing {}", path.display()))?;
+) -> Result<BTreeMap<String, BTreeMap<String, DVec3>>, FaceModelError> {
+    let text = std::fs::read_to_string(path).map_err(|e| FaceModelError::io(path, e))?;
+    let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| FaceModelError::Json {
+        path: path.to_path_buf(),
+        source: e,
+    })?;
     let faces = v
         .get("faces")
         .and_then(|f| f.as_object())
-        .with_context(|| format!("{}: no \"faces\" object", path.display()))?;
-    let mut out = std::collections::BTreeMap::new();
+        .ok_or_else(|| FaceModelError::json(path, "no \"faces\" object"))?;
+    let mut out = BTreeMap::new();
     for (name, lms) in faces {
-        let mut m = std::collections::BTreeMap::new();
+        let mut m = BTreeMap::new();
         if let Some(obj) = lms.as_object() {
             for (lm, arr) in obj {
                 let a: Vec<f64> = arr
@@ -160,7 +73,10 @@ pub fn read_landmark_positions(
                     .map(|a| a.iter().filter_map(|x| x.as_f64()).collect())
                     .unwrap_or_default();
                 if a.len() != 3 {
-                    bail!("{}: {name}.{lm} is not [x, y, z]", path.display());
+                    return Err(FaceModelError::json(
+                        path,
+                        format!("faces.{name}.{lm} is not [x, y, z]"),
+                    ));
                 }
                 m.insert(lm.clone(), DVec3::new(a[0], a[1], a[2]));
             }
@@ -180,17 +96,20 @@ fn order_key(name: &str) -> (String, u8, String) {
     )
 }
 
-/// Loads every `*.obj` of `dir` (sorted: person, neutral first, then expressions) and checks
-/// the ground-truth landmark vertices against `landmarks.json` when it is present.
-pub fn load_face_set(dir: &Path) -> Result<Vec<Face>> {
+/// Loads every `*.obj` of `dir` (sorted by person, the person's `neutral` first, then the
+/// expressions by name) with `mesh-io`, checks that each has the ground-truth landmark vertices
+/// and, when `landmarks.json` is present, that its positions lie on those vertices (within
+/// `1e-4` of the bounding-box diagonal).
+pub fn load_face_set(dir: &Path) -> Result<Vec<Face>, FaceModelError> {
+    let set_err = |problem: &str| FaceModelError::FaceSet {
+        dir: dir.to_path_buf(),
+        problem: problem.into(),
+    };
     if !dir.is_dir() {
-        bail!(
-            "face folder {} not found (set --faces DIR or BIPOLAR_SHARED)",
-            dir.display()
-        );
+        return Err(set_err("face folder not found"));
     }
     let mut names: Vec<String> = std::fs::read_dir(dir)
-        .with_context(|| format!("listing {}", dir.display()))?
+        .map_err(|e| FaceModelError::io(dir, e))?
         .filter_map(|e| e.ok())
         .map(|e| e.path())
         .filter(|p| p.extension().is_some_and(|x| x.eq_ignore_ascii_case("obj")))
@@ -198,7 +117,7 @@ pub fn load_face_set(dir: &Path) -> Result<Vec<Face>> {
         .collect();
     names.sort_by_key(|n| order_key(n));
     if names.is_empty() {
-        bail!("no .obj file in {}", dir.display());
+        return Err(set_err("no .obj file"));
     }
     let lm_path = dir.join("landmarks.json");
     let lms = if lm_path.is_file() {
@@ -208,15 +127,23 @@ pub fn load_face_set(dir: &Path) -> Result<Vec<Face>> {
     };
     let mut faces = Vec::new();
     for name in names {
-        let mesh = read_mesh(&dir.join(format!("{name}.obj")))?;
+        let path = dir.join(format!("{name}.obj"));
+        let mesh = mesh_io::read_mesh(&path)
+            .map_err(|e| FaceModelError::mesh(&path, e))?
+            .mesh;
         let landmarks = FaceLandmarks::ground_truth();
         for v in [
             landmarks.right_eye_outer,
             landmarks.left_eye_outer,
             landmarks.nose_tip,
         ] {
-            mesh.try_position(v)
-                .with_context(|| format!("{name}: landmark vertex {v} missing"))?;
+            if v as usize >= mesh.n_vertices() {
+                return Err(FaceModelError::MissingLandmarkVertex {
+                    face: name,
+                    vertex: v,
+                    n_vertices: mesh.n_vertices(),
+                });
+            }
         }
         if let Some(m) = lms.as_ref().and_then(|l| l.get(&name)) {
             let tol = 1e-4 * mesh.bbox().diagonal();
@@ -228,7 +155,12 @@ pub fn load_face_set(dir: &Path) -> Result<Vec<Face>> {
                 if let Some(p) = m.get(key) {
                     let d = (mesh.position(v) - *p).length();
                     if d > tol {
-                        bail!("{name}: landmarks.json {key} is {d} away from vertex {v}");
+                        return Err(FaceModelError::LandmarkMismatch {
+                            face: name,
+                            landmark: key.into(),
+                            vertex: v,
+                            distance: d,
+                        });
                     }
                 }
             }
@@ -251,18 +183,7 @@ pub fn load_face_set(dir: &Path) -> Result<Vec<Face>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn obj_parser_handles_quads_slashes_and_negative_indices() {
-        let m = parse_obj(
-            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1/1/1 2/2/2 3/3/3 4/4/4\nf -4 -2 -1\n",
-        )
-        .unwrap();
-        assert_eq!(m.n_vertices(), 4);
-        assert_eq!(m.triangles(), &[[0, 1, 2], [0, 2, 3], [0, 2, 3]]);
-        assert!(parse_obj("v 0 0\nf 1 2 3\n").is_err());
-        assert!(parse_obj("v 0 0 0\nf 1 2 9\n").is_err());
-    }
+    use std::path::PathBuf;
 
     #[test]
     fn order_puts_neutral_first() {
@@ -274,16 +195,128 @@ mod tests {
         );
     }
 
+    /// The vertex ids of the ICT topology are OBJ file order: mesh-io keeps it (1-based,
+    /// negative and `v/vt/vn` indices, polygons fan-split from their first corner), the
+    /// behaviour of the private reader this crate replaced.
     #[test]
-    fn paper_set_loads_with_landmarks() {
-        let dir = default_paper_set();
-        if !dir.is_dir() {
-            eprintln!("skipping: {} not found", dir.display());
-            return;
+    fn obj_vertices_keep_file_order() {
+        let m = mesh_io::read_mesh_from_bytes(
+            b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1/1/1 2/2/2 3/3/3 4/4/4\nf -4 -2 -1\n",
+            mesh_io::Format::Obj,
+        )
+        .unwrap()
+        .mesh;
+        assert_eq!(m.n_vertices(), 4);
+        assert_eq!(m.position(2), DVec3::new(1.0, 1.0, 0.0));
+        assert_eq!(m.triangles(), &[[0, 1, 2], [0, 2, 3], [0, 2, 3]]);
+        for bad in ["v 0 0\nf 1 2 3\n", "v 0 0 0\nf 1 2 9\n"] {
+            assert!(mesh_io::read_mesh_from_bytes(bad.as_bytes(), mesh_io::Format::Obj).is_err());
         }
+    }
+
+    fn tmp(name: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("facemodel-set-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    /// OBJ text of a strip of `n` vertices (enough for the ICT landmark ids when `n > 4857`).
+    fn strip(n: usize) -> String {
+        let mut s = String::new();
+        for v in 0..n {
+            s += &format!("v {} {} 0\n", v / 2, v % 2);
+        }
+        for v in 1..n - 1 {
+            s += &format!("f {} {} {}\n", v, v + 1, v + 2);
+        }
+        s
+    }
+
+    #[test]
+    fn face_sets_load_in_order_and_bad_sets_are_named() {
+        let dir = tmp("ok");
+        for name in ["id2_neutral", "id1_smile", "id1_neutral"] {
+            std::fs::write(dir.join(format!("{name}.obj")), strip(4860)).unwrap();
+        }
+        std::fs::write(dir.join("notes.txt"), "not a face").unwrap();
         let faces = load_face_set(&dir).unwrap();
-        assert_eq!(faces.len(), 12);
-        assert_eq!(faces[0].name, "id1_neutral");
-        assert!(faces.iter().all(|f| f.mesh.n_vertices() == 6706));
+        let names: Vec<&str> = faces.iter().map(|f| f.name.as_str()).collect();
+        assert_eq!(names, ["id1_neutral", "id1_smile", "id2_neutral"]);
+        assert_eq!(
+            (faces[1].person.as_str(), faces[1].expression.as_str()),
+            ("id1", "smile")
+        );
+        assert_eq!(faces[0].landmarks, FaceLandmarks::ground_truth());
+
+        // landmarks.json on the vertex passes; off it by more than the tolerance fails.
+        let p = faces[0].mesh.position(NOSE_TIP);
+        let json = |dx: f64| {
+            format!(
+                "{{\"faces\": {{\"id1_neutral\": {{\"nose_tip\": [{}, {}, {}]}}}}}}",
+                p.x + dx,
+                p.y,
+                p.z
+            )
+        };
+        std::fs::write(dir.join("landmarks.json"), json(0.0)).unwrap();
+        assert_eq!(load_face_set(&dir).unwrap().len(), 3);
+        std::fs::write(dir.join("landmarks.json"), json(1.0)).unwrap();
+        match load_face_set(&dir) {
+            Err(FaceModelError::LandmarkMismatch {
+                face,
+                landmark,
+                vertex,
+                ..
+            }) => {
+                assert_eq!(
+                    (face.as_str(), landmark.as_str(), vertex),
+                    ("id1_neutral", "nose_tip", NOSE_TIP)
+                );
+            }
+            other => panic!("{other:?}"),
+        }
+        std::fs::write(
+            dir.join("landmarks.json"),
+            "{\"faces\": {\"a\": {\"nose_tip\": [1, 2]}}}",
+        )
+        .unwrap();
+        let e = load_face_set(&dir).unwrap_err();
+        assert!(
+            e.to_string().contains("faces.a.nose_tip is not [x, y, z]"),
+            "{e}"
+        );
+        std::fs::write(dir.join("landmarks.json"), "{\"faces\": ").unwrap();
+        assert!(matches!(
+            load_face_set(&dir),
+            Err(FaceModelError::Json { .. })
+        ));
+        std::fs::remove_file(dir.join("landmarks.json")).unwrap();
+
+        // A face outside the ICT topology lacks the landmark vertices.
+        std::fs::write(dir.join("id3_neutral.obj"), strip(100)).unwrap();
+        assert!(matches!(
+            load_face_set(&dir),
+            Err(FaceModelError::MissingLandmarkVertex {
+                vertex: RIGHT_EYE_OUTER,
+                n_vertices: 100,
+                ..
+            })
+        ));
+        std::fs::write(dir.join("id3_neutral.obj"), "v 0 0 0\nf 1 2 3\n").unwrap();
+        let e = load_face_set(&dir).unwrap_err();
+        assert!(
+            matches!(e, FaceModelError::Mesh { .. }) && e.to_string().contains("id3_neutral.obj"),
+            "{e}"
+        );
+
+        let empty = tmp("empty");
+        assert!(matches!(
+            load_face_set(&empty),
+            Err(FaceModelError::FaceSet { .. })
+        ));
+        let missing = empty.join("missing");
+        let e = load_face_set(&missing).unwrap_err();
+        assert!(e.to_string().contains("not found"), "{e}");
     }
 }

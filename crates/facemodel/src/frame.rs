@@ -1,4 +1,4 @@
-//! The static (upper) face area, derived from the landmarks.
+//! The landmark-derived face frame and the static (upper) face area.
 //!
 //! Choice (documented in `docs/experiments.md`): a vertex is static when it lies within the
 //! geodesic distance `D` (between the outer eye corners) of **both** corners and **above the
@@ -22,7 +22,8 @@ pub struct FaceFrame {
     pub forward: DVec3,
 }
 
-/// Builds the frame from the two outer eye corners and the nose tip.
+/// Builds the frame from the two outer eye corners `r`, `q` and the nose tip. Degenerate input
+/// (coincident corners, a mean normal along the eye line) gives zero vectors, never a panic.
 pub fn face_frame(mesh: &TriMesh, r: DVec3, q: DVec3, nose: DVec3) -> FaceFrame {
     let x = (q - r).normalize_or_zero();
     let mut n = DVec3::ZERO;
@@ -42,7 +43,7 @@ pub fn face_frame(mesh: &TriMesh, r: DVec3, q: DVec3, nose: DVec3) -> FaceFrame 
 }
 
 /// The static-area vertex mask (see the module doc). `ur`, `uq`: distances from the two
-/// corners; `d`: the distance between them.
+/// corners (one per vertex; missing entries count as outside); `d`: the distance between them.
 pub fn static_mask(
     mesh: &TriMesh,
     ur: &[f64],
@@ -54,14 +55,49 @@ pub fn static_mask(
     mesh.positions()
         .iter()
         .enumerate()
-        .map(|(v, p)| ur[v] <= d && uq[v] <= d && (*p - nose).dot(frame.up) >= 0.0)
+        .map(|(v, p)| {
+            let within = |u: &[f64]| u.get(v).is_some_and(|&u| u <= d);
+            within(ur) && within(uq) && (*p - nose).dot(frame.up) >= 0.0
+        })
         .collect()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::experiments::walk::tests::plane;
+    use crate::random_rigid_motion;
+    use meshcore::shapes::{grid, Diagonals};
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// Jittered planar grid on [0, 1]^2 (z = 0), `n` cells a side (the grid the tests of
+    /// xtask's straightest geodesics use).
+    fn plane(n: usize, jitter: f64, seed: u64) -> TriMesh {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let h = 1.0 / n as f64;
+        grid(n, n, Diagonals::Uniform, |i, j| {
+            let inner = i > 0 && j > 0 && i < n && j < n;
+            let (dx, dy) = if inner && jitter > 0.0 {
+                (
+                    rng.random_range(-jitter..jitter) * h,
+                    rng.random_range(-jitter..jitter) * h,
+                )
+            } else {
+                (0.0, 0.0)
+            };
+            DVec3::new(i as f64 * h + dx, j as f64 * h + dy, 0.0)
+        })
+        .unwrap()
+    }
+
+    fn assert_orthonormal(f: &FaceFrame) {
+        for (a, b) in [(f.x, f.up), (f.x, f.forward), (f.up, f.forward)] {
+            assert!(a.dot(b).abs() < 1e-12, "{f:?}");
+        }
+        for v in [f.x, f.up, f.forward] {
+            assert!((v.length() - 1.0).abs() < 1e-12, "{f:?}");
+        }
+    }
 
     #[test]
     fn plane_mask_is_the_upper_half_of_the_lens() {
@@ -91,5 +127,73 @@ mod tests {
             nose,
         );
         assert!((fr2.up + DVec3::Y).length() < 1e-12);
+    }
+
+    /// A face-like height field: a nose bump on a forehead-to-chin slope, cm-sized.
+    fn face_like() -> (TriMesh, DVec3, DVec3, DVec3) {
+        let z =
+            |x: f64, y: f64| 2.0 * (-(x * x + (y + 0.5) * (y + 0.5)) / 2.0).exp() - 0.03 * x * x;
+        let n = 60;
+        let m = grid(n, n, Diagonals::Alternating, |i, j| {
+            let (x, y) = (
+                -6.0 + 12.0 * i as f64 / n as f64,
+                -7.0 + 12.0 * j as f64 / n as f64,
+            );
+            DVec3::new(x, y, z(x, y))
+        })
+        .unwrap();
+        let at = |x: f64, y: f64| DVec3::new(x, y, z(x, y));
+        (m, at(-3.03, 2.01), at(3.03, 2.01), at(0.0, -0.49))
+    }
+
+    #[test]
+    fn frame_is_orthonormal_and_mask_follows_the_face_under_rigid_motions() {
+        let (m, r, q, nose) = face_like();
+        let d = (q - r).length();
+        let fr = face_frame(&m, r, q, nose);
+        assert_orthonormal(&fr);
+        assert!((fr.x - DVec3::X).length() < 1e-12);
+        assert!(fr.up.y > 0.99 && fr.forward.z > 0.99, "{fr:?}");
+        let dist = |m: &TriMesh, c: DVec3| -> Vec<f64> {
+            m.positions().iter().map(|p| (*p - c).length()).collect()
+        };
+        let mask = static_mask(&m, &dist(&m, r), &dist(&m, q), d, &fr, nose);
+        let n = mask.iter().filter(|x| **x).count();
+        assert!(
+            n > 100 && n < m.n_vertices() / 2,
+            "{n} of {}",
+            m.n_vertices()
+        );
+        // Vertices whose three criteria are not within rounding of their thresholds.
+        let clear: Vec<bool> = m
+            .positions()
+            .iter()
+            .map(|p| {
+                ((*p - r).length() - d).abs() > 1e-9
+                    && ((*p - q).length() - d).abs() > 1e-9
+                    && (*p - nose).dot(fr.up).abs() > 1e-9
+            })
+            .collect();
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        for _ in 0..20 {
+            let t = random_rigid_motion(&mut rng, 10.0);
+            let mm = m.transformed(&t);
+            let (rr, qq, nn) = (
+                t.transform_point3(r),
+                t.transform_point3(q),
+                t.transform_point3(nose),
+            );
+            let f2 = face_frame(&mm, rr, qq, nn);
+            assert_orthonormal(&f2);
+            for (a, b) in [(fr.x, f2.x), (fr.up, f2.up), (fr.forward, f2.forward)] {
+                assert!((t.transform_vector3(a) - b).length() < 1e-9);
+            }
+            let m2 = static_mask(&mm, &dist(&mm, rr), &dist(&mm, qq), d, &f2, nn);
+            for v in 0..m.n_vertices() {
+                if clear[v] {
+                    assert_eq!(mask[v], m2[v], "vertex {v}");
+                }
+            }
+        }
     }
 }

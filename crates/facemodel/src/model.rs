@@ -6,37 +6,15 @@
 //! (expression names, expression recipes, landmark vertex ids). A face is
 //! `neutral + sum_i w_i * identities[i] + sum_j e_j * expressions[j]`, with `w_i ~ N(0, 1)` for a
 //! plausible person and `e_j` in `[0, 1]`.
-//!
-//! Reusable by every experiment: [`FaceModel::load`], [`FaceModel::sample`],
-//! [`FaceModel::random_identity`], [`FaceModel::random_expression`],
-//! [`FaceModel::recipe_weights`], [`random_rigid_motion`], [`shared_dir`].
 
-#![allow(dead_code)] // A library module: not every experiment uses every function.
-
-use anyhow::{anyhow, bail, Context, Result};
+use crate::FaceModelError;
 use meshcore::{DAffine3, DQuat, DVec3, TriMesh};
 use rand::Rng;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-/// The shared data folder: `$BIPOLAR_SHARED` if set, else `../shared` relative to the workspace
-/// root (the parent of `xtask/`).
-pub fn shared_dir() -> PathBuf {
-    if let Some(p) = std::env::var_os("BIPOLAR_SHARED") {
-        return PathBuf::from(p);
-    }
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .unwrap_or(Path::new("."));
-    root.join("..").join("shared")
-}
-
-/// Default location of the ICT model folder inside [`shared_dir`].
-pub fn default_model_dir() -> PathBuf {
-    shared_dir().join("faces").join("ict-facekit").join("model")
-}
-
-/// Names of the five landmarks of the model, in the order used by the experiments.
+/// Names of the five landmarks of the model, in the order of
+/// [`FaceModel::landmark_positions`].
 pub const LANDMARK_NAMES: [&str; 5] = [
     "right_eye_outer",
     "right_eye_inner",
@@ -62,29 +40,37 @@ pub struct FaceModel {
 }
 
 impl FaceModel {
-    /// Loads the model folder (see the module documentation for the files).
-    pub fn load(dir: &Path) -> Result<Self> {
-        let (neutral, triangles) = read_obj(&dir.join("neutral.obj"))?;
+    /// Loads the model folder (see the module documentation for the files). `model.json` needs
+    /// an `expressions` array of names; `landmarks` (name -> vertex id), `expression_recipes`
+    /// (name -> blendshape -> weight) and `units` (default `cm`) are optional.
+    pub fn load(dir: &Path) -> Result<Self, FaceModelError> {
+        let obj_path = dir.join("neutral.obj");
+        let (neutral, triangles) = read_obj(&obj_path)?;
         let n = neutral.len();
         let json_path = dir.join("model.json");
-        let text = std::fs::read_to_string(&json_path)
-            .with_context(|| format!("reading {}", json_path.display()))?;
-        let meta: serde_json::Value = serde_json::from_str(&text)
-            .with_context(|| format!("parsing {}", json_path.display()))?;
+        let text =
+            std::fs::read_to_string(&json_path).map_err(|e| FaceModelError::io(&json_path, e))?;
+        let meta: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| FaceModelError::Json {
+                path: json_path.clone(),
+                source: e,
+            })?;
+        let bad = |problem: String| FaceModelError::json(&json_path, problem);
         let expression_names: Vec<String> = meta["expressions"]
             .as_array()
-            .ok_or_else(|| anyhow!("{}: no `expressions` array", json_path.display()))?
+            .ok_or_else(|| bad("no `expressions` array".into()))?
             .iter()
             .map(|v| v.as_str().map(str::to_owned))
             .collect::<Option<_>>()
-            .ok_or_else(|| anyhow!("{}: non-string expression name", json_path.display()))?;
+            .ok_or_else(|| bad("non-string name in `expressions`".into()))?;
         let mut landmarks = BTreeMap::new();
         if let Some(obj) = meta["landmarks"].as_object() {
             for (k, v) in obj {
-                let id = v
-                    .as_u64()
-                    .filter(|&id| (id as usize) < n)
-                    .ok_or_else(|| anyhow!("{}: bad landmark id for {k}", json_path.display()))?;
+                let id = v.as_u64().filter(|&id| (id as usize) < n).ok_or_else(|| {
+                    bad(format!(
+                        "`landmarks.{k}` = {v} is not a vertex id below {n}"
+                    ))
+                })?;
                 landmarks.insert(k.clone(), id as u32);
             }
         }
@@ -94,7 +80,9 @@ impl FaceModel {
                 let mut m = BTreeMap::new();
                 for (k, v) in r.as_object().into_iter().flatten() {
                     if !expression_names.contains(k) {
-                        bail!("{}: recipe {name} uses unknown {k}", json_path.display());
+                        return Err(bad(format!(
+                            "`expression_recipes.{name}` uses unknown expression {k}"
+                        )));
                     }
                     m.insert(k.clone(), v.as_f64().unwrap_or(0.0));
                 }
@@ -102,19 +90,29 @@ impl FaceModel {
             }
         }
         let units = meta["units"].as_str().unwrap_or("cm").to_owned();
-        let (id_shape, id_data) = read_npy_f32(&dir.join("identities.npy"))?;
-        let (ex_shape, ex_data) = read_npy_f32(&dir.join("expressions.npy"))?;
-        for (name, shape) in [("identities", &id_shape), ("expressions", &ex_shape)] {
+        let id_path = dir.join("identities.npy");
+        let ex_path = dir.join("expressions.npy");
+        let (id_shape, id_data) = read_npy_f32(&id_path)?;
+        let (ex_shape, ex_data) = read_npy_f32(&ex_path)?;
+        for (path, shape) in [(&id_path, &id_shape), (&ex_path, &ex_shape)] {
             if shape.len() != 3 || shape[1] != n || shape[2] != 3 {
-                bail!("{name}.npy has shape {shape:?}, expected (k, {n}, 3)");
+                return Err(FaceModelError::NpyShape {
+                    path: path.clone(),
+                    shape: shape.clone(),
+                    expected: format!("(k, {n}, 3) for the {n} vertices of neutral.obj"),
+                });
             }
         }
         if ex_shape[0] != expression_names.len() {
-            bail!(
-                "expressions.npy has {} blendshapes but model.json names {}",
-                ex_shape[0],
-                expression_names.len()
-            );
+            return Err(FaceModelError::NpyShape {
+                path: ex_path,
+                shape: ex_shape,
+                expected: format!(
+                    "({}, {n}, 3) for the {} expressions of model.json",
+                    expression_names.len(),
+                    expression_names.len()
+                ),
+            });
         }
         let to_vecs = |d: &[f32]| -> Vec<DVec3> {
             d.chunks_exact(3)
@@ -154,7 +152,7 @@ impl FaceModel {
         &self.expression_names
     }
 
-    /// Names of the expression recipes of `model.json` (e.g. `happiness`).
+    /// Names of the expression recipes of `model.json` (e.g. `happiness`), sorted.
     pub fn recipe_names(&self) -> impl Iterator<Item = &str> {
         self.recipes.keys().map(String::as_str)
     }
@@ -166,11 +164,11 @@ impl FaceModel {
     }
 
     /// Vertex id of a named landmark.
-    pub fn landmark_id(&self, name: &str) -> Result<u32> {
+    pub fn landmark_id(&self, name: &str) -> Result<u32, FaceModelError> {
         self.landmarks
             .get(name)
             .copied()
-            .ok_or_else(|| anyhow!("the face model has no landmark named {name}"))
+            .ok_or_else(|| FaceModelError::UnknownLandmark { name: name.into() })
     }
 
     /// Units of the coordinates (`cm`).
@@ -179,16 +177,16 @@ impl FaceModel {
     }
 
     /// The neutral face.
-    pub fn neutral(&self) -> Result<TriMesh> {
+    pub fn neutral(&self) -> Result<TriMesh, FaceModelError> {
         Ok(TriMesh::new(self.neutral.clone(), self.triangles.clone())?)
     }
 
     /// Expression weights of a named recipe (e.g. `happiness`), scaled by `strength`.
-    pub fn recipe_weights(&self, name: &str, strength: f64) -> Result<Vec<f64>> {
+    pub fn recipe_weights(&self, name: &str, strength: f64) -> Result<Vec<f64>, FaceModelError> {
         let r = self
             .recipes
             .get(name)
-            .ok_or_else(|| anyhow!("no expression recipe named {name}"))?;
+            .ok_or_else(|| FaceModelError::UnknownRecipe { name: name.into() })?;
         Ok(self
             .expression_names
             .iter()
@@ -197,21 +195,26 @@ impl FaceModel {
     }
 
     /// `neutral + sum_i w_i identities[i] + sum_j e_j expressions[j]`. Shorter weight slices use
-    /// the leading components only; longer ones are an error.
-    pub fn sample(&self, identity_weights: &[f64], expression_weights: &[f64]) -> Result<TriMesh> {
+    /// the leading components only; longer ones are an error. Non-finite weights give a
+    /// [`FaceModelError::Geometry`] error.
+    pub fn sample(
+        &self,
+        identity_weights: &[f64],
+        expression_weights: &[f64],
+    ) -> Result<TriMesh, FaceModelError> {
         if identity_weights.len() > self.n_identities {
-            bail!(
-                "{} identity weights for a model of {} identities",
-                identity_weights.len(),
-                self.n_identities
-            );
+            return Err(FaceModelError::TooManyWeights {
+                kind: "identity",
+                given: identity_weights.len(),
+                available: self.n_identities,
+            });
         }
         if expression_weights.len() > self.n_expressions() {
-            bail!(
-                "{} expression weights for a model of {} expressions",
-                expression_weights.len(),
-                self.n_expressions()
-            );
+            return Err(FaceModelError::TooManyWeights {
+                kind: "expression",
+                given: expression_weights.len(),
+                available: self.n_expressions(),
+            });
         }
         let n = self.neutral.len();
         let mut pos = self.neutral.clone();
@@ -264,7 +267,7 @@ impl FaceModel {
 
     /// Positions of the named landmarks on a sampled (possibly moved) face, in
     /// [`LANDMARK_NAMES`] order.
-    pub fn landmark_positions(&self, mesh: &TriMesh) -> Result<[DVec3; 5]> {
+    pub fn landmark_positions(&self, mesh: &TriMesh) -> Result<[DVec3; 5], FaceModelError> {
         let mut out = [DVec3::ZERO; 5];
         for (o, name) in out.iter_mut().zip(LANDMARK_NAMES) {
             *o = mesh.try_position(self.landmark_id(name)?)?;
@@ -302,11 +305,10 @@ pub fn random_rigid_motion<R: Rng>(rng: &mut R, translation_sigma: f64) -> DAffi
     DAffine3::from_rotation_translation(q, t)
 }
 
-/// Reads a Wavefront OBJ file with `mesh_io` (the project's one OBJ reader: `v` and `f`
-/// lines, polygons fan-triangulated, `v/vt/vn` and negative indices accepted): positions and
-/// triangles.
-pub fn read_obj(path: &Path) -> Result<(Vec<DVec3>, Vec<[u32; 3]>)> {
-    let loaded = mesh_io::read_mesh(path).with_context(|| format!("reading {}", path.display()))?;
+/// Reads a Wavefront OBJ file with `mesh_io` (the project's one OBJ reader; vertices in file
+/// order, polygons fan-triangulated): positions and triangles.
+fn read_obj(path: &Path) -> Result<(Vec<DVec3>, Vec<[u32; 3]>), FaceModelError> {
+    let loaded = mesh_io::read_mesh(path).map_err(|e| FaceModelError::mesh(path, e))?;
     Ok((
         loaded.mesh.positions().to_vec(),
         loaded.mesh.triangles().to_vec(),
@@ -315,8 +317,8 @@ pub fn read_obj(path: &Path) -> Result<(Vec<DVec3>, Vec<[u32; 3]>)> {
 
 /// Reads a little-endian float32 C-order `.npy` file with `mesh_io` (the project's one `.npy`
 /// reader): shape and data.
-pub fn read_npy_f32(path: &Path) -> Result<(Vec<usize>, Vec<f32>)> {
-    mesh_io::read_npy_f32(path).with_context(|| format!("reading {}", path.display()))
+fn read_npy_f32(path: &Path) -> Result<(Vec<usize>, Vec<f32>), FaceModelError> {
+    mesh_io::read_npy_f32(path).map_err(|e| FaceModelError::npy(path, e))
 }
 
 #[cfg(test)]
@@ -324,74 +326,256 @@ mod tests {
     use super::*;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
+    use std::path::PathBuf;
 
-    /// FNV-1a (64 bit) over the little-endian bytes of every vertex coordinate, in vertex order.
-    fn digest(mesh: &TriMesh) -> u64 {
-        let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-        for p in mesh.positions() {
-            for c in p.to_array() {
-                for b in c.to_bits().to_le_bytes() {
-                    h ^= u64::from(b);
-                    h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    /// Bytes of a version-1 `.npy` file holding `data` as `<f4` of `shape`.
+    fn npy(shape: &[usize], data: &[f32]) -> Vec<u8> {
+        let dims: Vec<String> = shape.iter().map(usize::to_string).collect();
+        let mut header = format!(
+            "{{'descr': '<f4', 'fortran_order': False, 'shape': ({},), }}",
+            dims.join(", ")
+        );
+        while (10 + header.len() + 1) % 64 != 0 {
+            header.push(' ');
+        }
+        header.push('\n');
+        let mut b = b"\x93NUMPY\x01\x00".to_vec();
+        b.extend((header.len() as u16).to_le_bytes());
+        b.extend(header.as_bytes());
+        for x in data {
+            b.extend(x.to_le_bytes());
+        }
+        b
+    }
+
+    /// A 4-vertex model: a unit square, 2 identity and 3 expression components with offsets
+    /// `(k + 1) * 0.5^v` along x (identities) and y (expressions).
+    fn write_model(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("facemodel-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(
+            dir.join("neutral.obj"),
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n",
+        )
+        .unwrap();
+        let offsets = |k: usize, axis: usize| -> Vec<f32> {
+            (0..k)
+                .flat_map(|c| {
+                    (0..4).flat_map(move |v| {
+                        let mut d = [0.0f32; 3];
+                        d[axis] = (c + 1) as f32 * 0.5f32.powi(v);
+                        d
+                    })
+                })
+                .collect()
+        };
+        std::fs::write(dir.join("identities.npy"), npy(&[2, 4, 3], &offsets(2, 0))).unwrap();
+        std::fs::write(dir.join("expressions.npy"), npy(&[3, 4, 3], &offsets(3, 1))).unwrap();
+        std::fs::write(
+            dir.join("model.json"),
+            r#"{"units": "cm", "expressions": ["a", "b", "c"],
+                "landmarks": {"right_eye_outer": 0, "right_eye_inner": 1, "left_eye_inner": 1,
+                              "left_eye_outer": 2, "nose_tip": 3},
+                "expression_recipes": {"smile": {"a": 1, "c": 0.5}}}"#,
+        )
+        .unwrap();
+        dir
+    }
+
+    #[test]
+    fn sample_is_the_linear_combination() {
+        let m = FaceModel::load(&write_model("linear")).unwrap();
+        assert_eq!(
+            (m.n_vertices(), m.n_identities(), m.n_expressions()),
+            (4, 2, 3)
+        );
+        assert_eq!(m.units(), "cm");
+        assert_eq!(m.recipe_names().collect::<Vec<_>>(), ["smile"]);
+        assert_eq!(m.recipe_weights("smile", 0.5).unwrap(), [0.5, 0.0, 0.25]);
+        let face = m.sample(&[1.0, -2.0], &[0.0, 0.5]).unwrap();
+        // Identities: (1 - 2 * 2) * 0.5^v along x; expression 1: 0.5 * 2 * 0.5^v along y.
+        for v in 0..4 {
+            let s = 0.5f64.powi(v as i32);
+            let expect = m.neutral().unwrap().position(v) + DVec3::new(-3.0 * s, s, 0.0);
+            assert_eq!(face.position(v), expect, "vertex {v}");
+        }
+        assert_eq!(face.triangles(), m.neutral().unwrap().triangles());
+        // Shorter weight slices use the leading components; no weights give the neutral face.
+        assert_eq!(m.sample(&[], &[]).unwrap(), m.neutral().unwrap());
+        assert!(matches!(
+            m.sample(&[0.0; 3], &[]),
+            Err(FaceModelError::TooManyWeights {
+                kind: "identity",
+                given: 3,
+                available: 2
+            })
+        ));
+        assert!(matches!(
+            m.sample(&[], &[0.0; 4]),
+            Err(FaceModelError::TooManyWeights {
+                kind: "expression",
+                ..
+            })
+        ));
+        assert!(matches!(
+            m.sample(&[f64::NAN], &[]),
+            Err(FaceModelError::Geometry(_))
+        ));
+        assert!(matches!(
+            m.landmark_id("chin"),
+            Err(FaceModelError::UnknownLandmark { .. })
+        ));
+        assert!(matches!(
+            m.recipe_weights("sob", 1.0),
+            Err(FaceModelError::UnknownRecipe { .. })
+        ));
+        let lm = m.landmark_positions(&face).unwrap();
+        assert_eq!(lm[3], face.position(2));
+        assert_eq!(lm[4], face.position(3));
+    }
+
+    #[test]
+    fn sampling_is_deterministic_under_a_seed() {
+        let m = FaceModel::load(&write_model("seed")).unwrap();
+        let draw = |seed: u64| {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let id = m.random_identity(&mut rng);
+            let ex = m.random_expression(&mut rng);
+            let pose = random_rigid_motion(&mut rng, 10.0);
+            let face = m.sample(&id, &ex).unwrap().transformed(&pose);
+            (id, ex, pose, face)
+        };
+        let a = draw(7);
+        let b = draw(7);
+        assert_eq!(a, b);
+        assert_ne!(a.0, draw(8).0);
+        assert_eq!(a.0.len(), 2);
+        for seed in 0..200 {
+            let (_, ex, _, _) = draw(seed);
+            assert!(ex.iter().all(|w| (0.0..=1.0).contains(w)), "{ex:?}");
+        }
+    }
+
+    #[test]
+    fn random_rigid_motions_are_rotations() {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let mut mean_t = DVec3::ZERO;
+        for _ in 0..500 {
+            let m = random_rigid_motion(&mut rng, 2.0);
+            let r = m.matrix3;
+            let rtr = r.transpose() * r;
+            for (c, e) in
+                [rtr.x_axis, rtr.y_axis, rtr.z_axis]
+                    .iter()
+                    .zip([DVec3::X, DVec3::Y, DVec3::Z])
+            {
+                assert!((*c - e).length() < 1e-12, "R^T R = {rtr}");
+            }
+            assert!((r.determinant() - 1.0).abs() < 1e-12);
+            mean_t += m.translation / 500.0;
+        }
+        // Translations are N(0, 2^2) per axis: the mean of 500 is within 5 standard errors.
+        assert!(
+            mean_t.abs().max_element() < 5.0 * 2.0 / 500f64.sqrt(),
+            "{mean_t}"
+        );
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let pure = random_rigid_motion(&mut rng, 0.0);
+        assert_eq!(pure.translation, DVec3::ZERO);
+    }
+
+    #[test]
+    fn standard_normal_has_unit_variance() {
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let x: Vec<f64> = (0..20_000).map(|_| standard_normal(&mut rng)).collect();
+        let mean = x.iter().sum::<f64>() / x.len() as f64;
+        let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / x.len() as f64;
+        assert!(
+            mean.abs() < 0.03 && (var - 1.0).abs() < 0.05,
+            "{mean} {var}"
+        );
+        assert!(x.iter().all(|v| v.is_finite()));
+    }
+
+    #[test]
+    fn malformed_npy_files_are_named() {
+        let cases: [(&str, Vec<u8>); 4] = [
+            ("not npy", b"hello world, not an array".to_vec()),
+            ("truncated", npy(&[2, 4, 3], &[0.0; 23])),
+            ("shape", npy(&[2, 5, 3], &[0.0; 30])),
+            ("dtype", {
+                let mut b = npy(&[2, 4, 3], &[0.0; 24]);
+                let at = b.windows(3).position(|w| w == b"<f4").unwrap();
+                b[at + 1] = b'i';
+                b
+            }),
+        ];
+        for (what, bytes) in cases {
+            let dir = write_model(&format!("npy-{}", what.replace(' ', "-")));
+            let path = dir.join("identities.npy");
+            std::fs::write(&path, bytes).unwrap();
+            let e = FaceModel::load(&dir).unwrap_err();
+            let msg = e.to_string();
+            assert!(msg.contains("identities.npy"), "{what}: {msg}");
+            match (what, &e) {
+                ("shape", FaceModelError::NpyShape { path: p, shape, .. }) => {
+                    assert_eq!((p, shape.as_slice()), (&path, &[2, 5, 3][..]));
                 }
+                ("shape", _) => panic!("{what}: {e:?}"),
+                (_, FaceModelError::Npy { path: p, .. }) => assert_eq!(p, &path),
+                _ => panic!("{what}: {e:?}"),
             }
         }
-        h
+        // Expression count differing from model.json.
+        let dir = write_model("npy-count");
+        std::fs::write(dir.join("expressions.npy"), npy(&[2, 4, 3], &[0.0; 24])).unwrap();
+        let e = FaceModel::load(&dir).unwrap_err();
+        assert!(
+            matches!(&e, FaceModelError::NpyShape { expected, .. } if expected.contains("3 expressions")),
+            "{e:?}"
+        );
+        // A missing file keeps the OS error and the path.
+        let dir = write_model("npy-missing");
+        std::fs::remove_file(dir.join("expressions.npy")).unwrap();
+        match FaceModel::load(&dir).unwrap_err() {
+            FaceModelError::Io { path, source } => {
+                assert_eq!(path, dir.join("expressions.npy"));
+                assert_eq!(source.kind(), std::io::ErrorKind::NotFound);
+            }
+            e => panic!("{e:?}"),
+        }
     }
 
     #[test]
-    fn pin_sampled_faces() {
-        let dir = default_model_dir();
-        if !dir.is_dir() {
-            eprintln!("skipping: {} not found", dir.display());
-            return;
+    fn malformed_model_json_names_the_key() {
+        for (json, needle) in [
+            ("{\"expressions\": [\"a\", ", "line 1"),
+            ("{\"units\": \"cm\"}", "`expressions`"),
+            ("{\"expressions\": [\"a\", 2, \"c\"]}", "non-string"),
+            (
+                "{\"expressions\": [\"a\", \"b\", \"c\"], \"landmarks\": {\"nose_tip\": 4}}",
+                "`landmarks.nose_tip`",
+            ),
+            (
+                "{\"expressions\": [\"a\", \"b\", \"c\"], \"expression_recipes\": {\"x\": {\"z\": 1}}}",
+                "`expression_recipes.x` uses unknown expression z",
+            ),
+        ] {
+            let dir = write_model("json");
+            std::fs::write(dir.join("model.json"), json).unwrap();
+            let e = FaceModel::load(&dir).unwrap_err();
+            let msg = e.to_string();
+            assert!(msg.contains("model.json") && msg.contains(needle), "{json}: {msg}");
+            assert!(matches!(
+                e,
+                FaceModelError::Json { .. } | FaceModelError::JsonContent { .. }
+            ));
         }
-        let model = FaceModel::load(&dir).unwrap();
-        let pinned = [
-            (1u64, 0xc6c4_0fbc_7305_1b7b_u64),
-            (2, 0x17f1_0dfd_dc75_13db),
-            (3, 0x3ace_7802_7c93_f4bb),
-        ];
-        for (seed, want) in pinned {
-            let mut rng = ChaCha8Rng::seed_from_u64(seed);
-            let id = model.random_identity(&mut rng);
-            let ex = model.random_expression(&mut rng);
-            let pose = random_rigid_motion(&mut rng, 10.0);
-            let face = model.sample(&id, &ex).unwrap().transformed(&pose);
-            assert_eq!(digest(&face), want, "seed {seed}: {:#018x}", digest(&face));
-        }
-        assert_eq!(digest(&model.neutral().unwrap()), 0xd6b5_da21_6777_0c29);
-    }
-
-    #[test]
-    fn pin_obj_reader() {
-        let shared = shared_dir();
-        let mut files = vec![shared.join("faces/ict-facekit/model/neutral.obj")];
-        let ps = shared.join("faces/ict-facekit/paper-set");
-        if !ps.is_dir() {
-            return;
-        }
-        let mut v: Vec<_> = std::fs::read_dir(&ps)
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .filter(|p| p.extension().is_some_and(|e| e == "obj"))
-            .collect();
-        v.sort();
-        files.extend(v);
-        for f in files {
-            let a = crate::experiments::data::parse_obj(&std::fs::read_to_string(&f).unwrap())
-                .unwrap();
-            let b = mesh_io::read_mesh(&f).unwrap();
-            assert!(b.warnings.is_empty(), "{:?}", b.warnings);
-            let same_pos = a.positions().len() == b.mesh.positions().len()
-                && a
-                    .positions()
-                    .iter()
-                    .zip(b.mesh.positions())
-                    .all(|(x, y)| x.to_array().map(f64::to_bits) == y.to_array().map(f64::to_bits));
-            assert!(same_pos, "{}", f.display());
-            assert_eq!(a.triangles(), b.mesh.triangles(), "{}", f.display());
-            println!("{}: identical ({} vertices)", f.display(), a.n_vertices());
-        }
+        let dir = write_model("obj");
+        std::fs::write(dir.join("neutral.obj"), "v 0 0 0\nf 1 2 3\n").unwrap();
+        let e = FaceModel::load(&dir).unwrap_err();
+        assert!(matches!(e, FaceModelError::Mesh { .. }), "{e:?}");
+        assert!(e.to_string().contains("neutral.obj"), "{e}");
     }
 }
