@@ -2,8 +2,8 @@
 //! ICT face model (random identities, expressions and rigid motions), against the model's
 //! landmark vertices.
 
-use crate::facemodel::{self, FaceModel, LANDMARK_NAMES};
 use anyhow::{Context, Result};
+use facemodel::{FaceModel, LANDMARK_NAMES};
 use indicatif::{ProgressBar, ProgressStyle};
 use landmarks::{
     detect_with, DetectOptions, GenericModel, LandmarkName, LandmarkRegressor, RegressorOptions,
@@ -195,7 +195,9 @@ fn stats(name: &str, errs: &[f64]) -> Stats {
 
 /// Runs the evaluation.
 pub fn run(args: Args) -> Result<()> {
-    let model_dir = args.model_dir.unwrap_or_else(facemodel::default_model_dir);
+    let model_dir = args
+        .model_dir
+        .unwrap_or_else(crate::paths::default_model_dir);
     let ict = FaceModel::load(&model_dir)
         .with_context(|| format!("loading the ICT face model from {}", model_dir.display()))?;
     anyhow::ensure!(args.faces > 0, "--faces must be positive");

@@ -3,8 +3,8 @@
 use clap::{Parser, Subcommand};
 
 mod experiments;
-mod facemodel;
 mod landmarks_eval;
+mod paths;
 mod recognition;
 mod robustness;
 mod sphere_validate;

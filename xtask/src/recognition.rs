@@ -9,15 +9,14 @@
 //! probe x gallery pairs, and the ROC curve. Results: `report.md`, `summary.json`, `roc.svg` (and `roc.png`),
 //! CSV tables, in the output folder printed on the last line.
 
-use crate::experiments::data::default_out_dir;
 use crate::experiments::descriptor::{best_rotation, KeyedPoints};
 use crate::experiments::pipeline::{bar, bipolar, dist, resolve_methods, Refs, Region};
 use crate::experiments::polar::{polar_descriptor, PolarOptions, Pole};
 use crate::experiments::report::{f4, line_plot, Report, Series};
-use crate::experiments::segment::face_frame;
 use crate::experiments::walk::Walker;
-use crate::facemodel::{default_model_dir, random_rigid_motion, FaceModel};
+use crate::paths::{default_model_dir, default_out_dir};
 use anyhow::{bail, Context, Result};
+use facemodel::{face_frame, random_rigid_motion, FaceModel};
 use geodesic::{SolveOptions, Source};
 use meshcore::{DVec3, FaceLocator, TriMesh};
 use rand::SeedableRng;

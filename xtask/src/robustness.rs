@@ -7,7 +7,6 @@
 //! corners), and the single-pole comparison (figure 17) with the figure-15 argument.
 //! See `docs/experiments.md` for every choice made.
 
-use crate::experiments::data::{default_out_dir, default_paper_set, load_face_set, Face};
 use crate::experiments::descriptor::{isoline_segments, paired_distance, KeyedPoints};
 use crate::experiments::pipeline::{
     bar, bipolar, crate_failures, dist, field, field_at, matrix, perturb, resolve_methods,
@@ -15,9 +14,10 @@ use crate::experiments::pipeline::{
 };
 use crate::experiments::polar::{polar_descriptor, polar_key_parts, PolarOptions, Pole};
 use crate::experiments::report::{f4, heatmap, line_plot, render, Overlay, Report, Series};
-use crate::experiments::segment::{face_frame, static_mask, FaceFrame};
 use crate::experiments::walk::Walker;
+use crate::paths::{default_out_dir, default_paper_set};
 use anyhow::{bail, Result};
+use facemodel::{face_frame, load_face_set, static_mask, Face, FaceFrame};
 use geodesic::{GeodesicSolver, Method, Source};
 use meshcore::{DMat3, DQuat, DVec3, SurfacePoint};
 use rand::{Rng, SeedableRng};
@@ -1306,7 +1306,7 @@ mod tests {
             person: name.split('_').next().unwrap().into(),
             expression: String::new(),
             mesh: crate::experiments::walk::tests::plane(1, 0.0, 0),
-            landmarks: crate::experiments::data::FaceLandmarks::ground_truth(),
+            landmarks: facemodel::FaceLandmarks::ground_truth(),
         };
         let faces = vec![mk("a_n"), mk("a_x"), mk("b_n"), mk("c_n")];
         let m = vec![

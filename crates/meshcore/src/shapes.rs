@@ -3,9 +3,62 @@
 //! benchmarks may pick vertices by index. Every crate's tests, benches and the sphere
 //! validation use these instead of their own copies.
 
-use crate::TriMesh;
+use crate::{MeshError, TriMesh};
 use glam::DVec3;
 use std::collections::HashMap;
+
+/// How [`grid`] splits each square of the grid into two triangles. With corners
+/// `a = (i, j)`, `b = (i + 1, j)`, `c = (i + 1, j + 1)`, `d = (i, j + 1)`:
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Diagonals {
+    /// Every square along `a-c`: triangles `a b c` and `a c d`.
+    Uniform,
+    /// Chequerboard: `a b c`, `a c d` where `i + j` is even, else along `b-d`: `a b d`, `b c d`.
+    Alternating,
+}
+
+/// Grid of `nx x ny` squares, counter-clockwise in the `(i, j)` parameter plane. Vertex
+/// `(i, j)`, `0 <= i <= nx`, `0 <= j <= ny`, has id `j * (nx + 1) + i` and the position
+/// `position(i, j)`, called once per vertex in id order (so a seeded generator inside the
+/// closure gives a deterministic mesh). Errors when a position is not finite or `nx` or `ny` is
+/// zero.
+pub fn grid(
+    nx: usize,
+    ny: usize,
+    diagonals: Diagonals,
+    position: impl FnMut(usize, usize) -> DVec3,
+) -> Result<TriMesh, MeshError> {
+    let (pos, tris) = grid_parts(nx, ny, diagonals, position);
+    TriMesh::new(pos, tris)
+}
+
+/// Positions and triangles of [`grid`].
+fn grid_parts(
+    nx: usize,
+    ny: usize,
+    diagonals: Diagonals,
+    mut position: impl FnMut(usize, usize) -> DVec3,
+) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+    let mut pos = Vec::with_capacity((nx + 1) * (ny + 1));
+    for j in 0..=ny {
+        for i in 0..=nx {
+            pos.push(position(i, j));
+        }
+    }
+    let id = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
+    let mut tris = Vec::with_capacity(2 * nx * ny);
+    for j in 0..ny {
+        for i in 0..nx {
+            let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+            if diagonals == Diagonals::Uniform || (i + j) % 2 == 0 {
+                tris.extend([[a, b, c], [a, c, d]]);
+            } else {
+                tris.extend([[a, b, d], [b, c, d]]);
+            }
+        }
+    }
+    (pos, tris)
+}
 
 /// Square grid of `n x n` cells of size `h` starting at `(x0, x0)` in the plane z = 0, normals
 /// +z. Interior vertices are jittered by up to `jitter * h / 2` per axis (deterministic in
@@ -27,45 +80,22 @@ pub fn grid_plane(
             .wrapping_add(1442695040888963407);
         ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
     };
-    let mut pos = Vec::with_capacity((n + 1) * (n + 1));
-    for j in 0..=n {
-        for i in 0..=n {
-            let interior = i > 0 && j > 0 && i < n && j < n;
-            let (dx, dy) = if interior {
-                (rnd() * jitter * h, rnd() * jitter * h)
-            } else {
-                (0.0, 0.0)
-            };
-            pos.push(DVec3::new(
-                x0 + i as f64 * h + dx,
-                x0 + j as f64 * h + dy,
-                0.0,
-            ));
-        }
-    }
-    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-    let mut tris = Vec::with_capacity(2 * n * n);
-    for j in 0..n {
-        for i in 0..n {
-            let cand = if (i + j) % 2 == 0 {
-                [
-                    [id(i, j), id(i + 1, j), id(i + 1, j + 1)],
-                    [id(i, j), id(i + 1, j + 1), id(i, j + 1)],
-                ]
-            } else {
-                [
-                    [id(i, j), id(i + 1, j), id(i, j + 1)],
-                    [id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)],
-                ]
-            };
-            for t in cand {
-                let c = (pos[t[0] as usize] + pos[t[1] as usize] + pos[t[2] as usize]) / 3.0;
-                if !drop(c) {
-                    tris.push(t);
-                }
-            }
-        }
-    }
+    let (pos, cells) = grid_parts(n, n, Diagonals::Alternating, |i, j| {
+        let interior = i > 0 && j > 0 && i < n && j < n;
+        let (dx, dy) = if interior {
+            (rnd() * jitter * h, rnd() * jitter * h)
+        } else {
+            (0.0, 0.0)
+        };
+        DVec3::new(x0 + i as f64 * h + dx, x0 + j as f64 * h + dy, 0.0)
+    });
+    let tris = cells
+        .into_iter()
+        .filter(|t| {
+            let c = (pos[t[0] as usize] + pos[t[1] as usize] + pos[t[2] as usize]) / 3.0;
+            !drop(c)
+        })
+        .collect();
     // Drop unused vertices so the mesh has no isolated vertices.
     compact(pos, tris)
 }
@@ -275,6 +305,35 @@ mod tests {
         assert_eq!(m.position(0), DVec3::Z);
         assert_eq!(m.position((m.n_vertices() - 1) as u32), -DVec3::Z);
         assert!(Topology::new(&m).boundary_loops.is_empty());
+    }
+
+    #[test]
+    fn grid_ids_positions_and_diagonals() {
+        let u = grid(3, 2, Diagonals::Uniform, |i, j| {
+            DVec3::new(i as f64, j as f64, 0.5 * (i * j) as f64)
+        })
+        .unwrap();
+        assert_eq!((u.n_vertices(), u.n_faces()), (12, 12));
+        assert_eq!(u.position(2 * 4 + 1), DVec3::new(1.0, 2.0, 1.0));
+        // Square (1, 0): a = 1, b = 2, c = 6, d = 5.
+        assert_eq!(&u.triangles()[2..4], &[[1, 2, 6], [1, 6, 5]]);
+        let a = grid(3, 2, Diagonals::Alternating, |i, j| {
+            DVec3::new(i as f64, j as f64, 0.0)
+        })
+        .unwrap();
+        assert_eq!(
+            &a.triangles()[0..4],
+            &[[0, 1, 5], [0, 5, 4], [1, 2, 5], [2, 6, 5]]
+        );
+        for m in [&u, &a] {
+            let t = Topology::new(m);
+            assert_eq!(t.boundary_loops.len(), 1);
+            assert!(t.inconsistent_edges.is_empty());
+            for f in 0..m.n_faces() as u32 {
+                assert!(m.face_cross(f).z > 0.0, "face {f} is not counter-clockwise");
+            }
+        }
+        assert!(grid(1, 1, Diagonals::Uniform, |_, _| DVec3::splat(f64::NAN)).is_err());
     }
 
     #[test]

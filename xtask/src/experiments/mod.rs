@@ -1,11 +1,10 @@
-//! Shared pieces of `cargo xtask robustness` and `cargo xtask recognition`: face-set loading,
-//! straightest-geodesic perturbation of reference points, the static-area segmentation, the
-//! keyed descriptors (bipolar grid and single pole) with their distance, and report writing.
+//! Shared pieces of `cargo xtask robustness` and `cargo xtask recognition`:
+//! straightest-geodesic perturbation of reference points, the keyed descriptors (bipolar grid
+//! and single pole) with their distance, and report writing. Face-set loading, the face frame
+//! and the static-area mask are in the `facemodel` crate.
 
-pub mod data;
 pub mod descriptor;
 pub mod pipeline;
 pub mod polar;
 pub mod report;
-pub mod segment;
 pub mod walk;

@@ -3,9 +3,9 @@
 //! progress bars.
 
 use super::descriptor::{bipolar_grid, keyed_distance, GridOptions, KeyedPoints};
-use super::segment::{static_mask, FaceFrame};
 use super::walk::Walker;
 use anyhow::{bail, Context, Result};
+use facemodel::{static_mask, FaceFrame};
 use geodesic::{GeodesicSolver, Method, SolveOptions, Source};
 use indicatif::{ProgressBar, ProgressStyle};
 use meshcore::{DVec3, SurfacePoint, TriMesh};

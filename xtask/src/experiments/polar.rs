@@ -187,17 +187,13 @@ mod tests {
 #[cfg(test)]
 mod face_tests {
     use super::*;
-    use crate::experiments::data::{default_paper_set, load_face_set};
     use crate::experiments::descriptor::keyed_distance;
+    use facemodel::load_face_set;
     use geodesic::{Method, SolveOptions, Source};
 
     #[test]
     fn pole_as_vertex_or_as_point_agree_on_a_face() {
-        let dir = default_paper_set();
-        if !dir.is_dir() {
-            eprintln!("skipping: {} not found", dir.display());
-            return;
-        }
+        let dir = testsupport::require_shared!(testsupport::PAPER_SET);
         let faces = load_face_set(&dir).unwrap();
         let f = &faces[0];
         let m = &f.mesh;
