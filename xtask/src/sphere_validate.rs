@@ -367,13 +367,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
      -> anyhow::Result<()> {
         let series = methods
             .iter()
-            .map(|&m| viz::Series {
-                name: method_name(m).to_string(),
-                points: rows
-                    .iter()
-                    .filter(|r| keep(r) && r.method == method_name(m))
-                    .map(xy)
-                    .collect(),
+            .map(|&m| {
+                viz::Series::new(
+                    method_name(m),
+                    rows.iter()
+                        .filter(|r| keep(r) && r.method == method_name(m))
+                        .map(xy)
+                        .collect(),
+                )
             })
             .collect();
         viz::line_plot(

@@ -2,6 +2,7 @@
 
 use crate::{colormap, write_bytes, Format, VizError};
 use plotters::coord::Shift;
+use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use resvg::{tiny_skia, usvg};
@@ -16,6 +17,25 @@ pub struct Series {
     /// `(x, y)` points, drawn in the given order; non-finite points (and, on a log axis,
     /// non-positive y) are skipped.
     pub points: Vec<(f64, f64)>,
+    /// Draw the line (and its legend entry) dashed instead of solid; markers are unchanged.
+    pub dashed: bool,
+}
+
+impl Series {
+    /// A solid series.
+    pub fn new(name: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
+        Self {
+            name: name.into(),
+            points,
+            dashed: false,
+        }
+    }
+
+    /// Sets whether the line is dashed (builder style).
+    pub fn dashed(mut self, dashed: bool) -> Self {
+        self.dashed = dashed;
+        self
+    }
 }
 
 /// A line plot: several named series with markers and a legend.
@@ -66,12 +86,15 @@ impl PlotSpec {
         }
     }
 
-    /// Adds a series (builder style).
+    /// Adds a solid series (builder style).
     pub fn with_series(mut self, name: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
-        self.series.push(Series {
-            name: name.into(),
-            points,
-        });
+        self.series.push(Series::new(name, points));
+        self
+    }
+
+    /// Adds a series with its style (builder style).
+    pub fn with(mut self, series: Series) -> Self {
+        self.series.push(series);
         self
     }
 
@@ -95,6 +118,10 @@ const PALETTE: [(u8, u8, u8); 10] = [
     (188, 189, 34),
     (23, 190, 207),
 ];
+
+/// Dash and gap lengths of dashed series, in pixels.
+const DASH: i32 = 8;
+const GAP: i32 = 5;
 
 fn pick(i: usize) -> RGBColor {
     let (r, g, b) = PALETTE[i % PALETTE.len()];
@@ -203,13 +230,29 @@ pub fn line_plot_svg(spec: &PlotSpec) -> Result<String, VizError> {
                     .map_err(perr)?;
                 for (i, (s, pts)) in spec.series.iter().zip(&clean).enumerate() {
                     let c = pick(i);
-                    chart
-                        .draw_series(LineSeries::new(pts.iter().copied(), c.stroke_width(2)))
-                        .map_err(perr)?
-                        .label(s.name.as_str())
-                        .legend(move |(x, y)| {
-                            PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
-                        });
+                    let style = c.stroke_width(2);
+                    if s.dashed {
+                        chart
+                            .draw_series(DashedLineSeries::new(
+                                pts.iter().copied(),
+                                DASH,
+                                GAP,
+                                style,
+                            ))
+                            .map_err(perr)?
+                            .label(s.name.as_str())
+                            .legend(move |(x, y)| {
+                                DashedPathElement::new(vec![(x, y), (x + 20, y)], 6, 3, style)
+                            });
+                    } else {
+                        chart
+                            .draw_series(LineSeries::new(pts.iter().copied(), style))
+                            .map_err(perr)?
+                            .label(s.name.as_str())
+                            .legend(move |(x, y)| {
+                                PathElement::new(vec![(x, y), (x + 20, y)], style)
+                            });
+                    }
                     chart
                         .draw_series(pts.iter().map(|&(x, y)| Circle::new((x, y), 3, c.filled())))
                         .map_err(perr)?;

@@ -1,7 +1,8 @@
 //! Plot tests: well-formed SVG with the labels, valid PNG, errors.
 
 use viz::{
-    heatmap, heatmap_svg, histogram, histogram_svg, line_plot, line_plot_svg, PlotSpec, VizError,
+    heatmap, heatmap_svg, histogram, histogram_svg, line_plot, line_plot_svg, PlotSpec, Series,
+    VizError,
 };
 
 const PNG_SIG: &[u8] = b"\x89PNG\r\n\x1a\n";
@@ -84,6 +85,49 @@ fn line_plot_svg_has_labels_and_is_deterministic() {
     let log = line_plot_svg(&s.clone().with_log_y(true)).unwrap();
     assert_well_formed(&log);
     assert_ne!(a, log);
+}
+
+/// Number of line pieces an SVG draws (plotters writes a path as one `<polyline>` and each
+/// dash of a dashed path as its own).
+fn polylines(svg: &str) -> usize {
+    svg.matches("<polyline").count() + svg.matches("<line").count()
+}
+
+#[test]
+fn dashed_series_are_drawn_in_pieces_and_solid_ones_are_unchanged() {
+    let pts: Vec<(f64, f64)> = (0..=20)
+        .map(|i| (i as f64, (i as f64 / 3.0).sin()))
+        .collect();
+    let solid = PlotSpec::new("t", "x", "y").with_series("a", pts.clone());
+    let same = PlotSpec::new("t", "x", "y").with(Series::new("a", pts.clone()).dashed(false));
+    assert_eq!(solid, same);
+    assert_eq!(
+        line_plot_svg(&solid).unwrap(),
+        line_plot_svg(&same).unwrap()
+    );
+    let dashed = PlotSpec::new("t", "x", "y").with(Series::new("a", pts.clone()).dashed(true));
+    let (s, d) = (
+        line_plot_svg(&solid).unwrap(),
+        line_plot_svg(&dashed).unwrap(),
+    );
+    assert_well_formed(&d);
+    assert_ne!(s, d);
+    // A curve 20 units long across ~700 pixels: dozens of dashes instead of one polyline,
+    // and the legend entry dashed too; the markers stay.
+    assert!(
+        polylines(&d) >= polylines(&s) + 20,
+        "{} vs {}",
+        polylines(&d),
+        polylines(&s)
+    );
+    assert_eq!(d.matches("<circle").count(), s.matches("<circle").count());
+    assert_eq!(d, line_plot_svg(&dashed).unwrap());
+    // Mixed: a dashed and a solid series share the legend.
+    let mixed = PlotSpec::new("t", "x", "y")
+        .with_series("solid one", pts.clone())
+        .with(Series::new("dashed one", pts).dashed(true));
+    let m = line_plot_svg(&mixed).unwrap();
+    assert!(m.contains("solid one") && m.contains("dashed one"));
 }
 
 #[test]
