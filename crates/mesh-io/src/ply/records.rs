@@ -1,0 +1,143 @@
+//! What the ASCII and binary bodies share: where parsed values go, the roles of the vertex
+//! properties, and the checks of colours, indices and faces.
+
+use super::header::{Element, Prop, Ty};
+use crate::{IoError, ScalarField, ScalarType};
+use meshcore::DVec3;
+
+/// Where the parsed values go.
+pub(super) struct Sink {
+    pub(super) pos: Vec<DVec3>,
+    pub(super) colors: Vec<[u8; 4]>,
+    pub(super) scalars: Vec<(usize, ScalarField)>,
+    pub(super) tris: Vec<[u32; 3]>,
+    pub(super) tri_at: Vec<usize>,
+    pub(super) n_polygons: usize,
+}
+
+/// Roles of the properties of the vertex element.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum Role {
+    X,
+    Y,
+    Z,
+    Color(usize, bool),
+    Scalar(usize),
+    Ignore,
+}
+
+pub(super) fn vertex_roles(
+    el: &Element,
+    file: &str,
+) -> Result<(Vec<Role>, Vec<ScalarField>, bool), IoError> {
+    let mut roles = Vec::new();
+    let mut scalars = Vec::new();
+    let mut has_color = false;
+    for p in &el.props {
+        let role = match p {
+            Prop::Scalar(ty, name) => match name.as_str() {
+                "x" => Role::X,
+                "y" => Role::Y,
+                "z" => Role::Z,
+                "red" | "r" => {
+                    has_color = true;
+                    Role::Color(0, ty.is_float())
+                }
+                "green" | "g" => {
+                    has_color = true;
+                    Role::Color(1, ty.is_float())
+                }
+                "blue" | "b" => {
+                    has_color = true;
+                    Role::Color(2, ty.is_float())
+                }
+                "alpha" | "a" => Role::Color(3, ty.is_float()),
+                "nx" | "ny" | "nz" => Role::Ignore,
+                _ => {
+                    scalars.push(ScalarField {
+                        name: name.clone(),
+                        values: Vec::new(),
+                        ty: if *ty == Ty::F32 {
+                            ScalarType::F32
+                        } else {
+                            ScalarType::F64
+                        },
+                    });
+                    Role::Scalar(scalars.len() - 1)
+                }
+            },
+            Prop::List(..) => Role::Ignore,
+        };
+        roles.push(role);
+    }
+    for (r, axis) in [(Role::X, "x"), (Role::Y, "y"), (Role::Z, "z")] {
+        if !roles.contains(&r) {
+            return Err(IoError::line(
+                file,
+                el.line,
+                format!("vertex element has no '{axis}' property"),
+            ));
+        }
+    }
+    Ok((roles, scalars, has_color))
+}
+
+pub(super) fn face_list_index(el: &Element, file: &str) -> Result<usize, IoError> {
+    el.props
+        .iter()
+        .position(|p| {
+            matches!(p, Prop::List(..))
+                && (p.name() == "vertex_indices" || p.name() == "vertex_index")
+        })
+        .or_else(|| el.props.iter().position(|p| matches!(p, Prop::List(..))))
+        .ok_or_else(|| {
+            IoError::line(
+                file,
+                el.line,
+                "face element has no list property (vertex_indices)",
+            )
+        })
+}
+
+pub(super) fn color_value(v: f64, is_float: bool) -> u8 {
+    if is_float {
+        (v.clamp(0.0, 1.0) * 255.0).round() as u8
+    } else {
+        v.clamp(0.0, 255.0) as u8
+    }
+}
+
+pub(super) fn check_index(v: f64, file: &str, at: crate::Location) -> Result<u32, IoError> {
+    if v < 0.0 || v.fract() != 0.0 || v > (u32::MAX - 1) as f64 {
+        return Err(IoError::malformed(
+            file,
+            at,
+            format!("invalid vertex index {v}"),
+        ));
+    }
+    Ok(v as u32)
+}
+
+pub(super) fn push_face(
+    sink: &mut Sink,
+    corners: &[u32],
+    file: &str,
+    at: crate::Location,
+    where_: usize,
+) -> Result<(), IoError> {
+    if corners.len() < 3 {
+        return Err(IoError::malformed(
+            file,
+            at,
+            format!("face with {} corner(s); at least 3 needed", corners.len()),
+        ));
+    }
+    if corners.len() > 3 {
+        sink.n_polygons += 1;
+    }
+    for k in 1..corners.len() - 1 {
+        sink.tris.push([corners[0], corners[k], corners[k + 1]]);
+        sink.tri_at.push(where_);
+    }
+    Ok(())
+}
