@@ -232,6 +232,9 @@ struct Sink {
     tris: Vec<[u32; 3]>,
     tri_at: Vec<usize>,
     n_polygons: usize,
+    /// Triangle strips decoded and the degenerate strip triangles (repeated vertex) skipped.
+    n_strips: usize,
+    n_strip_degenerate: usize,
 }
 
 /// Roles of the properties of the vertex element.
@@ -384,6 +387,47 @@ fn push_face(
     Ok(())
 }
 
+/// Decodes a triangle strip (a `tristrips` list: `-1` restarts a strip, the winding alternates
+/// from one triangle to the next; triangles with a repeated vertex, used to join strips, are
+/// skipped).
+fn push_strip(
+    sink: &mut Sink,
+    raw: &[f64],
+    file: &str,
+    at: crate::Location,
+    where_: usize,
+) -> Result<(), IoError> {
+    let mut run: Vec<u32> = Vec::new();
+    let flush = |run: &mut Vec<u32>, sink: &mut Sink| {
+        if run.len() >= 3 {
+            sink.n_strips += 1;
+        }
+        for k in 2..run.len() {
+            let t = if k % 2 == 0 {
+                [run[k - 2], run[k - 1], run[k]]
+            } else {
+                [run[k - 1], run[k - 2], run[k]]
+            };
+            if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+                sink.n_strip_degenerate += 1;
+            } else {
+                sink.tris.push(t);
+                sink.tri_at.push(where_);
+            }
+        }
+        run.clear();
+    };
+    for &v in raw {
+        if v == -1.0 {
+            flush(&mut run, sink);
+        } else {
+            run.push(check_index(v, file, at)?);
+        }
+    }
+    flush(&mut run, sink);
+    Ok(())
+}
+
 fn read_binary(
     bytes: &[u8],
     h: &Header,
@@ -393,6 +437,7 @@ fn read_binary(
 ) -> Result<(), IoError> {
     let mut off = h.body_start;
     let mut corners: Vec<u32> = Vec::with_capacity(8);
+    let mut raw: Vec<f64> = Vec::new();
     for el in &h.elements {
         // The smallest a record can be: scalars plus list counts with zero items.
         let min_rec: usize = el
@@ -472,13 +517,15 @@ fn read_binary(
                     }
                 }
             }
-            "face" => {
+            "face" | "tristrips" => {
+                let strips = el.name == "tristrips";
                 let li = face_list_index(el, file)?;
                 sink.tris.reserve(el.count);
                 sink.tri_at.reserve(el.count);
                 // Fast path for the common layout `list uchar int|uint vertex_indices` alone:
                 // triangles are 13-byte records.
-                let fast = el.props.len() == 1
+                let fast = !strips
+                    && el.props.len() == 1
                     && matches!(el.props[0], Prop::List(Ty::U8, Ty::I32 | Ty::U32, _));
                 for _ in 0..el.count {
                     if fast && off + 13 <= bytes.len() && bytes[off] == 3 {
@@ -539,6 +586,15 @@ fn read_binary(
                                 let n = n as usize;
                                 if n.saturating_mul(it.size()) > bytes.len() - off {
                                     return Err(IoError::byte(file, rec, format!("face list of {n} indices runs past the end of the file")));
+                                }
+                                if strips {
+                                    raw.clear();
+                                    for _ in 0..n {
+                                        raw.push(get(bytes, off, *it, be));
+                                        off += it.size();
+                                    }
+                                    push_strip(sink, &raw, file, crate::Location::Byte(rec), rec)?;
+                                    continue;
                                 }
                                 corners.clear();
                                 for _ in 0..n {
@@ -688,6 +744,7 @@ fn read_ascii(
         line_offset: header_lines,
     };
     let mut corners = Vec::with_capacity(8);
+    let mut raw: Vec<f64> = Vec::new();
     for el in &h.elements {
         // Each record needs at least one token (>= 1 byte plus a separator) per property.
         let min_rec = 2 * el.props.len().max(1);
@@ -709,7 +766,8 @@ fn read_ascii(
         } else {
             (vec![Role::Ignore; el.props.len()], Vec::new(), false)
         };
-        let li = if el.name == "face" {
+        let strips = el.name == "tristrips";
+        let li = if el.name == "face" || strips {
             Some(face_list_index(el, file)?)
         } else {
             None
@@ -756,14 +814,19 @@ fn read_ascii(
                             ));
                         }
                         corners.clear();
+                        raw.clear();
                         for _ in 0..n {
                             let last = toks.line;
                             let (v, ln) = ascii_value(toks.next(), *it, file, last, &el.name)?;
-                            if Some(k) == li {
+                            if Some(k) == li && strips {
+                                raw.push(v);
+                            } else if Some(k) == li {
                                 corners.push(check_index(v, file, crate::Location::Line(ln))?);
                             }
                         }
-                        if Some(k) == li {
+                        if Some(k) == li && strips {
+                            push_strip(sink, &raw, file, crate::Location::Line(ln), ln)?;
+                        } else if Some(k) == li {
                             push_face(sink, &corners, file, crate::Location::Line(ln), ln)?;
                         }
                     }
@@ -801,10 +864,14 @@ pub(crate) fn read_ply(bytes: &[u8], file: &str) -> Result<LoadedMesh, IoError> 
     if !h.elements.iter().any(|e| e.name == "vertex") {
         return Err(IoError::whole(file, "no 'vertex' element"));
     }
-    if !h.elements.iter().any(|e| e.name == "face") {
+    if !h
+        .elements
+        .iter()
+        .any(|e| e.name == "face" || e.name == "tristrips")
+    {
         return Err(IoError::whole(
             file,
-            "no 'face' element (point clouds are not meshes)",
+            "no 'face' or 'tristrips' element (point clouds are not meshes)",
         ));
     }
     let mut sink = Sink {
@@ -814,6 +881,8 @@ pub(crate) fn read_ply(bytes: &[u8], file: &str) -> Result<LoadedMesh, IoError> 
         tris: Vec::new(),
         tri_at: Vec::new(),
         n_polygons: 0,
+        n_strips: 0,
+        n_strip_degenerate: 0,
     };
     let header_lines = bytes[..h.body_start]
         .iter()
@@ -855,6 +924,12 @@ pub(crate) fn read_ply(bytes: &[u8], file: &str) -> Result<LoadedMesh, IoError> 
         out.warnings.push(format!(
             "{} polygon(s) with more than 3 corners fan-triangulated",
             sink.n_polygons
+        ));
+    }
+    if sink.n_strips > 0 {
+        out.warnings.push(format!(
+            "{} triangle strip(s) decoded; {} degenerate strip triangle(s) (repeated vertex) skipped",
+            sink.n_strips, sink.n_strip_degenerate
         ));
     }
     Ok(out)
