@@ -30,7 +30,62 @@ impl BntGrid {
         p.x != self.zmin && p.y != self.zmin && p.z != self.zmin
     }
 
-    /// Serialises the grid in the `.bnt` layout (bottom row first), e.g. to synthesise test data.
+    /// Checks that the grid can be written as a `.bnt` file the reader accepts: 1 to 65535 rows
+    /// and columns, one `xyz` and one `uv` entry per sample, an image name of at most 65535
+    /// bytes, finite coordinates and a finite `zmin` (background samples hold `zmin` itself).
+    pub fn check_writable(&self) -> Result<(), String> {
+        let max = u16::MAX as usize;
+        if self.nrows == 0 || self.ncols == 0 || self.nrows > max || self.ncols > max {
+            return Err(format!(
+                "grid is {} x {}; a .bnt grid has 1 to {max} rows and columns",
+                self.nrows, self.ncols
+            ));
+        }
+        let n = self.nrows * self.ncols;
+        if self.xyz.len() != n || self.uv.len() != n {
+            return Err(format!(
+                "{} xyz and {} uv entries for {} x {} = {n} samples",
+                self.xyz.len(),
+                self.uv.len(),
+                self.nrows,
+                self.ncols
+            ));
+        }
+        if 5 * n > u32::MAX as usize {
+            return Err(format!("{n} samples do not fit the 32-bit data length"));
+        }
+        if self.image_file.len() > max {
+            return Err(format!(
+                "image name of {} bytes; at most {max}",
+                self.image_file.len()
+            ));
+        }
+        if !self.zmin.is_finite() {
+            return Err(format!(
+                "background sentinel zmin = {} is not finite",
+                self.zmin
+            ));
+        }
+        if let Some(i) = (0..n).find(|&i| !self.xyz[i].is_finite()) {
+            return Err(format!(
+                "sample {i} (row {}, column {}) has a non-finite coordinate {:?}; background samples hold zmin = {}",
+                i / self.ncols,
+                i % self.ncols,
+                self.xyz[i].to_array(),
+                self.zmin
+            ));
+        }
+        if let Some(i) = (0..n).find(|&i| !self.uv[i].iter().all(|c| c.is_finite())) {
+            return Err(format!(
+                "sample {i} has a non-finite texture coordinate {:?}",
+                self.uv[i]
+            ));
+        }
+        Ok(())
+    }
+
+    /// Serialises the grid in the `.bnt` layout (bottom row first) without checks; see
+    /// [`write_bnt_to_bytes`] for the checked writer.
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut out = Vec::new();
         out.extend_from_slice(&(self.nrows as u16).to_le_bytes());
@@ -395,6 +450,24 @@ fn grid_mesh(g: &BntGrid, o: &BntOptions, file: &str) -> Result<LoadedMesh, IoEr
         if removed_small > 0 { format!(", {removed_small} triangle(s) outside the largest dropped") } else { String::new() }
     ));
     Ok(lm)
+}
+
+/// Serialises a grid into the bytes of a `.bnt` file (layout of `docs/algorithms.md` section
+/// 4.1: little endian, rows stored bottom row first) after [`BntGrid::check_writable`]; the
+/// reader gives the same grid back, bit for bit.
+pub fn write_bnt_to_bytes(grid: &BntGrid) -> Result<Vec<u8>, IoError> {
+    grid.check_writable()
+        .map_err(|e| IoError::invalid("<memory>", e))?;
+    Ok(grid.to_bytes())
+}
+
+/// Writes a grid as a `.bnt` file (see [`write_bnt_to_bytes`]).
+pub fn write_bnt(path: impl AsRef<Path>, grid: &BntGrid) -> Result<(), IoError> {
+    let path = path.as_ref();
+    let name = path.display().to_string();
+    grid.check_writable()
+        .map_err(|e| IoError::invalid(&name, e))?;
+    std::fs::write(path, grid.to_bytes()).map_err(|e| IoError::io(&name, e))
 }
 
 /// Parses the bytes of a `.bnt` file into a grid (`file` names it in errors).

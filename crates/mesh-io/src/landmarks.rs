@@ -177,8 +177,45 @@ pub fn read_lm2(path: impl AsRef<Path>) -> Result<Landmarks2d, IoError> {
 
 /// Writes an `.lm3` file in the Bosphorus layout (coordinates in shortest exact decimal form).
 pub fn write_lm3(path: impl AsRef<Path>, lm: &Landmarks3d) -> Result<(), IoError> {
+    write_lm3_with_notes(path, lm, &[])
+}
+
+/// The information block of `.lm3` text: the non-empty lines after the header line up to the
+/// first empty line before the `<N> landmarks:` line (e.g. the landmarks a scanner could not
+/// see, as [`write_lm3_with_notes`] writes them). Empty when there is none.
+pub fn parse_lm3_notes(bytes: &[u8]) -> Vec<String> {
+    let mut out = Vec::new();
+    for (k, (_, l)) in lines(bytes).enumerate() {
+        let l = l.trim();
+        if k == 0 {
+            continue;
+        }
+        if l.is_empty() || count_line(l).is_some() {
+            break;
+        }
+        out.push(l.to_string());
+    }
+    out
+}
+
+/// Writes an `.lm3` file with an information block of `notes` (one line each, after the header
+/// line, ended by an empty line; readers skip it). Notes must be non-empty single lines that do
+/// not look like the `<N> landmarks:` line.
+pub fn write_lm3_with_notes(
+    path: impl AsRef<Path>,
+    lm: &Landmarks3d,
+    notes: &[String],
+) -> Result<(), IoError> {
     let path = path.as_ref();
     let name = path.display().to_string();
+    if let Some(n) = notes.iter().find(|n| {
+        n.trim().is_empty() || n.contains('\n') || n.contains('\r') || count_line(n).is_some()
+    }) {
+        return Err(IoError::invalid(
+            &name,
+            format!("invalid .lm3 note {n:?} (empty, multi-line or like the count line)"),
+        ));
+    }
     if lm.labels.len() != lm.points.len() {
         return Err(IoError::invalid(
             &name,
@@ -198,10 +235,12 @@ pub fn write_lm3(path: impl AsRef<Path>, lm: &Landmarks3d) -> Result<(), IoError
     if lm.points.iter().any(|p| !p.is_finite()) {
         return Err(IoError::invalid(&name, "non-finite landmark coordinate"));
     }
-    let mut s = format!(
-        "# written by bipolar mesh-io\n\n{} landmarks:\n",
-        lm.labels.len()
-    );
+    let mut s = String::from("# written by bipolar mesh-io\n");
+    for n in notes {
+        s.push_str(n.trim());
+        s.push('\n');
+    }
+    s.push_str(&format!("\n{} landmarks:\n", lm.labels.len()));
     for (l, p) in lm.labels.iter().zip(&lm.points) {
         s.push_str(l);
         s.push('\n');

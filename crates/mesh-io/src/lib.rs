@@ -6,7 +6,7 @@
 //!   the [`Format`] explicitly.
 //! * Writers: OBJ, PLY (ASCII or binary, optional per-vertex colours and named scalar
 //!   properties), STL binary, OFF, GLB (a mesh plus point sets and polylines with colours, see
-//!   [`gltf_io::GltfScene`]) and `.lm3`.
+//!   [`gltf_io::GltfScene`]), `.bnt` range grids ([`write_bnt`]) and `.lm3`.
 //!
 //! Every reader returns [`IoError`] naming the file and the line (text) or byte offset
 //! (binary) of the problem; nothing panics on bad input, and no allocation is sized from a
@@ -33,13 +33,15 @@ mod stl;
 mod text;
 
 pub use bnt::{
-    bnt_grid_to_mesh, read_bnt, read_bnt_grid, read_bnt_grid_from_bytes, BntGrid, BntOptions,
+    bnt_grid_to_mesh, read_bnt, read_bnt_grid, read_bnt_grid_from_bytes, write_bnt,
+    write_bnt_to_bytes, BntGrid, BntOptions,
 };
 pub use error::{IoError, Location};
 pub use gltf_io::{write_glb, GltfScene};
 pub use gltf_io::{write_glb_to_bytes, LineMode, PointSet, Polyline, SceneMesh};
 pub use landmarks::{
-    parse_lm2, parse_lm3, read_lm2, read_lm3, write_lm3, Landmarks2d, Landmarks3d,
+    parse_lm2, parse_lm3, parse_lm3_notes, read_lm2, read_lm3, write_lm3, write_lm3_with_notes,
+    Landmarks2d, Landmarks3d,
 };
 pub use npy::{parse_npy_f32, read_npy_f32};
 pub use ply::{PlyEncoding, PlyWriteOptions};

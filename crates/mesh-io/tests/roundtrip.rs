@@ -244,3 +244,30 @@ fn repairs_keep_extras_aligned() {
     }
     assert!(m.warnings.is_empty());
 }
+
+#[test]
+fn lm3_notes_round_trip_and_readers_skip_them() {
+    let lm = mesh_io::Landmarks3d {
+        labels: vec!["Nose tip".into()],
+        points: vec![DVec3::new(1.0, 2.0, 3.0)],
+    };
+    let dir = std::env::temp_dir().join(format!("mesh-io-lm3n-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join("x.lm3");
+    let notes = vec![
+        "not visible: Outer left eye corner: occluded".to_string(),
+        "scanner: seed 3".to_string(),
+    ];
+    mesh_io::write_lm3_with_notes(&p, &lm, &notes).unwrap();
+    assert_eq!(mesh_io::read_lm3(&p).unwrap(), lm);
+    let bytes = std::fs::read(&p).unwrap();
+    assert_eq!(mesh_io::parse_lm3_notes(&bytes), notes);
+    // A plain file has no notes.
+    mesh_io::write_lm3(&p, &lm).unwrap();
+    assert!(mesh_io::parse_lm3_notes(&std::fs::read(&p).unwrap()).is_empty());
+    // Notes that would break the layout are refused.
+    for bad in ["", "two\nlines", "3 landmarks:"] {
+        assert!(mesh_io::write_lm3_with_notes(&p, &lm, &[bad.to_string()]).is_err());
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -2,7 +2,7 @@
 
 use super::header::{Header, Prop, Ty};
 use super::records::{
-    check_index, color_value, face_list_index, push_face, vertex_roles, Role, Sink,
+    check_index, color_value, face_list_index, push_face, push_strip, vertex_roles, Role, Sink,
 };
 use crate::IoError;
 use meshcore::DVec3;
@@ -70,6 +70,7 @@ pub(super) fn read_ascii(
         line_offset: header_lines,
     };
     let mut corners = Vec::with_capacity(8);
+    let mut raw: Vec<f64> = Vec::new();
     for el in &h.elements {
         // Each record needs at least one token (>= 1 byte plus a separator) per property.
         let min_rec = 2 * el.props.len().max(1);
@@ -91,7 +92,8 @@ pub(super) fn read_ascii(
         } else {
             (vec![Role::Ignore; el.props.len()], Vec::new(), false)
         };
-        let li = if el.name == "face" {
+        let strips = el.name == "tristrips";
+        let li = if el.name == "face" || strips {
             Some(face_list_index(el, file)?)
         } else {
             None
@@ -138,14 +140,19 @@ pub(super) fn read_ascii(
                             ));
                         }
                         corners.clear();
+                        raw.clear();
                         for _ in 0..n {
                             let last = toks.line;
                             let (v, ln) = ascii_value(toks.next(), *it, file, last, &el.name)?;
-                            if Some(k) == li {
+                            if Some(k) == li && strips {
+                                raw.push(v);
+                            } else if Some(k) == li {
                                 corners.push(check_index(v, file, crate::Location::Line(ln))?);
                             }
                         }
-                        if Some(k) == li {
+                        if Some(k) == li && strips {
+                            push_strip(sink, &raw, file, crate::Location::Line(ln), ln)?;
+                        } else if Some(k) == li {
                             push_face(sink, &corners, file, crate::Location::Line(ln), ln)?;
                         }
                     }

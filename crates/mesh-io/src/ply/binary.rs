@@ -2,7 +2,7 @@
 
 use super::header::{Header, Prop, Ty};
 use super::records::{
-    check_index, color_value, face_list_index, push_face, vertex_roles, Role, Sink,
+    check_index, color_value, face_list_index, push_face, push_strip, vertex_roles, Role, Sink,
 };
 use crate::IoError;
 use meshcore::DVec3;
@@ -42,6 +42,7 @@ pub(super) fn read_binary(
 ) -> Result<(), IoError> {
     let mut off = h.body_start;
     let mut corners: Vec<u32> = Vec::with_capacity(8);
+    let mut raw: Vec<f64> = Vec::new();
     for el in &h.elements {
         // The smallest a record can be: scalars plus list counts with zero items.
         let min_rec: usize = el
@@ -121,13 +122,15 @@ pub(super) fn read_binary(
                     }
                 }
             }
-            "face" => {
+            "face" | "tristrips" => {
+                let strips = el.name == "tristrips";
                 let li = face_list_index(el, file)?;
                 sink.tris.reserve(el.count);
                 sink.tri_at.reserve(el.count);
                 // Fast path for the common layout `list uchar int|uint vertex_indices` alone:
                 // triangles are 13-byte records.
-                let fast = el.props.len() == 1
+                let fast = !strips
+                    && el.props.len() == 1
                     && matches!(el.props[0], Prop::List(Ty::U8, Ty::I32 | Ty::U32, _));
                 for _ in 0..el.count {
                     if fast && off + 13 <= bytes.len() && bytes[off] == 3 {
@@ -188,6 +191,15 @@ pub(super) fn read_binary(
                                 let n = n as usize;
                                 if n.saturating_mul(it.size()) > bytes.len() - off {
                                     return Err(IoError::byte(file, rec, format!("face list of {n} indices runs past the end of the file")));
+                                }
+                                if strips {
+                                    raw.clear();
+                                    for _ in 0..n {
+                                        raw.push(get(bytes, off, *it, be));
+                                        off += it.size();
+                                    }
+                                    push_strip(sink, &raw, file, crate::Location::Byte(rec), rec)?;
+                                    continue;
                                 }
                                 corners.clear();
                                 for _ in 0..n {

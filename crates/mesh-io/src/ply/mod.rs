@@ -54,10 +54,14 @@ pub(crate) fn read_ply(bytes: &[u8], file: &str) -> Result<LoadedMesh, IoError> 
     if !h.elements.iter().any(|e| e.name == "vertex") {
         return Err(IoError::whole(file, "no 'vertex' element"));
     }
-    if !h.elements.iter().any(|e| e.name == "face") {
+    if !h
+        .elements
+        .iter()
+        .any(|e| e.name == "face" || e.name == "tristrips")
+    {
         return Err(IoError::whole(
             file,
-            "no 'face' element (point clouds are not meshes)",
+            "no 'face' or 'tristrips' element (point clouds are not meshes)",
         ));
     }
     let mut sink = Sink {
@@ -67,6 +71,8 @@ pub(crate) fn read_ply(bytes: &[u8], file: &str) -> Result<LoadedMesh, IoError> 
         tris: Vec::new(),
         tri_at: Vec::new(),
         n_polygons: 0,
+        n_strips: 0,
+        n_strip_degenerate: 0,
     };
     let header_lines = bytes[..h.body_start]
         .iter()
@@ -108,6 +114,12 @@ pub(crate) fn read_ply(bytes: &[u8], file: &str) -> Result<LoadedMesh, IoError> 
         out.warnings.push(format!(
             "{} polygon(s) with more than 3 corners fan-triangulated",
             sink.n_polygons
+        ));
+    }
+    if sink.n_strips > 0 {
+        out.warnings.push(format!(
+            "{} triangle strip(s) decoded; {} degenerate strip triangle(s) (repeated vertex) skipped",
+            sink.n_strips, sink.n_strip_degenerate
         ));
     }
     Ok(out)

@@ -13,6 +13,9 @@ pub(super) struct Sink {
     pub(super) tris: Vec<[u32; 3]>,
     pub(super) tri_at: Vec<usize>,
     pub(super) n_polygons: usize,
+    /// Triangle strips decoded and the degenerate strip triangles (repeated vertex) skipped.
+    pub(super) n_strips: usize,
+    pub(super) n_strip_degenerate: usize,
 }
 
 /// Roles of the properties of the vertex element.
@@ -139,5 +142,46 @@ pub(super) fn push_face(
         sink.tris.push([corners[0], corners[k], corners[k + 1]]);
         sink.tri_at.push(where_);
     }
+    Ok(())
+}
+
+/// Decodes a triangle strip (a `tristrips` list: `-1` restarts a strip, the winding alternates
+/// from one triangle to the next; triangles with a repeated vertex, used to join strips, are
+/// skipped).
+pub(super) fn push_strip(
+    sink: &mut Sink,
+    raw: &[f64],
+    file: &str,
+    at: crate::Location,
+    where_: usize,
+) -> Result<(), IoError> {
+    let mut run: Vec<u32> = Vec::new();
+    let flush = |run: &mut Vec<u32>, sink: &mut Sink| {
+        if run.len() >= 3 {
+            sink.n_strips += 1;
+        }
+        for k in 2..run.len() {
+            let t = if k % 2 == 0 {
+                [run[k - 2], run[k - 1], run[k]]
+            } else {
+                [run[k - 1], run[k - 2], run[k]]
+            };
+            if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+                sink.n_strip_degenerate += 1;
+            } else {
+                sink.tris.push(t);
+                sink.tri_at.push(where_);
+            }
+        }
+        run.clear();
+    };
+    for &v in raw {
+        if v == -1.0 {
+            flush(&mut run, sink);
+        } else {
+            run.push(check_index(v, file, at)?);
+        }
+    }
+    flush(&mut run, sink);
     Ok(())
 }
