@@ -30,8 +30,8 @@ pub fn surface_points(
 /// The cut-off argument: None, +inf and values >= 1e100 (tvb-gdist's "infinity") mean none.
 pub fn cutoff(max_distance: Option<f64>) -> SolveOptions {
     SolveOptions {
-        // `!(c >= 1e100)` keeps NaN, which the library rejects with its own message.
-        max_distance: max_distance.filter(|c| !(*c >= 1e100)),
+        // NaN is kept: the library rejects it with its own message.
+        max_distance: max_distance.filter(|c| c.is_nan() || *c < 1e100),
     }
 }
 
