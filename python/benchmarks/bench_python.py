@@ -36,6 +36,7 @@ os.environ.setdefault("MKL_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 
 import bipolar  # noqa: E402
+import bipolar.gdist  # noqa: E402,F401
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SHARED = pathlib.Path(os.environ.get("BIPOLAR_SHARED", ROOT.parent / "shared"))
