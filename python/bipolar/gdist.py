@@ -142,10 +142,12 @@ def distance_matrix_of_selected_points(
     pts = _indices(points, "points", n, is_one_indexed)
     cut = _cutoff(max_distance)
     rows, cols, vals = [], [], []
-    if len(pts) > 1:
-        fields = solver.distances_many([[int(p)] for p in pts[:-1]], max_distance=cut)
-        for k, p in enumerate(pts[:-1]):
-            tgt = pts[k + 1 :]
+    # Fields 64 sources at a time (in parallel), so memory stays 64 x N whatever len(points).
+    for start in range(0, max(len(pts) - 1, 0), 64):
+        chunk = pts[start : min(start + 64, len(pts) - 1)]
+        fields = solver.distances_many([[int(p)] for p in chunk], max_distance=cut)
+        for k, p in enumerate(chunk):
+            tgt = pts[start + k + 1 :]
             d = fields[k, tgt]
             rows.extend([np.full(len(tgt), p), tgt])
             cols.extend([tgt, np.full(len(tgt), p)])

@@ -230,6 +230,24 @@ pub fn u64_vec(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<u64>> {
         .collect()
 }
 
+/// A 1-D boolean array (bool dtype only).
+pub fn bool_vec(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<bool>> {
+    let a = as_ndarray(obj, what)?;
+    if a.dtype().kind() != b'b' {
+        return Err(errors::type_error(format!(
+            "{what} must be a boolean array, got dtype {}",
+            dtype_name(&a)
+        )));
+    }
+    if a.ndim() != 1 {
+        return Err(errors::input(format!(
+            "{what} must be 1-dimensional, got shape {}",
+            shape_str(a.shape())
+        )));
+    }
+    a.call_method0("tolist")?.extract()
+}
+
 /// An `(m, 3)` array of vertex indices (range against the vertex count is checked by
 /// `TriMesh::new`).
 pub fn triangles(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<[u32; 3]>> {

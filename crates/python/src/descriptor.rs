@@ -69,11 +69,7 @@ impl PyDescriptor {
             None => vec![0.0; n],
         };
         let a: Vec<bool> = match ambiguous {
-            Some(a) => a
-                .call_method1("astype", ("bool",))
-                .and_then(|b| b.call_method0("tolist"))
-                .and_then(|l| l.extract())
-                .map_err(|_| errors::type_error("ambiguous must be a boolean array"))?,
+            Some(a) => convert::bool_vec(a, "ambiguous")?,
             None => vec![false; n],
         };
         if c.len() != n || a.len() != n {
@@ -296,7 +292,7 @@ pub fn _descriptor_from_state(
     let p = convert::points(points, "points")?;
     let k = convert::u64_vec(keys, "keys")?;
     let c = convert::f64_vec(cos, "cos")?;
-    let a: Vec<bool> = ambiguous.call_method0("tolist")?.extract()?;
+    let a = convert::bool_vec(ambiguous, "ambiguous")?;
     let f = convert::u32_vec(faces, "faces")?;
     let b = convert::points(bary, "bary")?;
     let n = p.len();
