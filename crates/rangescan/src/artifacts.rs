@@ -310,20 +310,20 @@ pub(crate) fn apply(
     let ray_dir = |i: usize| cam.ray((i % nc) as f64, (i / nc) as f64).1;
     if let Some(nz) = a.noise {
         let mut rng = stream(seed, STREAM_NOISE);
-        for i in 0..n {
+        for (i, sample) in samples.iter_mut().enumerate() {
             let g: f64 = rng.sample(StandardNormal);
-            if let Some(p) = &mut samples[i] {
+            if let Some(p) = sample {
                 *p += ray_dir(i) * (nz.sigma_mm * g);
             }
         }
     }
     if let Some(s) = a.spikes {
         let mut rng = stream(seed, STREAM_SPIKES);
-        for i in 0..n {
+        for (i, sample) in samples.iter_mut().enumerate() {
             let u: f64 = rng.random();
             let m: f64 = rng.random();
             let towards: bool = rng.random();
-            if let Some(p) = &mut samples[i] {
+            if let Some(p) = sample {
                 if u < s.fraction {
                     let mag = s.min_mm + m * (s.max_mm - s.min_mm);
                     *p += ray_dir(i) * if towards { -mag } else { mag };
