@@ -16,6 +16,7 @@ mod mesh;
 pub mod repair;
 pub mod shapes;
 mod topology;
+pub mod units;
 
 pub use error::MeshError;
 pub use glam::{DAffine3, DMat3, DQuat, DVec3};
