@@ -20,6 +20,7 @@ mod mesh;
 pub mod repair;
 pub mod shapes;
 mod topology;
+pub mod units;
 
 pub use choice::{Choice, UnknownChoice};
 pub use error::MeshError;
