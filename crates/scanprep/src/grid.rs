@@ -31,7 +31,7 @@ pub struct GridCheck {
 /// MAX_COORDINATE_MM` in a valid sample), at least one valid sample and a coverage of at least
 /// `min_coverage`.
 pub fn check_grid(grid: &BntGrid, min_coverage: f64) -> Result<GridCheck, ScanPrepError> {
-    let n = grid.nrows.checked_mul(grid.ncols).unwrap_or(usize::MAX);
+    let n = grid.nrows.saturating_mul(grid.ncols);
     if grid.xyz.len() != n || grid.uv.len() != n {
         return Err(ScanPrepError::InvalidInput(format!(
             "grid of {} x {} with {} xyz and {} uv entries",
@@ -141,12 +141,15 @@ pub fn grid_spacing(grid: &BntGrid) -> Option<f64> {
 pub struct SpikeOptions {
     /// Half width of the square window of neighbours (2: a 5 x 5 window).
     pub window_radius: usize,
-    /// A sample is a spike when its depth differs from the median depth of its valid
-    /// neighbours by more than `threshold_spacings` grid spacings and more than
-    /// `mad_factor` robust standard deviations (1.4826 MAD) of those depths. Default 3.
+    /// A sample is a spike when its depth differs from the predicted depth by more than
+    /// `threshold_spacings` grid spacings and more than `mad_factor` robust standard
+    /// deviations of the prediction. The prediction is the median, over the pairs of opposite
+    /// valid neighbours in the window, of the pair's mean depth (exact on a plane, whatever
+    /// its slope; one spike spoils one pair); the spread is 1.4826 times the median absolute
+    /// deviation of those means. Samples with fewer than 3 such pairs are kept. Default 3.
     pub threshold_spacings: f64,
-    /// See `threshold_spacings`; the spread term keeps steep but smooth slopes (the rim of a
-    /// sphere, the sides of the nose) where they are. Default 4.
+    /// See `threshold_spacings`; the spread term keeps strongly curved parts seen at a slant
+    /// (the rim of a sphere, the sides of the nose) where they are. Default 4.
     pub mad_factor: f64,
     /// A valid sample with fewer valid neighbours in its window is an isolated outlier and
     /// removed. Default 4.
@@ -202,6 +205,11 @@ pub fn remove_grid_spikes(
     let valid: Vec<bool> = (0..n).map(|i| grid.is_valid(i)).collect();
     let thr = grid_spacing(grid).map(|s| o.threshold_spacings * s);
     let w = o.window_radius as isize;
+    let at = |r: usize, c: usize, dr: isize, dc: isize| -> Option<usize> {
+        let (rr, cc) = (r as isize + dr, c as isize + dc);
+        (rr >= 0 && cc >= 0 && rr < nr as isize && cc < nc as isize)
+            .then(|| rr as usize * nc + cc as usize)
+    };
     let mut remove = vec![0u8; n];
     let mut zs: Vec<f64> = Vec::with_capacity((2 * o.window_radius + 1).pow(2));
     for r in 0..nr {
@@ -210,28 +218,38 @@ pub fn remove_grid_spikes(
             if !valid[i] {
                 continue;
             }
+            // Neighbour count, and the mean depth of each pair of valid opposite neighbours
+            // (exact at the centre of a plane, a curvature term off it).
+            let mut count = 0usize;
             zs.clear();
             for dr in -w..=w {
-                let rr = r as isize + dr;
-                if rr < 0 || rr >= nr as isize {
-                    continue;
-                }
                 for dc in -w..=w {
-                    let cc = c as isize + dc;
-                    if (dr == 0 && dc == 0) || cc < 0 || cc >= nc as isize {
+                    if dr == 0 && dc == 0 {
                         continue;
                     }
-                    let j = rr as usize * nc + cc as usize;
-                    if valid[j] {
-                        zs.push(grid.xyz[j].z);
+                    let Some(j) = at(r, c, dr, dc) else { continue };
+                    if !valid[j] {
+                        continue;
+                    }
+                    count += 1;
+                    // Each pair once: the half-window with dr > 0, or dr == 0 and dc > 0.
+                    if dr > 0 || (dr == 0 && dc > 0) {
+                        if let Some(k) = at(r, c, -dr, -dc) {
+                            if valid[k] {
+                                zs.push(0.5 * (grid.xyz[j].z + grid.xyz[k].z));
+                            }
+                        }
                     }
                 }
             }
-            if zs.len() < o.min_neighbours {
+            if count < o.min_neighbours {
                 remove[i] = 2;
                 continue;
             }
             let Some(thr) = thr else { continue };
+            if zs.len() < MIN_PAIRS {
+                continue;
+            }
             let med = median(&mut zs);
             for z in zs.iter_mut() {
                 *z = (*z - med).abs();
@@ -255,6 +273,9 @@ pub fn remove_grid_spikes(
     Ok(counts)
 }
 
+/// Fewer pairs of opposite valid neighbours than this: no spike decision (the sample is kept).
+const MIN_PAIRS: usize = 3;
+
 /// Median of a non-empty slice (reorders it; upper median for even lengths).
 fn median(v: &mut [f64]) -> f64 {
     let mid = v.len() / 2;
@@ -268,8 +289,8 @@ const SUPPORT_RING: usize = 3;
 /// hole (filled or not), in order of their first sample.
 ///
 /// A hole is a 4-connected set of invalid samples that does not reach the edge of the grid
-/// (background around the object always does). Its diameter is its larger extent in rows or
-/// columns, in samples, times the grid spacing. A filled sample gets `x`, `y` and `(u, v)` from
+/// (background around the object always does). Its diameter is the largest distance between
+/// two samples of its rim (the valid 4-neighbours of its samples). A filled sample gets `x`, `y` and `(u, v)` from
 /// an affine fit in `(column, row)` and `z` from a quadratic fit in `(x, y)`, both least
 /// squares over the valid samples within 3 rows and columns of the hole (exact on planes and
 /// quadrics seen as height fields). A hole with fewer than 12 supporting samples is left and
@@ -286,9 +307,6 @@ pub fn fill_grid_holes(
     let (nr, nc) = (grid.nrows, grid.ncols);
     let n = nr * nc;
     let valid: Vec<bool> = (0..n).map(|i| grid.is_valid(i)).collect();
-    let Some(spacing) = grid_spacing(grid) else {
-        return Ok(Vec::new());
-    };
     let mut label = vec![u32::MAX; n];
     let mut holes = Vec::new();
     let mut stack = Vec::new();
@@ -341,20 +359,21 @@ pub fn fill_grid_holes(
             c0 = c0.min(i % nc);
             c1 = c1.max(i % nc);
         }
-        let diameter = ((r1 - r0).max(c1 - c0) + 1) as f64 * spacing;
         // Centre: mean of the valid 4-neighbours of the hole (its rim).
-        let mut rim = DVec3::ZERO;
-        let mut n_rim = 0usize;
+        let mut rim = Vec::new();
         for &i in &members {
             // Not on the grid edge (the hole does not touch it), so all four exist.
             for j in [i - nc, i + nc, i - 1, i + 1] {
                 if valid[j] {
-                    rim += grid.xyz[j];
-                    n_rim += 1;
+                    rim.push(j);
                 }
             }
         }
-        let centre = rim / n_rim.max(1) as f64;
+        rim.sort_unstable();
+        rim.dedup();
+        let rim: Vec<DVec3> = rim.iter().map(|&j| grid.xyz[j]).collect();
+        let centre = rim.iter().sum::<DVec3>() / rim.len().max(1) as f64;
+        let diameter = rim_diameter(&rim);
         let mut hole = Hole {
             size: members.len(),
             diameter_mm: diameter,
@@ -370,6 +389,21 @@ pub fn fill_grid_holes(
         out.push(hole);
     }
     Ok(out)
+}
+
+/// Largest distance between two rim samples (the bounding-box diagonal for rims of more than
+/// 3000 samples, to bound the cost).
+fn rim_diameter(rim: &[DVec3]) -> f64 {
+    if rim.len() > 3000 {
+        return meshcore::Aabb::from_points(rim).map_or(0.0, |b| b.diagonal());
+    }
+    let mut d2 = 0.0f64;
+    for (k, a) in rim.iter().enumerate() {
+        for b in &rim[k + 1..] {
+            d2 = d2.max(a.distance_squared(*b));
+        }
+    }
+    d2.sqrt()
 }
 
 /// Valid samples within [`SUPPORT_RING`] rows and columns of a hole sample (in grid order).
@@ -510,10 +544,11 @@ pub(crate) fn least_squares<const K: usize>(rows: &[[f64; K]], t: &[f64]) -> Opt
         }
         m.swap(col, piv);
         rhs.swap(col, piv);
+        let pivot_row = m[col];
         for r in col + 1..K {
-            let f = m[r][col] / m[col][col];
-            for c in col..K {
-                m[r][c] -= f * m[col][c];
+            let f = m[r][col] / pivot_row[col];
+            for (x, p) in m[r][col..].iter_mut().zip(&pivot_row[col..]) {
+                *x -= f * p;
             }
             rhs[r] -= f * rhs[col];
         }

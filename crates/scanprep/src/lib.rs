@@ -102,8 +102,8 @@ pub enum ScanPrepError {
 pub struct Hole {
     /// Grid: missing samples; mesh: vertices of its boundary loop.
     pub size: usize,
-    /// Diameter in mm (grid: larger extent in samples times the spacing; mesh: largest
-    /// distance between loop vertices).
+    /// Diameter in mm: the largest distance between two samples of its rim (grid) or two
+    /// vertices of its boundary loop (mesh).
     pub diameter_mm: f64,
     /// Mean position of its rim (mm).
     pub centre: DVec3,
@@ -515,7 +515,7 @@ pub fn clean(input: Input<'_>, o: &CleanOptions) -> Result<Cleaned, ScanPrepErro
 }
 
 fn crop_sphere_check(c: &Crop) -> Result<(), ScanPrepError> {
-    if !c.centre.is_finite() || !(c.radius_mm.is_finite() && c.radius_mm > 0.0) {
+    if !(c.centre.is_finite() && c.radius_mm.is_finite() && c.radius_mm > 0.0) {
         return Err(ScanPrepError::InvalidOption(format!(
             "crop sphere centre {:?}, radius {} mm (expected finite, radius > 0)",
             c.centre.to_array(),

@@ -238,7 +238,7 @@ pub fn crop_sphere(
     centre: DVec3,
     radius: f64,
 ) -> Result<(TriMesh, usize), ScanPrepError> {
-    if !centre.is_finite() || !(radius.is_finite() && radius > 0.0) {
+    if !(centre.is_finite() && radius.is_finite() && radius > 0.0) {
         return Err(ScanPrepError::InvalidOption(format!(
             "crop sphere centre {:?}, radius {radius} (expected finite, radius > 0)",
             centre.to_array()
