@@ -6,11 +6,14 @@
 //!   boundary loops, connected components, manifold and orientation checks).
 //! * [`SurfacePoint`]: a point on the surface as (face, barycentric coordinates), with conversion
 //!   to a position and [`FaceLocator`] for the nearest surface point to an arbitrary 3D point.
+//! * [`linalg`]: the small dense linear algebra of the workspace (3x3 symmetric eigen, SVD,
+//!   Kabsch and Horn rotations, the one rigid fit [`linalg::fit_rigid`]).
 //! * [`repair`]: explicit, opt-in repairs (drop degenerate faces, weld duplicate vertices).
 //!
 //! Nothing here panics on user data: constructors return [`MeshError`].
 
 mod error;
+pub mod linalg;
 mod locate;
 mod mesh;
 pub mod repair;
