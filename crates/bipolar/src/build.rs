@@ -1131,7 +1131,7 @@ impl<'c, 'a> Strip<'c, 'a> {
                 }
             }
         }
-        let (vals, vecs) = shapedist::linalg::sym_eigen3(glam::DMat3::from_cols_array_2d(&m));
+        let (vals, vecs) = meshcore::linalg::sym_eigen3(glam::DMat3::from_cols_array_2d(&m));
         if vals[0].is_nan() || vals[0] <= 0.0 || vals[0] < so.min_ratio * vals[1].max(0.0) {
             return None;
         }

@@ -6,6 +6,8 @@
 //!   boundary loops, connected components, manifold and orientation checks).
 //! * [`SurfacePoint`]: a point on the surface as (face, barycentric coordinates), with conversion
 //!   to a position and [`FaceLocator`] for the nearest surface point to an arbitrary 3D point.
+//! * [`linalg`]: the small dense linear algebra of the workspace (3x3 symmetric eigen, SVD,
+//!   Kabsch and Horn rotations, the one rigid fit [`linalg::fit_rigid`]).
 //! * [`repair`]: explicit, opt-in repairs (drop degenerate faces, weld duplicate vertices),
 //!   the one implementation every reader and binary uses.
 //! * [`Choice`] and [`choice!`]: option enums that parse by name, with [`UnknownChoice`]
@@ -15,6 +17,7 @@
 
 pub mod choice;
 mod error;
+pub mod linalg;
 mod locate;
 mod mesh;
 pub mod repair;
