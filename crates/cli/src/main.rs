@@ -2,6 +2,7 @@
 
 use clap::{Parser, Subcommand};
 
+mod cmd_clean;
 mod cmd_convert;
 mod cmd_describe;
 mod cmd_distance;
@@ -10,6 +11,7 @@ mod cmd_info;
 mod cmd_landmarks;
 mod cmd_matrix;
 mod cmd_render;
+mod cmd_scan;
 
 /// Bipolar invariant representation of 3D surfaces: inspect meshes, compute geodesic fields and
 /// descriptors, compare faces.
@@ -38,6 +40,10 @@ enum Command {
     Matrix(cmd_matrix::Args),
     /// Detect face landmarks (outer eye corners, nose tip).
     Landmarks(cmd_landmarks::Args),
+    /// Scan a mesh with the virtual range scanner into a Bosphorus `.bnt` grid (mm).
+    Scan(cmd_scan::Args),
+    /// Prepare a scan: spikes, outliers, small holes, crop, smoothing, decimation; units.
+    Clean(cmd_clean::Args),
 }
 
 fn main() -> std::process::ExitCode {
@@ -51,6 +57,8 @@ fn main() -> std::process::ExitCode {
         Command::Distance(a) => cmd_distance::run(a),
         Command::Matrix(a) => cmd_matrix::run(a),
         Command::Landmarks(a) => cmd_landmarks::run(a),
+        Command::Scan(a) => cmd_scan::run(a),
+        Command::Clean(a) => cmd_clean::run(a),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,
