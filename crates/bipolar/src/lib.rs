@@ -34,6 +34,6 @@ pub use error::BipolarError;
 pub use geodesic::Source;
 pub use key::Key;
 pub use types::{
-    Descriptor, DescriptorOptions, DescriptorPoint, DescriptorStats, LevelSpec, SelectionRule,
-    SplineOptions, StripOptions, TangentMethod,
+    Descriptor, DescriptorOptions, DescriptorPoint, DescriptorStats, LevelSpec, SelectionKind,
+    SelectionRule, SplineOptions, StripOptions, TangentMethod,
 };

@@ -46,6 +46,10 @@ pub enum Parametrization {
     /// safer when the point spacing varies a lot.
     Centripetal,
 }
+meshcore::choice!(Parametrization, "parametrization", BSplineError {
+    ChordLength = "chord-length" | "chord",
+    Centripetal = "centripetal",
+});
 
 impl Parametrization {
     fn exponent(self) -> f64 {
@@ -134,6 +138,9 @@ pub enum BSplineError {
         /// Index of the failing pivot.
         pivot: usize,
     },
+    /// An option name that is none of the valid names (they are listed).
+    #[error(transparent)]
+    UnknownChoice(#[from] meshcore::UnknownChoice),
 }
 
 /// A fitted cubic B-spline curve in 3D: open clamped on `[0, 1]` or closed periodic with

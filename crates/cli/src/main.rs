@@ -2,6 +2,7 @@
 
 use clap::{Parser, Subcommand};
 
+mod choice;
 mod cmd_convert;
 mod cmd_describe;
 mod cmd_distance;
@@ -10,6 +11,7 @@ mod cmd_info;
 mod cmd_landmarks;
 mod cmd_matrix;
 mod cmd_render;
+mod refpoint;
 
 /// Bipolar invariant representation of 3D surfaces: inspect meshes, compute geodesic fields and
 /// descriptors, compare faces.
