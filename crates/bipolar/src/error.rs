@@ -75,12 +75,26 @@ pub enum BipolarError {
     /// The spline tangent method failed in a way that has no fallback.
     #[error("B-spline tangents: {0}")]
     Spline(#[from] bspline::BSplineError),
-    /// Reading or writing a descriptor file failed.
-    #[error("{path}: {message}")]
+    /// A descriptor file could not be read or written (the OS error is the source).
+    #[error("cannot {action} {}", path.display())]
     Io {
+        /// What was being done (`"read"`, `"write"`).
+        action: &'static str,
         /// File.
-        path: String,
-        /// What went wrong (line number included where relevant).
+        path: std::path::PathBuf,
+        /// The OS error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A descriptor file is malformed or cannot hold the descriptor.
+    #[error("{}: {message}", path.display())]
+    File {
+        /// File.
+        path: std::path::PathBuf,
+        /// What is wrong (line number included where relevant).
         message: String,
     },
+    /// An option name that is none of the valid names (they are listed).
+    #[error(transparent)]
+    UnknownChoice(#[from] meshcore::UnknownChoice),
 }

@@ -19,18 +19,26 @@ use std::path::Path;
 pub const CSV_HEADER: &str = "x,y,z,a,b,i,j,side,sign,cos,ambiguous";
 
 fn io_err(path: &Path, message: impl Into<String>) -> BipolarError {
-    BipolarError::Io {
-        path: path.display().to_string(),
+    BipolarError::File {
+        path: path.to_path_buf(),
         message: message.into(),
     }
 }
 
 fn write_file(path: &Path, text: &str) -> Result<(), BipolarError> {
-    std::fs::write(path, text).map_err(|e| io_err(path, format!("cannot write: {e}")))
+    std::fs::write(path, text).map_err(|source| BipolarError::Io {
+        action: "write",
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 fn read_file(path: &Path) -> Result<String, BipolarError> {
-    std::fs::read_to_string(path).map_err(|e| io_err(path, format!("cannot read: {e}")))
+    std::fs::read_to_string(path).map_err(|source| BipolarError::Io {
+        action: "read",
+        path: path.to_path_buf(),
+        source,
+    })
 }
 
 /// CSV text of a descriptor (see the module docs).

@@ -38,6 +38,6 @@ pub use geodesic::Source;
 pub use key::Key;
 pub use polar::{describe_polar, PolarDescriptor, PolarKey, PolarOptions, PolarPoint};
 pub use types::{
-    Descriptor, DescriptorOptions, DescriptorPoint, DescriptorStats, LevelSpec, SelectionRule,
-    SplineOptions, StripOptions, TangentMethod,
+    Descriptor, DescriptorOptions, DescriptorPoint, DescriptorStats, LevelSpec, SelectionKind,
+    SelectionRule, SplineOptions, StripOptions, TangentMethod,
 };

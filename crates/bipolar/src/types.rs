@@ -28,19 +28,11 @@ pub enum TangentMethod {
     Spline,
 }
 
-impl std::str::FromStr for TangentMethod {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "gradient" => Ok(Self::Gradient),
-            "strip" => Ok(Self::Strip),
-            "spline" => Ok(Self::Spline),
-            o => Err(format!(
-                "unknown tangent method {o:?} (expected gradient, strip or spline)"
-            )),
-        }
-    }
-}
+meshcore::choice!(TangentMethod, "tangent method", crate::BipolarError {
+    Gradient = "gradient",
+    Strip = "strip",
+    Spline = "spline",
+});
 
 /// Which intersection points are kept (the two readings of the paper's rule, §2.5).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -57,6 +49,49 @@ pub enum SelectionRule {
     IsoAngle,
     /// Every intersection of the two level families (no angle selection). Keys `(i, j, side)`.
     All,
+}
+
+/// The name of a [`SelectionRule`] without its parameters (`filter`, `isoangle`, `all`), for
+/// choosing a rule by name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum SelectionKind {
+    /// [`SelectionRule::Filter`].
+    Filter,
+    /// [`SelectionRule::IsoAngle`].
+    #[default]
+    IsoAngle,
+    /// [`SelectionRule::All`].
+    All,
+}
+meshcore::choice!(SelectionKind, "rule", crate::BipolarError {
+    Filter = "filter",
+    IsoAngle = "isoangle" | "iso-angle",
+    All = "all",
+});
+
+impl SelectionKind {
+    /// The rule of this kind; `filter_tolerance` is the band of [`SelectionRule::Filter`]
+    /// (ignored by the others).
+    pub fn rule(self, filter_tolerance: f64) -> SelectionRule {
+        match self {
+            SelectionKind::Filter => SelectionRule::Filter {
+                tolerance: filter_tolerance,
+            },
+            SelectionKind::IsoAngle => SelectionRule::IsoAngle,
+            SelectionKind::All => SelectionRule::All,
+        }
+    }
+}
+
+impl SelectionRule {
+    /// The kind of this rule.
+    pub fn kind(&self) -> SelectionKind {
+        match self {
+            SelectionRule::Filter { .. } => SelectionKind::Filter,
+            SelectionRule::IsoAngle => SelectionKind::IsoAngle,
+            SelectionRule::All => SelectionKind::All,
+        }
+    }
 }
 
 /// Settings of the strip tangent method (M1).

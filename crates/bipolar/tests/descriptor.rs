@@ -750,3 +750,22 @@ fn a_region_limit_cuts_the_fields_off_without_changing_the_descriptor() {
         }
     }
 }
+
+#[test]
+fn option_names_round_trip_and_bad_names_list_the_choices() {
+    use bipolar::{BipolarError, SelectionKind, SelectionRule, TangentMethod};
+    meshcore::choice::check_choice::<TangentMethod>("normal").unwrap();
+    meshcore::choice::check_choice::<SelectionKind>("band").unwrap();
+    let k: SelectionKind = "iso-angle".parse().unwrap();
+    assert_eq!(k.rule(0.1), SelectionRule::IsoAngle);
+    assert_eq!(
+        SelectionKind::Filter.rule(0.1).kind(),
+        SelectionKind::Filter
+    );
+    match "band".parse::<SelectionKind>() {
+        Err(BipolarError::UnknownChoice(e)) => {
+            assert_eq!(e.expected, ["filter", "isoangle", "all"]);
+        }
+        other => panic!("{other:?}"),
+    }
+}

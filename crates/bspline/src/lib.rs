@@ -53,6 +53,10 @@ pub enum Parametrization {
     /// safer when the point spacing varies a lot.
     Centripetal,
 }
+meshcore::choice!(Parametrization, "parametrization", BSplineError {
+    ChordLength = "chord-length" | "chord",
+    Centripetal = "centripetal",
+});
 
 impl Parametrization {
     fn exponent(self) -> f64 {
@@ -141,4 +145,7 @@ pub enum BSplineError {
         /// Index of the failing pivot.
         pivot: usize,
     },
+    /// An option name that is none of the valid names (they are listed).
+    #[error(transparent)]
+    UnknownChoice(#[from] meshcore::UnknownChoice),
 }

@@ -477,3 +477,12 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn parametrization_names_round_trip() {
+    meshcore::choice::check_choice::<bspline::Parametrization>("uniform").unwrap();
+    assert!(matches!(
+        "uniform".parse::<bspline::Parametrization>(),
+        Err(bspline::BSplineError::UnknownChoice(_))
+    ));
+}

@@ -2,6 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::choice::choice;
 use anyhow::Context;
 use glam::{DMat3, DVec3};
 use serde_json::json;
@@ -11,7 +12,7 @@ use shapedist::{
 };
 
 /// How the two descriptors are compared.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Mode {
     /// Pair the points by key, closed-form rotation (Kabsch): normalised L2 distance.
     Keys,
@@ -20,36 +21,36 @@ pub enum Mode {
     /// Global ICP without keys: normalised symmetric Hausdorff distance after alignment.
     Hausdorff,
 }
-
-/// ICP error variant.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum Variant {
-    /// Point-to-point (the paper's definition).
-    Point,
-    /// Point-to-plane (normals by PCA of nearest neighbours).
-    Plane,
-}
+meshcore::choice!(Mode, "comparison mode", meshcore::UnknownChoice {
+    Keys = "keys",
+    Icp = "icp",
+    Hausdorff = "hausdorff",
+});
 
 /// Robust weights for the keyed fit.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Robust {
     /// Huber weights (k = 1.345 robust sigmas).
     Huber,
     /// Tukey biweight (c = 4.685 robust sigmas).
     Tukey,
 }
+meshcore::choice!(Robust, "robust loss", meshcore::UnknownChoice {
+    Huber = "huber",
+    Tukey = "tukey",
+});
 
 /// Options shared by `bipolar distance` and `bipolar matrix`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct CompareArgs {
     /// Comparison mode.
-    #[arg(long, value_enum, default_value_t = Mode::Keys)]
+    #[arg(long, default_value = "keys", value_parser = choice::<Mode>())]
     pub mode: Mode,
     /// Keys mode: closed-form solver.
-    #[arg(long, default_value = "kabsch", value_parser = ["kabsch", "horn"])]
-    pub solver: String,
+    #[arg(long, default_value = "kabsch", value_parser = choice::<RotationMethod>())]
+    pub solver: RotationMethod,
     /// Keys mode: robust IRLS weights.
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = choice::<Robust>())]
     pub robust: Option<Robust>,
     /// Keys mode: drop pairs whose residual after alignment exceeds this length (same unit as
     /// the points; the method notes use about 0.3 x the reference distance).
@@ -60,8 +61,8 @@ pub struct CompareArgs {
     #[arg(long)]
     pub keep_ambiguous: bool,
     /// ICP modes: error variant of the refinement.
-    #[arg(long, value_enum, default_value_t = Variant::Point)]
-    pub variant: Variant,
+    #[arg(long, default_value = "point", value_parser = choice::<IcpVariant>())]
+    pub variant: IcpVariant,
     /// ICP modes: fraction of the worst pairs rejected at each iteration.
     #[arg(long, default_value_t = 0.0)]
     pub trim: f64,
@@ -127,11 +128,7 @@ impl CompareArgs {
     /// Keyed options from the flags.
     pub fn keyed_options(&self) -> anyhow::Result<KeyedOptions> {
         Ok(KeyedOptions {
-            method: if self.solver == "horn" {
-                RotationMethod::Horn
-            } else {
-                RotationMethod::Kabsch
-            },
+            method: self.solver,
             robust: self.robust.map(|r| match r {
                 Robust::Huber => RobustLoss::Huber(1.345),
                 Robust::Tukey => RobustLoss::Tukey(4.685),
@@ -146,10 +143,7 @@ impl CompareArgs {
         GlobalOptions {
             grid: !self.no_global,
             refine: IcpOptions {
-                variant: match self.variant {
-                    Variant::Point => IcpVariant::PointToPoint,
-                    Variant::Plane => IcpVariant::PointToPlane,
-                },
+                variant: self.variant,
                 max_iterations: self.iterations.max(1),
                 trim: self.trim,
                 ..IcpOptions::default()
@@ -232,7 +226,7 @@ pub fn compare(
                 r.stats.hausdorff_normalised
             };
             let v = json!({
-                "mode": if c.mode == Mode::Icp { "icp" } else { "hausdorff" },
+                "mode": c.mode.to_string(),
                 "a": a.label, "b": b.label,
                 "distance": d,
                 "normalisation": if c.mode == Mode::Icp {

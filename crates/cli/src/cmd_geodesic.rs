@@ -5,9 +5,11 @@
 //! shape `(n,)`) or `.ply` (the mesh with a `double distance` vertex property). Unreachable
 //! vertices (other components, beyond `--max-distance`) get `inf`.
 
-use anyhow::{bail, Context};
+use crate::choice::{choice, from_extension};
+use crate::refpoint::{RefArgs, Resolver};
+use anyhow::Context;
 use geodesic::{Method, SolveOptions, Source};
-use meshcore::{DVec3, FaceLocator, TriMesh};
+use meshcore::TriMesh;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -18,14 +20,22 @@ use std::time::Instant;
 pub struct Args {
     /// Input mesh (OBJ, PLY, STL, OFF, glTF/GLB, BNT).
     pub mesh: PathBuf,
-    /// Source vertex index (0-based); repeat for several sources.
-    #[arg(long = "source", value_name = "V")]
-    pub source: Vec<u32>,
-    /// Source point `X,Y,Z`, snapped to the nearest surface point; repeat for several.
-    #[arg(long = "source-point", value_name = "X,Y,Z", value_parser = parse_point, allow_hyphen_values = true)]
-    pub source_point: Vec<DVec3>,
+    /// Source: a vertex index (0-based), `X,Y,Z` (snapped to the nearest surface point, within
+    /// --snap-tolerance) or a landmark name (from --landmarks, or detected); repeat for several.
+    #[arg(long = "source", value_name = "REF", allow_hyphen_values = true)]
+    pub source: Vec<String>,
+    /// Source point `X,Y,Z` (read like --source); repeat for several.
+    #[arg(
+        long = "source-point",
+        value_name = "X,Y,Z",
+        allow_hyphen_values = true
+    )]
+    pub source_point: Vec<String>,
+    /// How sources are read (landmark file, snapping tolerance).
+    #[command(flatten)]
+    pub refs: RefArgs,
     /// Method: exact (polyhedral), fmm (fast marching), heat (heat method) or dijkstra (edges).
-    #[arg(long, default_value = "exact", value_parser = parse_method)]
+    #[arg(long, default_value = "exact", value_parser = choice::<Method>())]
     pub method: Method,
     /// Stop at this distance; farther vertices get `inf`.
     #[arg(long = "max-distance", value_name = "D")]
@@ -33,29 +43,6 @@ pub struct Args {
     /// Output file: `.txt`, `.csv`, `.npy` or `.ply`.
     #[arg(long)]
     pub out: PathBuf,
-}
-
-fn parse_method(s: &str) -> Result<Method, String> {
-    s.parse::<Method>().map_err(|e| e.to_string())
-}
-
-fn parse_point(s: &str) -> Result<DVec3, String> {
-    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
-    if parts.len() != 3 {
-        return Err(format!(
-            "expected X,Y,Z (three comma-separated numbers), got {s:?}"
-        ));
-    }
-    let mut c = [0.0; 3];
-    for (k, p) in parts.iter().enumerate() {
-        c[k] = p
-            .parse::<f64>()
-            .map_err(|e| format!("coordinate {} of {s:?}: {e}", k + 1))?;
-        if !c[k].is_finite() {
-            return Err(format!("coordinate {} of {s:?} is not finite", k + 1));
-        }
-    }
-    Ok(DVec3::from_array(c))
 }
 
 /// Output formats.
@@ -66,23 +53,15 @@ enum OutFormat {
     Npy,
     Ply,
 }
+meshcore::choice!(OutFormat, "distance file", meshcore::UnknownChoice {
+    Txt = "txt",
+    Csv = "csv",
+    Npy = "npy",
+    Ply = "ply",
+});
 
 fn out_format(path: &Path) -> anyhow::Result<OutFormat> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
-    Ok(match ext.as_str() {
-        "txt" => OutFormat::Txt,
-        "csv" => OutFormat::Csv,
-        "npy" => OutFormat::Npy,
-        "ply" => OutFormat::Ply,
-        _ => bail!(
-            "unknown output extension {ext:?} of {}: expected .txt, .csv, .npy or .ply",
-            path.display()
-        ),
-    })
+    from_extension(path)
 }
 
 /// Runs the command.
@@ -91,17 +70,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let loaded = mesh_io::read_mesh(&args.mesh)
         .with_context(|| format!("reading {}", args.mesh.display()))?;
     let mesh = loaded.mesh;
-    let mut sources: Vec<Source> = args.source.iter().map(|&v| Source::Vertex(v)).collect();
-    if !args.source_point.is_empty() {
-        let loc = FaceLocator::new(&mesh);
-        for p in &args.source_point {
-            let (sp, d) = loc.nearest(*p)?;
-            eprintln!(
-                "source point ({}, {}, {}) snapped to face {} (bary {:.6}, {:.6}, {:.6}), {:.3e} away",
-                p.x, p.y, p.z, sp.face, sp.bary.x, sp.bary.y, sp.bary.z, d
-            );
-            sources.push(Source::Point(sp));
-        }
+    let resolver = Resolver::new(&mesh, &args.mesh, &args.refs)?;
+    let mut sources: Vec<Source> = Vec::new();
+    for s in &args.source {
+        sources.push(resolver.resolve(s, "--source")?.source);
+    }
+    for s in &args.source_point {
+        sources.push(resolver.resolve(s, "--source-point")?.source);
     }
     let t0 = Instant::now();
     let solver = geodesic::new_solver(&mesh, args.method)
@@ -211,13 +186,7 @@ mod tests {
     }
 
     #[test]
-    fn point_parsing() {
-        assert_eq!(
-            parse_point("1, -2.5,3e-1").unwrap(),
-            DVec3::new(1.0, -2.5, 0.3)
-        );
-        assert!(parse_point("1,2").is_err());
-        assert!(parse_point("1,2,nan").is_err());
+    fn output_formats() {
         assert!(out_format(Path::new("a.xyz")).is_err());
         assert_eq!(out_format(Path::new("a.NPY")).unwrap(), OutFormat::Npy);
     }

@@ -65,11 +65,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         );
     }
     if let Some(p) = &args.out {
-        io::write_landmarks_json(p, &lm)?;
+        mesh_io::write_landmarks_json(p, &io::to_json_file(&lm))?;
         println!("wrote {}", p.display());
     }
     if let Some(p) = &args.lm3 {
-        io::write_lm3(p, &lm)?;
+        mesh_io::write_lm3(p, &io::to_lm3_file(&lm))?;
         println!("wrote {}", p.display());
     }
     Ok(())

@@ -16,10 +16,12 @@
 //!
 //! Curves and points hidden by the surface are not drawn.
 
+use crate::choice::choice;
+use crate::refpoint::{RefArgs, Resolver};
 use anyhow::{bail, Context};
 use geodesic::{Method, SolveOptions, Source};
 use glam::DVec3;
-use meshcore::{FaceLocator, Topology, TriMesh};
+use meshcore::{Choice, Topology, TriMesh};
 use std::path::{Path, PathBuf};
 use viz::{Marker, Polyline, Scene, View};
 
@@ -38,14 +40,18 @@ pub struct Args {
     /// `--ref-a/--ref-b`) or equally spaced levels of `--field`.
     #[arg(long, value_name = "N")]
     pub curves: Option<u32>,
-    /// First reference point: vertex index or `X,Y,Z`.
+    /// First reference point: vertex index, `X,Y,Z` (within --snap-tolerance of the surface)
+    /// or a landmark name (from --landmarks, or detected).
     #[arg(long = "ref-a", value_name = "A", allow_hyphen_values = true)]
     pub ref_a: Option<String>,
-    /// Second reference point: vertex index or `X,Y,Z`.
+    /// Second reference point: vertex index, `X,Y,Z` or a landmark name.
     #[arg(long = "ref-b", value_name = "B", allow_hyphen_values = true)]
     pub ref_b: Option<String>,
+    /// How reference points are read (landmark file, snapping tolerance).
+    #[command(flatten)]
+    pub refs: RefArgs,
     /// Geodesic method for the reference fields: exact, fmm, heat or dijkstra.
-    #[arg(long, default_value = "exact", value_parser = parse_method)]
+    #[arg(long, default_value = "exact", value_parser = choice::<Method>())]
     pub method: Method,
     /// View: front, back, left, right, top, or a viewing direction `X,Y,Z` (eye to scene).
     #[arg(long, default_value = "front", value_parser = parse_view, allow_hyphen_values = true)]
@@ -67,10 +73,6 @@ pub struct Args {
     pub out: PathBuf,
 }
 
-fn parse_method(s: &str) -> Result<Method, String> {
-    s.parse::<Method>().map_err(|e| e.to_string())
-}
-
 fn parse_view(s: &str) -> Result<View, String> {
     View::parse(s).map_err(|e| e.to_string())
 }
@@ -86,52 +88,19 @@ enum OutKind {
     Picture,
     Glb,
 }
+meshcore::choice!(OutKind, "picture", meshcore::UnknownChoice {
+    Picture = "svg" | "png",
+    Glb = "glb",
+});
 
 fn out_kind(path: &Path) -> anyhow::Result<OutKind> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
-    Ok(match ext.as_str() {
-        "svg" | "png" => OutKind::Picture,
-        "glb" => OutKind::Glb,
-        _ => bail!(
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    OutKind::from_name(ext).map_err(|_| {
+        anyhow::anyhow!(
             "unknown output extension {ext:?} of {}: expected .svg, .png or .glb",
             path.display()
-        ),
+        )
     })
-}
-
-/// A reference point: its geodesic source and its position.
-fn parse_ref(s: &str, mesh: &TriMesh, name: &str) -> anyhow::Result<(Source, DVec3)> {
-    let t = s.trim();
-    if let Ok(v) = t.parse::<u32>() {
-        let p = mesh
-            .try_position(v)
-            .with_context(|| format!("{name} = {t}"))?;
-        return Ok((Source::Vertex(v), p));
-    }
-    let parts: Vec<&str> = t.split(',').map(str::trim).collect();
-    if parts.len() != 3 {
-        bail!("{name} = {t:?}: expected a vertex index or X,Y,Z");
-    }
-    let mut c = [0.0; 3];
-    for (k, p) in parts.iter().enumerate() {
-        c[k] = p
-            .parse::<f64>()
-            .ok()
-            .filter(|x| x.is_finite())
-            .with_context(|| {
-                format!(
-                    "{name} = {t:?}: coordinate {} is not a finite number",
-                    k + 1
-                )
-            })?;
-    }
-    let (sp, _) = FaceLocator::new(mesh).nearest(DVec3::from_array(c))?;
-    let pos = mesh.point_position(&sp)?;
-    Ok((Source::Point(sp), pos))
 }
 
 /// Reads one value per vertex from a `.txt` or `.csv` file.
@@ -226,8 +195,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 
     match (&args.ref_a, &args.ref_b) {
         (Some(a), Some(b)) => {
-            let (src_a, pos_a) = parse_ref(a, &mesh, "--ref-a")?;
-            let (src_b, pos_b) = parse_ref(b, &mesh, "--ref-b")?;
+            let resolver = Resolver::new(&mesh, &args.mesh, &args.refs)?;
+            let ra = resolver.resolve(a, "--ref-a")?;
+            let rb = resolver.resolve(b, "--ref-b")?;
+            let (src_a, pos_a, src_b, pos_b) = (ra.source, ra.position, rb.source, rb.position);
             if pos_a.distance(pos_b) <= 1e-12 * mesh.bbox().diagonal() {
                 bail!("--ref-a and --ref-b are the same point");
             }

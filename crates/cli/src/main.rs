@@ -3,6 +3,7 @@
 use clap::{Parser, Subcommand};
 
 mod cmd_clean;
+mod choice;
 mod cmd_convert;
 mod cmd_describe;
 mod cmd_distance;
@@ -12,6 +13,7 @@ mod cmd_landmarks;
 mod cmd_matrix;
 mod cmd_render;
 mod cmd_scan;
+mod refpoint;
 
 /// Bipolar invariant representation of 3D surfaces: inspect meshes, compute geodesic fields and
 /// descriptors, compare faces.

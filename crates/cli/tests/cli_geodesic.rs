@@ -105,6 +105,9 @@ fn writes_every_format() {
         m,
         "--source-point",
         "2.5,3.25,0.7",
+        // 0.7 off the plane is 6 % of its bounding-box diagonal (default tolerance 1 %).
+        "--snap-tolerance",
+        "0.1",
         "--method",
         "heat",
         "--out",

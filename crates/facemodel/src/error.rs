@@ -8,8 +8,10 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 pub enum FaceModelError {
     /// The operating system could not read the file or list the folder.
-    #[error("{}: {source}", path.display())]
+    #[error("cannot {action} {}", path.display())]
     Io {
+        /// What was being done (`"read"`, `"list"`).
+        action: &'static str,
         /// The file or folder.
         path: PathBuf,
         /// The underlying error.
@@ -149,7 +151,8 @@ impl FaceModelError {
     /// Wraps an error of `mesh_io::read_mesh` on `path`, keeping an OS error as [`Self::Io`].
     pub(crate) fn mesh(path: &std::path::Path, e: mesh_io::IoError) -> Self {
         match e {
-            mesh_io::IoError::Io { source, .. } => Self::Io {
+            mesh_io::IoError::Io { action, source, .. } => Self::Io {
+                action,
                 path: path.to_path_buf(),
                 source,
             },
@@ -163,7 +166,8 @@ impl FaceModelError {
     /// Wraps an error of `mesh_io::read_npy_f32` on `path`, keeping an OS error as [`Self::Io`].
     pub(crate) fn npy(path: &std::path::Path, e: mesh_io::IoError) -> Self {
         match e {
-            mesh_io::IoError::Io { source, .. } => Self::Io {
+            mesh_io::IoError::Io { action, source, .. } => Self::Io {
+                action,
                 path: path.to_path_buf(),
                 source,
             },
@@ -175,8 +179,9 @@ impl FaceModelError {
     }
 
     /// An OS error on `path`.
-    pub(crate) fn io(path: &std::path::Path, source: std::io::Error) -> Self {
+    pub(crate) fn io(action: &'static str, path: &std::path::Path, source: std::io::Error) -> Self {
         Self::Io {
+            action,
             path: path.to_path_buf(),
             source,
         }

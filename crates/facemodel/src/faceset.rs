@@ -54,7 +54,7 @@ pub struct Face {
 pub fn read_landmark_positions(
     path: &Path,
 ) -> Result<BTreeMap<String, BTreeMap<String, DVec3>>, FaceModelError> {
-    let text = std::fs::read_to_string(path).map_err(|e| FaceModelError::io(path, e))?;
+    let text = std::fs::read_to_string(path).map_err(|e| FaceModelError::io("read", path, e))?;
     let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| FaceModelError::Json {
         path: path.to_path_buf(),
         source: e,
@@ -109,7 +109,7 @@ pub fn load_face_set(dir: &Path) -> Result<Vec<Face>, FaceModelError> {
         return Err(set_err("face folder not found"));
     }
     let mut names: Vec<String> = std::fs::read_dir(dir)
-        .map_err(|e| FaceModelError::io(dir, e))?
+        .map_err(|e| FaceModelError::io("list", dir, e))?
         .filter_map(|e| e.ok())
         .map(|e| e.path())
         .filter(|p| p.extension().is_some_and(|x| x.eq_ignore_ascii_case("obj")))

@@ -48,8 +48,8 @@ impl FaceModel {
         let (neutral, triangles) = read_obj(&obj_path)?;
         let n = neutral.len();
         let json_path = dir.join("model.json");
-        let text =
-            std::fs::read_to_string(&json_path).map_err(|e| FaceModelError::io(&json_path, e))?;
+        let text = std::fs::read_to_string(&json_path)
+            .map_err(|e| FaceModelError::io("read", &json_path, e))?;
         let meta: serde_json::Value =
             serde_json::from_str(&text).map_err(|e| FaceModelError::Json {
                 path: json_path.clone(),
@@ -539,7 +539,7 @@ mod tests {
         let dir = write_model("npy-missing");
         std::fs::remove_file(dir.join("expressions.npy")).unwrap();
         match FaceModel::load(&dir).unwrap_err() {
-            FaceModelError::Io { path, source } => {
+            FaceModelError::Io { path, source, .. } => {
                 assert_eq!(path, dir.join("expressions.npy"));
                 assert_eq!(source.kind(), std::io::ErrorKind::NotFound);
             }

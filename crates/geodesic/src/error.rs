@@ -17,9 +17,9 @@ pub enum GeodesicError {
         /// Number of vertices.
         vertices: usize,
     },
-    /// A method name was not recognised.
-    #[error("unknown geodesic method {0:?} (expected exact, fmm, heat or dijkstra)")]
-    UnknownMethod(String),
+    /// An option name that is none of the valid names (they are listed).
+    #[error(transparent)]
+    UnknownChoice(#[from] meshcore::UnknownChoice),
     /// The method is not available yet.
     #[error("geodesic method {0} is not implemented yet")]
     NotImplemented(&'static str),

@@ -71,6 +71,12 @@ pub enum FmmUpdate {
     #[default]
     CurvedFront,
 }
+meshcore::choice!(FmmUpdate, "fast-marching update", crate::GeodesicError {
+    PlaneWave = "plane-wave",
+    PointSource = "point-source",
+    Blend = "blend",
+    CurvedFront = "curved-front",
+});
 
 /// Fast marching distance on a triangle mesh.
 ///

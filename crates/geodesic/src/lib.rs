@@ -75,28 +75,17 @@ pub enum Method {
     Dijkstra,
 }
 
-impl Method {
-    /// Short lowercase name, as used on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Exact => "exact",
-            Method::Fmm => "fmm",
-            Method::Heat => "heat",
-            Method::Dijkstra => "dijkstra",
-        }
-    }
-}
+meshcore::choice!(Method, "geodesic method", GeodesicError {
+    Exact = "exact",
+    Fmm = "fmm",
+    Heat = "heat",
+    Dijkstra = "dijkstra",
+});
 
-impl std::str::FromStr for Method {
-    type Err = GeodesicError;
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        match s {
-            "exact" => Ok(Method::Exact),
-            "fmm" => Ok(Method::Fmm),
-            "heat" => Ok(Method::Heat),
-            "dijkstra" => Ok(Method::Dijkstra),
-            other => Err(GeodesicError::UnknownMethod(other.to_string())),
-        }
+impl Method {
+    /// Short lowercase name, as used on the command line ([`meshcore::Choice::name`]).
+    pub fn name(self) -> &'static str {
+        meshcore::Choice::name(self)
     }
 }
 

@@ -230,3 +230,17 @@ fn row_of_sources_on_a_plane() {
         assert!(e < tol, "{rule:?}: {e}");
     }
 }
+
+#[test]
+fn option_names_round_trip_and_bad_names_list_the_choices() {
+    use geodesic::{FmmUpdate, GeodesicError, Method};
+    meshcore::choice::check_choice::<Method>("mmp").unwrap();
+    meshcore::choice::check_choice::<FmmUpdate>("planewave").unwrap();
+    assert_eq!("FMM".parse::<Method>().unwrap(), Method::Fmm);
+    match "mmp".parse::<Method>() {
+        Err(GeodesicError::UnknownChoice(e)) => {
+            assert_eq!(e.expected, ["exact", "fmm", "heat", "dijkstra"]);
+        }
+        other => panic!("{other:?}"),
+    }
+}

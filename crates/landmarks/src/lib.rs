@@ -13,7 +13,8 @@
 //!   [`LandmarkRegressor`] (the shipped one does), the eye corners are placed by its learned
 //!   regression from the local depth maps. Inputs that do not fit a face (not a face, inverted
 //!   normals) end with [`LandmarkError::NotFound`].
-//! * [`io`]: `.lm3` reader and writer, the ICT `landmarks.json` layout, JSON output.
+//! * [`io`]: conversions between [`Landmarks`] and the landmark files of `mesh-io` (which
+//!   reads and writes every landmark file), and [`io::select_five`].
 
 pub mod curvature;
 mod detect;
@@ -184,22 +185,29 @@ pub enum LandmarkError {
     /// Mesh error.
     #[error(transparent)]
     Mesh(#[from] MeshError),
-    /// File could not be read or written.
-    #[error("{path}: {source}")]
+    /// A file could not be read or written (the OS error is the source).
+    #[error("cannot {action} {}", path.display())]
     Io {
+        /// What was being done (`"read"`, `"write"`).
+        action: &'static str,
         /// The file.
-        path: String,
+        path: std::path::PathBuf,
         /// The cause.
+        #[source]
         source: std::io::Error,
     },
-    /// Landmark file content error.
-    #[error("{path}:{line}: {message}")]
-    Parse {
-        /// The file.
-        path: String,
-        /// 1-based line (0 when not applicable).
-        line: usize,
-        /// What is wrong.
-        message: String,
+    /// A landmark file could not be read or is malformed (`mesh-io` reads them).
+    #[error(transparent)]
+    File(#[from] mesh_io::IoError),
+    /// A set of labelled points lacks one of the five landmarks.
+    #[error("{source_name}: no landmark {label:?}")]
+    MissingLandmark {
+        /// Where the points came from (a file name).
+        source_name: String,
+        /// The Bosphorus label of the missing landmark.
+        label: String,
     },
+    /// An option name that is none of the valid names (they are listed).
+    #[error(transparent)]
+    UnknownChoice(#[from] meshcore::UnknownChoice),
 }

@@ -342,7 +342,8 @@ impl GenericModel {
     /// Reads a model file.
     pub fn load(path: &std::path::Path) -> Result<Self, LandmarkError> {
         let text = std::fs::read_to_string(path).map_err(|e| LandmarkError::Io {
-            path: path.display().to_string(),
+            action: "read",
+            path: path.to_path_buf(),
             source: e,
         })?;
         Self::from_json(&text).map_err(|e| match e {

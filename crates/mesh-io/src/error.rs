@@ -84,6 +84,9 @@ pub enum IoError {
         /// What is wrong.
         problem: String,
     },
+    /// An option name that is none of the valid names (they are listed).
+    #[error(transparent)]
+    UnknownChoice(#[from] meshcore::UnknownChoice),
 }
 
 impl IoError {

@@ -356,6 +356,11 @@ pub enum LineMode {
     /// Points taken in pairs, each pair one segment (glTF `LINES`).
     Segments,
 }
+meshcore::choice!(LineMode, "line mode", crate::IoError {
+    Strip = "strip",
+    Loop = "loop",
+    Segments = "segments",
+});
 
 /// A triangle mesh in a [`GltfScene`].
 #[derive(Debug, Clone, PartialEq)]

@@ -1,26 +1,60 @@
-//! Bosphorus landmark files: `.lm3` (3D) and `.lm2` (2D image coordinates).
+//! Landmark files, read and written here only: Bosphorus `.lm3` (3D) and `.lm2` (2D image
+//! coordinates), the landmark JSON written by `bipolar landmarks` (or a flat
+//! `{label: [x, y, z]}` object) and the ICT FaceKit `landmarks.json` layout.
 
 use crate::text::{lines, push_f64};
 use crate::IoError;
 use meshcore::DVec3;
+use std::collections::BTreeMap;
 use std::path::Path;
 
-/// Labelled 3D landmarks (`.lm3`).
+/// A file of labelled 3D landmarks (`.lm3`, landmark JSON, one face of the ICT layout).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Landmarks3d {
-    /// Labels, trimmed (e.g. "Nose tip", "Outer left eye corner").
+    /// Labels, trimmed (e.g. "Nose tip", "Outer left eye corner", "nose_tip").
     pub labels: Vec<String>,
     /// Coordinates, one per label.
     pub points: Vec<DVec3>,
+    /// Per label, the mesh vertex the file names (JSON `vertex`, ICT `vertex_ids`); empty when
+    /// the file names no vertex (`.lm3`).
+    pub vertices: Vec<Option<u32>>,
+    /// Per label, a confidence (JSON `confidence`); empty when the file has none.
+    pub confidences: Vec<Option<f64>>,
+    /// Numbers about the whole set, in file order (JSON top-level numbers such as a detection's
+    /// `confidence` or `fit_rms`); empty for `.lm3`.
+    pub attributes: Vec<(String, f64)>,
 }
 
 impl Landmarks3d {
     /// The point with exactly this (trimmed) label.
     pub fn get(&self, label: &str) -> Option<DVec3> {
-        self.labels
-            .iter()
-            .position(|l| l == label.trim())
-            .map(|i| self.points[i])
+        self.index(label).map(|i| self.points[i])
+    }
+
+    /// The position of the entry with exactly this (trimmed) label.
+    pub fn index(&self, label: &str) -> Option<usize> {
+        self.labels.iter().position(|l| l == label.trim())
+    }
+
+    /// The vertex the file names for entry `i`, if any.
+    pub fn vertex(&self, i: usize) -> Option<u32> {
+        self.vertices.get(i).copied().flatten()
+    }
+
+    /// Appends an entry (keeping the optional columns aligned when they are in use).
+    pub fn push(&mut self, label: impl Into<String>, point: DVec3, vertex: Option<u32>) {
+        let n = self.labels.len();
+        if vertex.is_some() && self.vertices.len() < n {
+            self.vertices.resize(n, None);
+        }
+        if !self.vertices.is_empty() || vertex.is_some() {
+            self.vertices.push(vertex);
+        }
+        if !self.confidences.is_empty() {
+            self.confidences.resize(n + 1, None);
+        }
+        self.labels.push(label.into());
+        self.points.push(point);
     }
 }
 
@@ -252,4 +286,188 @@ pub fn write_lm3_with_notes(
         s.push('\n');
     }
     std::fs::write(path, s).map_err(|e| IoError::io("write", path, e))
+}
+
+fn json_vec3(v: &serde_json::Value, file: &str, what: &str) -> Result<DVec3, IoError> {
+    let c: Vec<f64> = v
+        .as_array()
+        .map(|a| a.iter().filter_map(|c| c.as_f64()).collect())
+        .unwrap_or_default();
+    if c.len() != 3 || v.as_array().map_or(0, Vec::len) != 3 || c.iter().any(|c| !c.is_finite()) {
+        return Err(IoError::whole(
+            file,
+            format!("{what}: expected [x, y, z] with finite numbers, got {v}"),
+        ));
+    }
+    Ok(DVec3::new(c[0], c[1], c[2]))
+}
+
+fn json_value(bytes: &[u8], file: &str) -> Result<serde_json::Value, IoError> {
+    serde_json::from_slice(bytes).map_err(|e| {
+        IoError::line(
+            file,
+            e.line().max(1),
+            format!("not a JSON landmark file: {e}"),
+        )
+    })
+}
+
+fn json_u32(v: Option<&serde_json::Value>) -> Option<u32> {
+    v.and_then(|x| x.as_u64())
+        .and_then(|x| u32::try_from(x).ok())
+}
+
+/// Parses landmark JSON: as written by [`landmarks_json`] (`{"landmarks": {label: {"vertex",
+/// "position": [x, y, z], "confidence"}}, <numbers>}`) or a flat `{label: [x, y, z]}` object.
+/// Entries that are neither an array nor have a `position` are skipped; at least one landmark
+/// must be present.
+pub fn parse_landmarks_json(bytes: &[u8], file: &str) -> Result<Landmarks3d, IoError> {
+    let v = json_value(bytes, file)?;
+    let nested = v.get("landmarks").and_then(|l| l.as_object());
+    let obj = nested
+        .or_else(|| v.as_object())
+        .ok_or_else(|| IoError::whole(file, "expected a JSON object of landmarks"))?;
+    let mut out = Landmarks3d::default();
+    let mut confidences = Vec::new();
+    for (label, x) in obj {
+        let (position, vertex, confidence) = if let Some(p) = x.get("position") {
+            (
+                json_vec3(p, file, label)?,
+                json_u32(x.get("vertex")),
+                x.get("confidence").and_then(|c| c.as_f64()),
+            )
+        } else if x.is_array() {
+            (json_vec3(x, file, label)?, None, None)
+        } else {
+            continue;
+        };
+        out.push(label.clone(), position, vertex);
+        confidences.push(confidence);
+    }
+    if out.labels.is_empty() {
+        return Err(IoError::whole(file, "no landmark positions found"));
+    }
+    if confidences.iter().any(Option::is_some) {
+        out.confidences = confidences;
+    }
+    if let (Some(_), Some(top)) = (nested, v.as_object()) {
+        out.attributes = top
+            .iter()
+            .filter_map(|(k, x)| x.as_f64().map(|x| (k.clone(), x)))
+            .collect();
+    }
+    Ok(out)
+}
+
+/// The landmark JSON of `lm` (see [`parse_landmarks_json`]): its attributes at the top level and
+/// `"landmarks": {label: {"position", "vertex"?, "confidence"?}}`.
+pub fn landmarks_json(lm: &Landmarks3d) -> serde_json::Value {
+    let mut m = serde_json::Map::new();
+    for (i, (label, p)) in lm.labels.iter().zip(&lm.points).enumerate() {
+        let mut e = serde_json::Map::new();
+        e.insert("position".into(), serde_json::json!(p.to_array()));
+        if let Some(v) = lm.vertex(i) {
+            e.insert("vertex".into(), v.into());
+        }
+        if let Some(c) = lm.confidences.get(i).copied().flatten() {
+            e.insert("confidence".into(), c.into());
+        }
+        m.insert(label.clone(), e.into());
+    }
+    let mut top = serde_json::Map::new();
+    for (k, x) in &lm.attributes {
+        top.insert(k.clone(), (*x).into());
+    }
+    top.insert("landmarks".into(), m.into());
+    top.into()
+}
+
+/// Writes [`landmarks_json`] of `lm` (pretty-printed, newline-terminated).
+pub fn write_landmarks_json(path: impl AsRef<Path>, lm: &Landmarks3d) -> Result<(), IoError> {
+    let path = path.as_ref();
+    let name = path.display().to_string();
+    if lm.labels.len() != lm.points.len() {
+        return Err(IoError::invalid(
+            &name,
+            format!("{} labels for {} points", lm.labels.len(), lm.points.len()),
+        ));
+    }
+    if lm.points.iter().any(|p| !p.is_finite()) {
+        return Err(IoError::invalid(&name, "non-finite landmark coordinate"));
+    }
+    let s = serde_json::to_string_pretty(&landmarks_json(lm))
+        .map_err(|e| IoError::invalid(&name, e.to_string()))?;
+    std::fs::write(path, s + "\n").map_err(|e| IoError::io("write", path, e))
+}
+
+/// Parses the ICT FaceKit `landmarks.json` layout (`{"vertex_ids": {label: id}, "faces":
+/// {face: {label: [x, y, z]}}}`): face name -> its landmarks, each with the vertex id of its
+/// label when `vertex_ids` gives one.
+pub fn parse_ict_landmarks(
+    bytes: &[u8],
+    file: &str,
+) -> Result<BTreeMap<String, Landmarks3d>, IoError> {
+    let v = json_value(bytes, file)?;
+    let faces = v
+        .get("faces")
+        .and_then(|f| f.as_object())
+        .ok_or_else(|| IoError::whole(file, "no \"faces\" object"))?;
+    let ids = v.get("vertex_ids").and_then(|i| i.as_object());
+    let mut out = BTreeMap::new();
+    for (name, f) in faces {
+        let f = f
+            .as_object()
+            .ok_or_else(|| IoError::whole(file, format!("faces.{name} is not an object")))?;
+        let mut lm = Landmarks3d::default();
+        for (label, p) in f {
+            let q = json_vec3(p, file, &format!("faces.{name}.{label}"))?;
+            lm.push(label.clone(), q, json_u32(ids.and_then(|i| i.get(label))));
+        }
+        out.insert(name.clone(), lm);
+    }
+    Ok(out)
+}
+
+/// Reads the ICT FaceKit `landmarks.json` layout (see [`parse_ict_landmarks`]).
+pub fn read_ict_landmarks(
+    path: impl AsRef<Path>,
+) -> Result<BTreeMap<String, Landmarks3d>, IoError> {
+    let path = path.as_ref();
+    let bytes = std::fs::read(path).map_err(|e| IoError::io("read", path, e))?;
+    parse_ict_landmarks(&bytes, &path.display().to_string())
+}
+
+/// Reads any file of labelled 3D landmarks: `.lm3` by extension, otherwise JSON: the ICT
+/// layout (the face named `face`, usually the mesh file's stem; an error listing the faces when
+/// it is missing or `None`), the landmark JSON of [`write_landmarks_json`] or a flat
+/// `{label: [x, y, z]}` object.
+pub fn read_landmark_file(
+    path: impl AsRef<Path>,
+    face: Option<&str>,
+) -> Result<Landmarks3d, IoError> {
+    let path = path.as_ref();
+    let name = path.display().to_string();
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("lm3"))
+    {
+        return read_lm3(path);
+    }
+    let bytes = std::fs::read(path).map_err(|e| IoError::io("read", path, e))?;
+    let v = json_value(&bytes, &name)?;
+    if v.get("faces").is_some_and(|f| f.is_object()) {
+        let mut faces = parse_ict_landmarks(&bytes, &name)?;
+        let names: Vec<String> = faces.keys().cloned().collect();
+        return face.and_then(|f| faces.remove(f)).ok_or_else(|| {
+            IoError::whole(
+                &name,
+                format!(
+                    "no face named {:?} in this ICT landmark file; it has: {}",
+                    face.unwrap_or(""),
+                    names.join(", ")
+                ),
+            )
+        });
+    }
+    parse_landmarks_json(&bytes, &name)
 }

@@ -1,7 +1,9 @@
 //! Readers and writers for triangle meshes and landmark files.
 //!
 //! * Readers: OBJ, PLY (ASCII, binary little and big endian), STL (ASCII and binary), OFF,
-//!   glTF/GLB, Bosphorus `.bnt` range grids, `.lm3`/`.lm2` landmark files and `.npy` arrays.
+//!   glTF/GLB, Bosphorus `.bnt` range grids, landmark files (`.lm3`/`.lm2`, landmark JSON,
+//!   the ICT `landmarks.json` layout; the only landmark-file code of the workspace) and `.npy`
+//!   arrays.
 //!   [`read_mesh`] picks the reader from the file extension; [`read_mesh_from_bytes`] takes
 //!   the [`Format`] explicitly.
 //! * Writers: OBJ, PLY (ASCII or binary, optional per-vertex colours and named scalar
@@ -40,8 +42,9 @@ pub use error::{IoError, Location};
 pub use gltf_io::{write_glb, GltfScene};
 pub use gltf_io::{write_glb_to_bytes, LineMode, PointSet, Polyline, SceneMesh};
 pub use landmarks::{
-    parse_lm2, parse_lm3, parse_lm3_notes, read_lm2, read_lm3, write_lm3, write_lm3_with_notes,
-    Landmarks2d, Landmarks3d,
+    landmarks_json, parse_ict_landmarks, parse_landmarks_json, parse_lm2, parse_lm3,
+    parse_lm3_notes, read_ict_landmarks, read_landmark_file, read_lm2, read_lm3,
+    write_landmarks_json, write_lm3, write_lm3_with_notes, Landmarks2d, Landmarks3d,
 };
 pub use npy::{parse_npy_f32, read_npy_f32};
 pub use ply::{PlyEncoding, PlyWriteOptions};
@@ -67,6 +70,15 @@ pub enum Format {
     /// Bosphorus range grid (`.bnt`, read only).
     Bnt,
 }
+meshcore::choice!(Format, "mesh format", IoError {
+    Obj = "obj",
+    Ply = "ply",
+    Stl = "stl",
+    Off = "off",
+    Gltf = "gltf",
+    Glb = "glb",
+    Bnt = "bnt",
+});
 
 impl Format {
     /// The format named by a path's extension (case-insensitive).
@@ -76,20 +88,9 @@ impl Format {
             .and_then(|e| e.to_str())
             .unwrap_or("")
             .to_ascii_lowercase();
-        Ok(match ext.as_str() {
-            "obj" => Format::Obj,
-            "ply" => Format::Ply,
-            "stl" => Format::Stl,
-            "off" => Format::Off,
-            "gltf" => Format::Gltf,
-            "glb" => Format::Glb,
-            "bnt" => Format::Bnt,
-            _ => {
-                return Err(IoError::UnknownFormat {
-                    file: path.display().to_string(),
-                    ext,
-                })
-            }
+        <Format as meshcore::Choice>::from_name(&ext).map_err(|_| IoError::UnknownFormat {
+            file: path.display().to_string(),
+            ext,
         })
     }
 }
@@ -102,6 +103,10 @@ pub enum ScalarType {
     /// 64-bit float.
     F64,
 }
+meshcore::choice!(ScalarType, "scalar type", IoError {
+    F32 = "f32" | "float32" | "float",
+    F64 = "f64" | "float64" | "double",
+});
 
 /// A named per-vertex scalar property (e.g. a geodesic distance field).
 #[derive(Debug, Clone, PartialEq)]

@@ -262,3 +262,21 @@ fn ply_element_without_properties_and_huge_count_does_not_hang() {
     let m = read_mesh_from_bytes(&b, Format::Ply).unwrap();
     assert_eq!(m.mesh.n_faces(), 1);
 }
+
+#[test]
+fn option_names_round_trip_and_bad_names_list_the_choices() {
+    use mesh_io::{Format, IoError, LineMode, PlyEncoding, ScalarType};
+    meshcore::choice::check_choice::<Format>("fbx").unwrap();
+    meshcore::choice::check_choice::<PlyEncoding>("utf8").unwrap();
+    meshcore::choice::check_choice::<ScalarType>("int").unwrap();
+    meshcore::choice::check_choice::<LineMode>("fan").unwrap();
+    match "utf8".parse::<PlyEncoding>() {
+        Err(IoError::UnknownChoice(e)) => {
+            assert_eq!(
+                e.expected,
+                ["ascii", "binary_little_endian", "binary_big_endian"]
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+}

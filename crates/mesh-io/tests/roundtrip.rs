@@ -190,6 +190,7 @@ fn lm3_round_trip() {
             DVec3::new(0.1, -2.5e-7, 1e10),
             DVec3::new(-45.25, 30.0, 0.0),
         ],
+        ..Default::default()
     };
     let dir = std::env::temp_dir().join(format!("mesh-io-lm3-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -250,6 +251,7 @@ fn lm3_notes_round_trip_and_readers_skip_them() {
     let lm = mesh_io::Landmarks3d {
         labels: vec!["Nose tip".into()],
         points: vec![DVec3::new(1.0, 2.0, 3.0)],
+        ..Default::default()
     };
     let dir = std::env::temp_dir().join(format!("mesh-io-lm3n-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -270,4 +272,47 @@ fn lm3_notes_round_trip_and_readers_skip_them() {
         assert!(mesh_io::write_lm3_with_notes(&p, &lm, &[bad.to_string()]).is_err());
     }
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn landmark_json_round_trips_and_every_layout_reads() {
+    let dir = std::env::temp_dir().join(format!("mesh-io-lmjson-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut lm = mesh_io::Landmarks3d::default();
+    lm.push("nose_tip", DVec3::new(0.1, -2.5e-7, 12.0), Some(7));
+    lm.push("outer_eye_left", DVec3::new(4.0, 3.0, 8.0), Some(9));
+    lm.confidences = vec![Some(0.9), None];
+    lm.attributes = vec![("confidence".into(), 0.75), ("fit_rms".into(), 0.01)];
+    let p = dir.join("lm.json");
+    mesh_io::write_landmarks_json(&p, &lm).unwrap();
+    let back = mesh_io::read_landmark_file(&p, None).unwrap();
+    assert_eq!(back, lm);
+    // A flat object: positions only.
+    let flat =
+        mesh_io::parse_landmarks_json(br#"{"a": [1, 2, 3], "note": "x"}"#, "f.json").unwrap();
+    assert_eq!(flat.labels, ["a"]);
+    assert!(flat.vertices.is_empty() && flat.confidences.is_empty());
+    let e = mesh_io::parse_landmarks_json(br#"{"a": [1, 2]}"#, "g.json").unwrap_err();
+    assert!(
+        e.to_string().contains("g.json: a: expected [x, y, z]"),
+        "{e}"
+    );
+    // ICT layout: the face named like the mesh, with vertex ids.
+    let ict = dir.join("landmarks.json");
+    std::fs::write(
+        &ict,
+        r#"{"vertex_ids": {"nose_tip": 5}, "faces": {"f1": {"nose_tip": [0, 0, 12], "right_eye_outer": [-4, 3, 8]}}}"#,
+    )
+    .unwrap();
+    let f1 = mesh_io::read_landmark_file(&ict, Some("f1")).unwrap();
+    assert_eq!(f1.get("nose_tip"), Some(DVec3::new(0.0, 0.0, 12.0)));
+    assert_eq!(f1.vertex(f1.index("nose_tip").unwrap()), Some(5));
+    assert_eq!(f1.vertex(f1.index("right_eye_outer").unwrap()), None);
+    let e = mesh_io::read_landmark_file(&ict, Some("f2")).unwrap_err();
+    assert!(e.to_string().contains("it has: f1"), "{e}");
+    assert_eq!(mesh_io::read_ict_landmarks(&ict).unwrap()["f1"], f1);
+    let e = mesh_io::read_landmark_file(dir.join("missing.lm3"), None).unwrap_err();
+    assert!(matches!(e, mesh_io::IoError::Io { action: "read", .. }));
+    assert!(std::error::Error::source(&e).is_some());
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -31,19 +31,11 @@ fn options(
         (Some(n), None) => LevelSpec::Count(n),
         (None, None) => LevelSpec::Count(10),
     };
-    let rule = match rule {
-        "filter" => SelectionRule::Filter {
-            tolerance: tolerance.unwrap_or(alpha / (4.0 * angles.max(1) as f64)),
-        },
-        "isoangle" | "iso-angle" => SelectionRule::IsoAngle,
-        "all" => SelectionRule::All,
-        o => {
-            return Err(errors::input(format!(
-                "unknown rule {o:?} (expected filter, isoangle or all)"
-            )))
-        }
-    };
-    let tangent: TangentMethod = tangent.parse().map_err(errors::input)?;
+    let rule = rule
+        .parse::<bipolar::SelectionKind>()
+        .map_err(errors::descriptor)?
+        .rule(tolerance.unwrap_or(alpha / (4.0 * angles.max(1) as f64)));
+    let tangent: TangentMethod = tangent.parse().map_err(errors::descriptor)?;
     Ok(DescriptorOptions {
         levels,
         max_level,
@@ -56,7 +48,7 @@ fn options(
 }
 
 /// Labelled landmark positions given by the caller: a path (lm3 / JSON, read by
-/// `landmarks::io::read_landmarks`) or a dict `{label: (x, y, z)}`.
+/// `mesh_io::read_landmark_file`) or a dict `{label: (x, y, z)}`.
 fn given_landmarks(obj: &Bound<'_, PyAny>) -> PyResult<Vec<(String, DVec3)>> {
     if let Ok(d) = obj.cast::<PyDict>() {
         let mut out = Vec::new();
@@ -70,7 +62,8 @@ fn given_landmarks(obj: &Bound<'_, PyAny>) -> PyResult<Vec<(String, DVec3)>> {
         return Ok(out);
     }
     let p = convert::path(obj, "landmarks")?;
-    landmarks::io::read_landmarks(&p).map_err(errors::landmarks)
+    let lm = mesh_io::read_landmark_file(&p, None).map_err(errors::io)?;
+    Ok(lm.labels.into_iter().zip(lm.points).collect())
 }
 
 fn snap(mesh: &TriMesh, p: DVec3, what: &str) -> PyResult<Source> {

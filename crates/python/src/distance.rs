@@ -21,6 +21,11 @@ enum Mode {
     Icp,
     Hausdorff,
 }
+meshcore::choice!(Mode, "mode", meshcore::UnknownChoice {
+    Keys = "keys",
+    Icp = "icp",
+    Hausdorff = "hausdorff",
+});
 
 /// How two descriptors are compared (the flags of ``bipolar distance``).
 ///
@@ -66,25 +71,8 @@ impl PyDistanceOptions {
         iterations: usize,
         global_search: bool,
     ) -> PyResult<Self> {
-        let m = match mode {
-            "keys" => Mode::Keys,
-            "icp" => Mode::Icp,
-            "hausdorff" => Mode::Hausdorff,
-            o => {
-                return Err(errors::input(format!(
-                    "unknown mode {o:?} (expected keys, icp or hausdorff)"
-                )))
-            }
-        };
-        let method = match solver {
-            "kabsch" => RotationMethod::Kabsch,
-            "horn" => RotationMethod::Horn,
-            o => {
-                return Err(errors::input(format!(
-                    "unknown solver {o:?} (expected kabsch or horn)"
-                )))
-            }
-        };
+        let m: Mode = mode.parse().map_err(|e| errors::input(format!("{e}")))?;
+        let method: RotationMethod = solver.parse().map_err(errors::shapedist)?;
         let robust_loss = match robust {
             None => None,
             Some("huber") => Some(RobustLoss::Huber(1.345)),
@@ -95,15 +83,7 @@ impl PyDistanceOptions {
                 )))
             }
         };
-        let icp_variant = match variant {
-            "point" => IcpVariant::PointToPoint,
-            "plane" => IcpVariant::PointToPlane,
-            o => {
-                return Err(errors::input(format!(
-                    "unknown ICP variant {o:?} (expected point or plane)"
-                )))
-            }
-        };
+        let icp_variant: IcpVariant = variant.parse().map_err(errors::shapedist)?;
         let keyed = KeyedOptions {
             method,
             robust: robust_loss,

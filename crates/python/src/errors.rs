@@ -88,17 +88,40 @@ pub fn mesh(e: meshcore::MeshError) -> PyErr {
     err(kind, e.to_string())
 }
 
-/// `mesh_io::IoError`.
-pub fn io(e: mesh_io::IoError) -> PyErr {
+/// The message of an error followed by its sources (`a: b: c`): the library errors keep the
+/// OS error as their source, not in their own text.
+pub fn chain(e: &dyn std::error::Error) -> String {
+    let mut s = e.to_string();
+    let mut cur = e.source();
+    while let Some(c) = cur {
+        let t = c.to_string();
+        if !s.ends_with(&t) {
+            s.push_str(": ");
+            s.push_str(&t);
+        }
+        cur = c.source();
+    }
+    s
+}
+
+fn io_kind(e: &mesh_io::IoError) -> Kind {
     use mesh_io::IoError as E;
-    let kind = match e {
+    match e {
         E::Io { .. } => Kind::File,
         E::Malformed { .. } | E::Unsupported { .. } | E::UnknownFormat { .. } | E::Mesh { .. } => {
             Kind::Format
         }
-        E::InvalidInput { .. } => Kind::Input,
-    };
-    err(kind, e.to_string())
+        E::InvalidInput { .. } | E::UnknownChoice(_) => Kind::Input,
+    }
+}
+
+fn io_kind_err(e: &mesh_io::IoError, message: String) -> PyErr {
+    err(io_kind(e), message)
+}
+
+/// `mesh_io::IoError`.
+pub fn io(e: mesh_io::IoError) -> PyErr {
+    err(io_kind(&e), chain(&e))
 }
 
 fn geodesic_kind(e: &geodesic::GeodesicError) -> Kind {
@@ -110,7 +133,7 @@ fn geodesic_kind(e: &geodesic::GeodesicError) -> Kind {
         | E::SourceOutOfRange { .. } => Kind::Index,
         E::Mesh(_)
         | E::NoSource
-        | E::UnknownMethod(_)
+        | E::UnknownChoice(_)
         | E::InvalidCutoff(_)
         | E::InvalidDirection(_)
         | E::InvalidLength(_) => Kind::Input,
@@ -133,18 +156,11 @@ pub fn descriptor(e: bipolar::BipolarError) -> PyErr {
         E::Geodesic(g) => geodesic_kind(g),
         E::NoIntersections(_) => Kind::NoPoints,
         E::Spline(_) => Kind::Computation,
-        // The descriptor files' errors carry the OS failure in the message ("cannot read: ...",
-        // "cannot write: ..."); everything else is a content problem.
-        E::Io { message, .. } => {
-            if message.starts_with("cannot read") || message.starts_with("cannot write") {
-                Kind::File
-            } else {
-                Kind::Format
-            }
-        }
+        E::Io { .. } => Kind::File,
+        E::File { .. } => Kind::Format,
         _ => Kind::Input,
     };
-    err(kind, e.to_string())
+    err(kind, chain(&e))
 }
 
 /// `shapedist::ShapeDistError` (every variant is about the input sets or options).
@@ -159,8 +175,11 @@ pub fn landmarks(e: landmarks::LandmarkError) -> PyErr {
         E::NotFound { .. } => Kind::NotFound,
         E::Mesh(m) => return mesh(m.clone()),
         E::Io { .. } => Kind::File,
-        E::Parse { .. } => Kind::Format,
-        E::InvalidModel(_) | E::InvalidTraining(_) | E::InvalidOption(_) => Kind::Input,
+        E::File(f) => return io_kind_err(f, chain(&e)),
+        E::MissingLandmark { .. } => Kind::Format,
+        E::InvalidModel(_) | E::InvalidTraining(_) | E::InvalidOption(_) | E::UnknownChoice(_) => {
+            Kind::Input
+        }
     };
-    err(kind, e.to_string())
+    err(kind, chain(&e))
 }

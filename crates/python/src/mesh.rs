@@ -81,13 +81,7 @@ pub fn mesh_arg<'py>(obj: &Bound<'py, PyAny>) -> PyResult<MeshArg<'py>> {
 }
 
 fn scalar_type(name: &str) -> PyResult<ScalarType> {
-    match name {
-        "f32" | "float32" | "float" => Ok(ScalarType::F32),
-        "f64" | "float64" | "double" => Ok(ScalarType::F64),
-        o => Err(errors::input(format!(
-            "unknown scalar storage type {o:?} (expected float32 or float64)"
-        ))),
-    }
+    name.parse().map_err(errors::io)
 }
 
 /// A format name (`"ply"`, `".obj"`, ...) parsed by mesh-io's own extension rule.
@@ -437,16 +431,7 @@ pub fn write_ply(
     encoding: &str,
 ) -> PyResult<()> {
     let p = convert::path(path, "path")?;
-    let encoding = match encoding {
-        "ascii" => PlyEncoding::Ascii,
-        "binary_little_endian" | "binary_le" | "binary" => PlyEncoding::BinaryLittleEndian,
-        "binary_big_endian" | "binary_be" => PlyEncoding::BinaryBigEndian,
-        o => {
-            return Err(errors::input(format!(
-                "unknown PLY encoding {o:?} (expected ascii, binary_little_endian or binary_big_endian)"
-            )))
-        }
-    };
+    let encoding: PlyEncoding = encoding.parse().map_err(errors::io)?;
     let m = mesh.get();
     let opts = PlyWriteOptions {
         encoding,
@@ -493,10 +478,12 @@ pub fn read_landmarks<'py>(
     path: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let p = convert::path(path, "path")?;
-    let pts = landmarks::io::read_landmarks(&p).map_err(errors::landmarks)?;
+    let lm = mesh_io::read_landmark_file(&p, None).map_err(errors::io)?;
     labelled(
         py,
-        pts.into_iter()
+        lm.labels
+            .into_iter()
+            .zip(lm.points)
             .map(|(l, q)| (l, q.to_array().to_vec()))
             .collect(),
     )
@@ -510,9 +497,10 @@ pub fn read_ict_landmarks<'py>(
     path: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let p = convert::path(path, "path")?;
-    let faces = landmarks::io::read_ict_landmarks(&p).map_err(errors::landmarks)?;
+    let faces = mesh_io::read_ict_landmarks(&p).map_err(errors::io)?;
     let out = PyDict::new(py);
-    for (face, pts) in faces {
+    for (face, lm) in faces {
+        let pts = landmarks::io::select_five(&lm, &face).map_err(errors::landmarks)?;
         let items = landmarks::LandmarkName::ALL
             .iter()
             .zip(pts)

@@ -63,4 +63,7 @@ pub enum ShapeDistError {
     /// Two matrices of different sizes, or a matrix input with fewer than one set.
     #[error("invalid option: {0}")]
     InvalidOption(String),
+    /// An option name that is none of the valid names (they are listed).
+    #[error(transparent)]
+    UnknownChoice(#[from] meshcore::UnknownChoice),
 }

@@ -201,6 +201,10 @@ pub enum IcpVariant {
     /// (linearised rotation per iteration); converges in far fewer iterations on surfaces.
     PointToPlane,
 }
+meshcore::choice!(IcpVariant, "ICP variant", ShapeDistError {
+    PointToPoint = "point" | "point-to-point",
+    PointToPlane = "plane" | "point-to-plane",
+});
 
 /// Options of one ICP run.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

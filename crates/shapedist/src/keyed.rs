@@ -18,6 +18,10 @@ pub enum RotationMethod {
     /// Horn's unit quaternion (largest eigenvector of a 4x4 symmetric matrix).
     Horn,
 }
+meshcore::choice!(RotationMethod, "rotation solver", ShapeDistError {
+    Kabsch = "kabsch",
+    Horn = "horn",
+});
 
 /// Robust loss for iteratively reweighted least squares on the pair residuals.
 ///

@@ -331,3 +331,18 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn option_names_round_trip_and_bad_names_list_the_choices() {
+    use shapedist::{IcpVariant, RotationMethod, ShapeDistError};
+    meshcore::choice::check_choice::<RotationMethod>("svd").unwrap();
+    meshcore::choice::check_choice::<IcpVariant>("normal").unwrap();
+    assert_eq!(
+        "point-to-plane".parse::<IcpVariant>().unwrap(),
+        IcpVariant::PointToPlane
+    );
+    match "svd".parse::<RotationMethod>() {
+        Err(ShapeDistError::UnknownChoice(e)) => assert_eq!(e.expected, ["kabsch", "horn"]),
+        other => panic!("{other:?}"),
+    }
+}

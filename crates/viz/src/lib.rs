@@ -53,8 +53,10 @@ pub enum VizError {
     #[error("unsupported picture format for {0} (use .svg or .png)")]
     UnsupportedFormat(PathBuf),
     /// Writing the file failed.
-    #[error("cannot write {path}: {source}")]
+    #[error("cannot {action} {}", path.display())]
     Io {
+        /// What was being done (`"write"`).
+        action: &'static str,
         /// The file.
         path: PathBuf,
         /// The underlying error.
@@ -81,6 +83,9 @@ pub enum VizError {
     /// Another invalid argument.
     #[error("invalid argument: {0}")]
     InvalidArgument(String),
+    /// An option name that is none of the valid names (they are listed).
+    #[error(transparent)]
+    UnknownChoice(#[from] meshcore::UnknownChoice),
 }
 
 /// Picture formats chosen from the file extension.
@@ -91,6 +96,10 @@ pub enum Format {
     /// `.png`
     Png,
 }
+meshcore::choice!(Format, "picture format", VizError {
+    Svg = "svg",
+    Png = "png",
+});
 
 impl Format {
     /// Format of a path by its (case-insensitive) extension.
@@ -101,15 +110,16 @@ impl Format {
             .map(|e| e.to_ascii_lowercase())
             .as_deref()
         {
-            Some("svg") => Ok(Format::Svg),
-            Some("png") => Ok(Format::Png),
-            _ => Err(VizError::UnsupportedFormat(path.to_path_buf())),
+            Some(ext) => <Format as meshcore::Choice>::from_name(ext)
+                .map_err(|_| VizError::UnsupportedFormat(path.to_path_buf())),
+            None => Err(VizError::UnsupportedFormat(path.to_path_buf())),
         }
     }
 }
 
 pub(crate) fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), VizError> {
     std::fs::write(path, bytes).map_err(|source| VizError::Io {
+        action: "write",
         path: path.to_path_buf(),
         source,
     })

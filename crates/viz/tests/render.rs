@@ -288,3 +288,12 @@ fn write_sample_pictures() {
     let svg = std::fs::read_to_string("/tmp/viz-sphere.svg").unwrap();
     std::fs::write("/tmp/viz-sphere-svg.png", viz::svg_to_png(&svg).unwrap()).unwrap();
 }
+
+#[test]
+fn picture_format_names_round_trip() {
+    meshcore::choice::check_choice::<viz::Format>("jpg").unwrap();
+    assert!(matches!(
+        "jpg".parse::<viz::Format>(),
+        Err(viz::VizError::UnknownChoice(_))
+    ));
+}

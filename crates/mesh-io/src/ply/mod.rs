@@ -25,6 +25,11 @@ pub enum PlyEncoding {
     /// Binary, big endian.
     BinaryBigEndian,
 }
+meshcore::choice!(PlyEncoding, "PLY encoding", crate::IoError {
+    Ascii = "ascii",
+    BinaryLittleEndian = "binary_little_endian" | "binary_le" | "binary",
+    BinaryBigEndian = "binary_big_endian" | "binary_be",
+});
 
 /// What [`crate::write_ply`] writes besides positions (always `double x y z`) and faces
 /// (`list uchar int vertex_indices`).
