@@ -21,7 +21,7 @@ use bipolar::{
 };
 use glam::DVec3;
 use indicatif::{ProgressBar, ProgressStyle};
-use meshcore::{FaceLocator, Topology, TriMesh};
+use meshcore::{FaceLocator, TriMesh};
 use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -281,7 +281,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             .map(|r| solver.distances(&[*r], &geodesic::SolveOptions::default()))
             .collect::<Result<Vec<_>, _>>()?;
         geodesic_ms.push((sm.name.clone(), tg.elapsed().as_secs_f64() * 1e3));
-        let topo = Topology::new(&sm.mesh);
+        let surface = bipolar::Surface::new(sm.mesh.clone());
         for &n in &LEVELS {
             let max_level = 2 * n - 1;
             for &(rule, rname) in &rules {
@@ -298,11 +298,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                         ..DescriptorOptions::default()
                     };
                     let t0 = Instant::now();
-                    let d = bipolar::describe_fields_with_refs(
-                        &sm.mesh,
-                        &topo,
-                        &fields,
-                        Some(&sm.refs),
+                    let d = bipolar::describe(
+                        &surface,
+                        bipolar::Fields::Precomputed {
+                            fields: &fields,
+                            references: Some(&sm.refs),
+                        },
                         &opts,
                     )?;
                     let ms = t0.elapsed().as_secs_f64() * 1e3;
@@ -431,7 +432,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let mut renders = Vec::new();
     {
         let sm = &meshes[1];
-        let topo = Topology::new(&sm.mesh);
+        let surface = bipolar::Surface::new(sm.mesh.clone());
         let solver = geodesic::new_solver(&sm.mesh, geodesic::Method::Exact)
             .or_else(|_| geodesic::new_solver(&sm.mesh, geodesic::Method::Dijkstra))?;
         let fields = sm
@@ -443,7 +444,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let step = std::f64::consts::FRAC_PI_2 / n as f64;
         let mut polylines = Vec::new();
         for (fi, color) in [(0usize, [200u8, 60, 40]), (1, [40, 90, 200])] {
-            let lv = levelcurves::isolines_uniform(&sm.mesh, &topo, &fields[fi], step, 2 * n - 1)?;
+            let lv = levelcurves::isolines_uniform(
+                surface.mesh(),
+                surface.topology(),
+                &fields[fi],
+                step,
+                2 * n - 1,
+            )?;
             for pieces in lv {
                 for iso in pieces {
                     polylines.push(viz::Polyline {
@@ -467,11 +474,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 tangent: m,
                 ..DescriptorOptions::default()
             };
-            let d = bipolar::describe_fields_with_refs(
-                &sm.mesh,
-                &topo,
-                &fields,
-                Some(&sm.refs),
+            let d = bipolar::describe(
+                &surface,
+                bipolar::Fields::Precomputed {
+                    fields: &fields,
+                    references: Some(&sm.refs),
+                },
                 &opts,
             )?;
             let mut points: Vec<viz::Marker> = truth

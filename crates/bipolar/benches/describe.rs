@@ -5,11 +5,9 @@
 // criterion_group! generates an undocumented function.
 #![allow(missing_docs)]
 
-use bipolar::{
-    describe_fields_with_refs, DescriptorOptions, LevelSpec, SelectionRule, Source, TangentMethod,
-};
+use bipolar::{DescriptorOptions, LevelSpec, SelectionRule, Source, TangentMethod};
 use criterion::{criterion_group, criterion_main, Criterion};
-use meshcore::{Topology, TriMesh};
+use meshcore::{Surface, TriMesh};
 use std::path::PathBuf;
 
 fn shared_dir() -> PathBuf {
@@ -62,7 +60,7 @@ fn bench(c: &mut Criterion) {
         30,
     ));
     for (name, mesh, refs, n) in &cases {
-        let topo = Topology::new(mesh);
+        let surface = Surface::new(mesh.clone());
         let (f, solver) = fields(mesh, refs);
         eprintln!(
             "{name}: {} vertices, fields from the {solver} solver",
@@ -111,14 +109,32 @@ fn bench(c: &mut Criterion) {
                 tangent,
                 ..DescriptorOptions::default()
             };
-            let d = describe_fields_with_refs(mesh, &topo, &f, Some(refs), &opts).unwrap();
+            let d = bipolar::describe(
+                &surface,
+                bipolar::Fields::Precomputed {
+                    fields: &f,
+                    references: Some(refs),
+                },
+                &opts,
+            )
+            .unwrap();
             eprintln!(
                 "  {label}: {} points from {} intersections",
                 d.len(),
                 d.stats.intersections
             );
             g.bench_function(label, |b| {
-                b.iter(|| describe_fields_with_refs(mesh, &topo, &f, Some(refs), &opts).unwrap())
+                b.iter(|| {
+                    bipolar::describe(
+                        &surface,
+                        bipolar::Fields::Precomputed {
+                            fields: &f,
+                            references: Some(refs),
+                        },
+                        &opts,
+                    )
+                    .unwrap()
+                })
             });
         }
         g.finish();
@@ -135,6 +151,7 @@ fn bench_whole(c: &mut Criterion) {
     };
     let mut g = c.benchmark_group("whole_describe_face_exact");
     g.sample_size(10);
+    let surface = Surface::new(mesh.clone());
     for (label, max_level) in [("region_30_of_30", Some(30)), ("whole_face", None)] {
         let opts = DescriptorOptions {
             levels: LevelSpec::Count(30),
@@ -142,15 +159,41 @@ fn bench_whole(c: &mut Criterion) {
             ..DescriptorOptions::default()
         };
         let solver = geodesic::new_solver(&mesh, geodesic::Method::Exact).unwrap();
-        let d = bipolar::describe(&mesh, solver.as_ref(), &refs, &opts).unwrap();
+        let d = bipolar::describe(
+            &surface,
+            bipolar::Fields::Solve {
+                solver: solver.as_ref(),
+                references: &refs,
+            },
+            &opts,
+        )
+        .unwrap();
         eprintln!("  {label}: {} points", d.len());
         g.bench_function(format!("{label}_solver_prepared"), |b| {
-            b.iter(|| bipolar::describe(&mesh, solver.as_ref(), &refs, &opts).unwrap())
+            b.iter(|| {
+                bipolar::describe(
+                    &surface,
+                    bipolar::Fields::Solve {
+                        solver: solver.as_ref(),
+                        references: &refs,
+                    },
+                    &opts,
+                )
+                .unwrap()
+            })
         });
         g.bench_function(format!("{label}_with_solver_setup"), |b| {
             b.iter(|| {
                 let solver = geodesic::new_solver(&mesh, geodesic::Method::Exact).unwrap();
-                bipolar::describe(&mesh, solver.as_ref(), &refs, &opts).unwrap()
+                bipolar::describe(
+                    &surface,
+                    bipolar::Fields::Solve {
+                        solver: solver.as_ref(),
+                        references: &refs,
+                    },
+                    &opts,
+                )
+                .unwrap()
             })
         });
     }

@@ -7,7 +7,7 @@ use crate::{
 use geodesic::{GeodesicSolver, SolveOptions, Source};
 use glam::DVec3;
 use levelcurves::face_gradient;
-use meshcore::{Topology, TriMesh};
+use meshcore::{Surface, Topology, TriMesh};
 
 mod grid;
 mod isoangle;
@@ -17,14 +17,58 @@ mod strip;
 use spline::SplineSet;
 use strip::Strip;
 
-/// Builds the descriptor of `mesh` for the reference points `refs` (two or more; every pair
-/// `a < b` contributes points whose keys carry the pair), computing one distance field per
-/// reference with `solver`.
+/// Where the distance fields of [`describe`] come from: one field per reference point (two to
+/// 256; every pair `a < b` contributes points whose keys carry the pair).
+#[derive(Debug, Clone, Copy)]
+pub enum Fields<'a> {
+    /// Solved by [`describe`] with `solver` (prepared for the surface's mesh). With a region
+    /// limit (`max_level`) each field is cut off just past the region, which leaves every value
+    /// the descriptor reads unchanged.
+    Solve {
+        /// The solver.
+        solver: &'a dyn GeodesicSolver,
+        /// The reference points.
+        references: &'a [Source],
+    },
+    /// Precomputed fields (one per reference point, one value per vertex, `+inf` where
+    /// unreachable). With the reference points, `d(r, q)` and the reference positions come from
+    /// them, and they are checked for coincidence and components; without them, `d(r, q)` is
+    /// estimated as `min_v (U_0(v) + U_1(v))` and each reference position as the vertex where
+    /// its field is smallest.
+    Precomputed {
+        /// The fields.
+        fields: &'a [Vec<f64>],
+        /// The reference points, when known.
+        references: Option<&'a [Source]>,
+    },
+}
+
+/// Builds the descriptor of `surface` from the distance fields of `fields` (the one entry
+/// point: a mesh and its topology come together in [`Surface`], so they cannot disagree).
 ///
-/// The step is `d(refs[0], refs[1]) / N` for [`LevelSpec::Count`]. Errors: see
-/// [`BipolarError`] (different components, coincident references, no points, ...).
+/// The step is `d(r_0, r_1) / N` for [`LevelSpec::Count`]. Errors: see [`BipolarError`]
+/// (fields or solver of the wrong size, different components, coincident references, no
+/// points, ...).
 pub fn describe(
+    surface: &Surface,
+    fields: Fields<'_>,
+    opts: &DescriptorOptions,
+) -> Result<Descriptor, BipolarError> {
+    let (mesh, topo) = (surface.mesh(), surface.topology());
+    match fields {
+        Fields::Solve { solver, references } => {
+            solve_and_describe(mesh, topo, solver, references, opts)
+        }
+        Fields::Precomputed { fields, references } => {
+            describe_fields(mesh, topo, fields, references, opts)
+        }
+    }
+}
+
+/// [`Fields::Solve`]: one field per reference with `solver`, then [`describe_fields`].
+fn solve_and_describe(
     mesh: &TriMesh,
+    topo: &Topology,
     solver: &dyn GeodesicSolver,
     refs: &[Source],
     opts: &DescriptorOptions,
@@ -39,13 +83,12 @@ pub fn describe(
             mesh.n_vertices()
         )));
     }
-    let topo = Topology::new(mesh);
-    check_references(mesh, &topo, refs)?;
+    check_references(mesh, topo, refs)?;
     let fields = match opts.max_level {
-        Some(m) if m > 0 => region_fields(mesh, &topo, solver, refs, opts.levels, m)?,
+        Some(m) if m > 0 => region_fields(mesh, topo, solver, refs, opts.levels, m)?,
         _ => solve_all(solver, refs, &vec![None; refs.len()])?,
     };
-    describe_fields_with_refs(mesh, &topo, &fields, Some(refs), opts)
+    describe_fields(mesh, topo, &fields, Some(refs), opts)
 }
 
 /// One field per reference, solved in parallel (rayon; each field is independent, so the result
@@ -84,7 +127,7 @@ fn region_fields(
     max_level: u32,
 ) -> Result<Vec<Vec<f64>>, BipolarError> {
     let margin = topo
-        .edges
+        .edges()
         .iter()
         .map(|e| (mesh.position(e.v[0]) - mesh.position(e.v[1])).length())
         .fold(0.0f64, f64::max)
@@ -93,8 +136,8 @@ fn region_fields(
         .iter()
         .map(|r| source_position(mesh, r))
         .collect::<Result<Vec<_>, _>>()?;
-    let mut comp_size = vec![0usize; topo.n_components];
-    for &c in &topo.vertex_component {
+    let mut comp_size = vec![0usize; topo.n_components()];
+    for &c in topo.vertex_component() {
         comp_size[c as usize] += 1;
     }
     // Region radius L = max_level * step; for `Count` the step needs d(r0, r1), first guessed
@@ -124,7 +167,7 @@ fn region_fields(
     for a in 0..refs.len() {
         loop {
             let f = &fields[a];
-            let comp = topo.vertex_component[source_vertex(mesh, &refs[a]) as usize] as usize;
+            let comp = topo.vertex_component()[source_vertex(mesh, &refs[a]) as usize] as usize;
             let whole = f.iter().filter(|x| x.is_finite()).count() >= comp_size[comp];
             let mut needed = 0.0f64;
             let mut missing = false;
@@ -155,24 +198,8 @@ fn region_fields(
     Ok(fields)
 }
 
-/// Builds the descriptor from precomputed distance fields (one per reference point, `+inf` for
-/// unreachable vertices).
-///
-/// Without the reference points, `d(r, q)` (for [`LevelSpec::Count`]) is estimated as
-/// `min_v (U_0(v) + U_1(v))` and the reference positions as the vertices where each field is
-/// smallest.
-pub fn describe_fields(
-    mesh: &TriMesh,
-    topo: &Topology,
-    fields: &[Vec<f64>],
-    opts: &DescriptorOptions,
-) -> Result<Descriptor, BipolarError> {
-    describe_fields_with_refs(mesh, topo, fields, None, opts)
-}
-
-/// [`describe_fields`] with the reference points known (used for `d(r, q)` and the reference
-/// positions, and checked for coincidence / components).
-pub fn describe_fields_with_refs(
+/// [`Fields::Precomputed`] (and the second half of [`Fields::Solve`]).
+fn describe_fields(
     mesh: &TriMesh,
     topo: &Topology,
     fields: &[Vec<f64>],
@@ -204,11 +231,6 @@ pub fn describe_fields_with_refs(
         }
     }
     check_options(opts, n)?;
-    if topo.face_edges.len() != mesh.n_faces() {
-        return Err(BipolarError::InvalidOption(
-            "topology was built for another mesh".into(),
-        ));
-    }
     let diag = mesh.bbox().diagonal();
 
     // Reference positions and pairwise distances.
@@ -475,8 +497,8 @@ fn check_references(mesh: &TriMesh, topo: &Topology, refs: &[Source]) -> Result<
     }
     for a in 0..refs.len() {
         for b in a + 1..refs.len() {
-            let ca = topo.vertex_component[source_vertex(mesh, &refs[a]) as usize];
-            let cb = topo.vertex_component[source_vertex(mesh, &refs[b]) as usize];
+            let ca = topo.vertex_component()[source_vertex(mesh, &refs[a]) as usize];
+            let cb = topo.vertex_component()[source_vertex(mesh, &refs[b]) as usize];
             if ca != cb {
                 return Err(BipolarError::DifferentComponents { a, b });
             }

@@ -6,8 +6,9 @@
 //! the set of points whose opening falls on the levels `alpha k / K`, each with a [`Key`] that
 //! puts descriptors of different surfaces in correspondence.
 //!
-//! * [`describe`] (mesh + geodesic solver + reference points) and [`describe_fields`] /
-//!   [`describe_fields_with_refs`] (precomputed fields) build a [`Descriptor`].
+//! * [`describe`] builds a [`Descriptor`] of a [`Surface`] (a mesh with its topology) from
+//!   [`Fields`]: a geodesic solver and reference points ([`Fields::Solve`]) or precomputed
+//!   fields ([`Fields::Precomputed`]).
 //! * [`DescriptorOptions`]: step ([`LevelSpec`]), region (`max_level`, `vertex_mask`), `K`,
 //!   `alpha`, the selection rule ([`SelectionRule::Filter`], [`SelectionRule::IsoAngle`],
 //!   [`SelectionRule::All`]) and the tangent method ([`TangentMethod::Gradient`] = M0 exact
@@ -32,10 +33,11 @@ pub mod polar;
 pub mod synthetic;
 mod types;
 
-pub use build::{describe, describe_fields, describe_fields_with_refs};
+pub use build::{describe, Fields};
 pub use error::BipolarError;
 pub use geodesic::Source;
 pub use key::Key;
+pub use meshcore::Surface;
 pub use polar::{describe_polar, PolarDescriptor, PolarKey, PolarOptions, PolarPoint};
 pub use types::{
     Descriptor, DescriptorOptions, DescriptorPoint, DescriptorStats, LevelSpec, SelectionKind,

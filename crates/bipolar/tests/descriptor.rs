@@ -3,11 +3,11 @@
 
 use bipolar::synthetic::{euclidean_field, great_circle_field, grid_plane, icosphere};
 use bipolar::{
-    describe, describe_fields, describe_fields_with_refs, BipolarError, Descriptor,
-    DescriptorOptions, LevelSpec, SelectionRule, Source, TangentMethod,
+    describe, BipolarError, Descriptor, DescriptorOptions, Fields, LevelSpec, SelectionRule,
+    Source, TangentMethod,
 };
 use glam::{DAffine3, DQuat, DVec3};
-use meshcore::{Topology, TriMesh};
+use meshcore::{Surface, TriMesh};
 use proptest::prelude::*;
 
 fn opts(rule: SelectionRule, tangent: TangentMethod, levels: LevelSpec) -> DescriptorOptions {
@@ -24,10 +24,10 @@ fn opts(rule: SelectionRule, tangent: TangentMethod, levels: LevelSpec) -> Descr
 fn plane_setup(
     n: usize,
     jitter: f64,
-) -> (TriMesh, Topology, Vec<Vec<f64>>, Vec<Source>, [DVec3; 2]) {
+) -> (TriMesh, Surface, Vec<Vec<f64>>, Vec<Source>, [DVec3; 2]) {
     let h = 3.0 / n as f64;
     let mesh = grid_plane(n, h, -1.5, jitter, 5, |_| false);
-    let topo = Topology::new(&mesh);
+    let surface = Surface::new(mesh.clone());
     let near = |p: DVec3| {
         (0..mesh.n_vertices() as u32)
             .min_by(|&a, &b| {
@@ -45,7 +45,7 @@ fn plane_setup(
     let fields = vec![euclidean_field(&mesh, r), euclidean_field(&mesh, q)];
     (
         mesh,
-        topo,
+        surface,
         fields,
         vec![Source::Vertex(vr), Source::Vertex(vq)],
         [r, q],
@@ -61,7 +61,7 @@ fn law_of_cosines(p: DVec3, r: DVec3, q: DVec3) -> f64 {
 fn linear_fields_give_exact_angles_and_positions() {
     // PL interpolation of affine fields is exact: cos must match to rounding.
     let mesh = grid_plane(30, 0.1, -1.5, 0.3, 9, |_| false);
-    let topo = Topology::new(&mesh);
+    let surface = Surface::new(mesh.clone());
     let e1 = DVec3::new(1.0, 0.0, 0.0);
     let e2 = DVec3::new(0.6, 0.8, 0.0);
     let fa: Vec<f64> = mesh.positions().iter().map(|p| p.dot(e1) + 2.0).collect();
@@ -71,7 +71,15 @@ fn linear_fields_give_exact_angles_and_positions() {
         TangentMethod::Gradient,
         LevelSpec::Step(0.25),
     );
-    let d = describe_fields(&mesh, &topo, &[fa, fb], &o).unwrap();
+    let d = describe(
+        &surface,
+        Fields::Precomputed {
+            fields: &[fa, fb],
+            references: None,
+        },
+        &o,
+    )
+    .unwrap();
     assert!(d.len() > 100);
     for p in &d.points {
         assert!((p.cos - e1.dot(e2)).abs() < 1e-12, "cos {}", p.cos);
@@ -94,14 +102,22 @@ fn linear_fields_give_exact_angles_and_positions() {
 fn plane_euclidean_fields_follow_the_law_of_cosines() {
     let mut mean_err = Vec::new();
     for n in [30, 60, 120] {
-        let (mesh, topo, fields, refs, [r, q]) = plane_setup(n, 0.3);
+        let (_, surface, fields, refs, [r, q]) = plane_setup(n, 0.3);
         let h = 3.0 / n as f64;
         let o = opts(
             SelectionRule::All,
             TangentMethod::Gradient,
             LevelSpec::Count(5),
         );
-        let d = describe_fields_with_refs(&mesh, &topo, &fields, Some(&refs), &o).unwrap();
+        let d = describe(
+            &surface,
+            Fields::Precomputed {
+                fields: &fields,
+                references: Some(&refs),
+            },
+            &o,
+        )
+        .unwrap();
         let dist = (r - q).length();
         assert!((d.step - dist / 5.0).abs() < 1e-12);
         assert!((d.reference_distance - dist).abs() < 1e-12);
@@ -130,12 +146,13 @@ fn plane_euclidean_fields_follow_the_law_of_cosines() {
 
 #[test]
 fn filter_rule_keeps_only_points_near_angle_levels() {
-    let (mesh, topo, fields, refs, _) = plane_setup(60, 0.3);
-    let all = describe_fields_with_refs(
-        &mesh,
-        &topo,
-        &fields,
-        Some(&refs),
+    let (_, surface, fields, refs, _) = plane_setup(60, 0.3);
+    let all = describe(
+        &surface,
+        Fields::Precomputed {
+            fields: &fields,
+            references: Some(&refs),
+        },
         &opts(
             SelectionRule::All,
             TangentMethod::Gradient,
@@ -149,7 +166,15 @@ fn filter_rule_keeps_only_points_near_angle_levels() {
         TangentMethod::Gradient,
         LevelSpec::Count(5),
     );
-    let d = describe_fields_with_refs(&mesh, &topo, &fields, Some(&refs), &o).unwrap();
+    let d = describe(
+        &surface,
+        Fields::Precomputed {
+            fields: &fields,
+            references: Some(&refs),
+        },
+        &o,
+    )
+    .unwrap();
     assert!(!d.is_empty() && d.len() < all.len());
     for p in &d.points {
         let c = p.cos.abs();
@@ -176,7 +201,7 @@ fn filter_rule_keeps_only_points_near_angle_levels() {
 
 #[test]
 fn isoangle_points_sit_on_angle_levels() {
-    let (mesh, topo, fields, refs, [r, q]) = plane_setup(90, 0.3);
+    let (_, surface, fields, refs, [r, q]) = plane_setup(90, 0.3);
     let h = 3.0 / 90.0;
     for tangent in [
         TangentMethod::Gradient,
@@ -187,7 +212,15 @@ fn isoangle_points_sit_on_angle_levels() {
             max_level: Some(5),
             ..opts(SelectionRule::IsoAngle, tangent, LevelSpec::Count(5))
         };
-        let d = describe_fields_with_refs(&mesh, &topo, &fields, Some(&refs), &o).unwrap();
+        let d = describe(
+            &surface,
+            Fields::Precomputed {
+                fields: &fields,
+                references: Some(&refs),
+            },
+            &o,
+        )
+        .unwrap();
         assert!(d.len() > 40, "{tangent:?}: {}", d.len());
         let mut errs = Vec::new();
         for p in &d.points {
@@ -207,7 +240,7 @@ fn isoangle_points_sit_on_angle_levels() {
 #[test]
 fn sphere_matches_the_spherical_law_of_cosines() {
     let mesh = icosphere(4);
-    let topo = Topology::new(&mesh);
+    let surface = Surface::new(mesh.clone());
     // Two orthogonal poles, at vertices of the icosphere: (0, 1, t) and (0, -1, t) are not
     // orthogonal, so use the directions of two vertices and exact great-circle fields.
     let vr = 0u32;
@@ -242,7 +275,15 @@ fn sphere_matches_the_spherical_law_of_cosines() {
             max_level: Some(8),
             ..opts(SelectionRule::All, tangent, LevelSpec::Count(6))
         };
-        let d = describe_fields_with_refs(&mesh, &topo, &fields, Some(&refs), &o).unwrap();
+        let d = describe(
+            &surface,
+            Fields::Precomputed {
+                fields: &fields,
+                references: Some(&refs),
+            },
+            &o,
+        )
+        .unwrap();
         assert!(d.len() > 50);
         let mut errs: Vec<f64> = d
             .points
@@ -321,7 +362,7 @@ proptest! {
     #[test]
     fn rigid_motion_invariance(seed in 0u64..10_000, iso in prop::bool::ANY) {
         let mesh = icosphere(3);
-        let topo = Topology::new(&mesh);
+        let surface = Surface::new(mesh.clone());
         let r = mesh.position(3);
         let q = mesh.position(40);
         let fields = vec![great_circle_field(&mesh, r, 1.0), great_circle_field(&mesh, q, 1.0)];
@@ -329,8 +370,8 @@ proptest! {
         let o = opts(rule, TangentMethod::Gradient, LevelSpec::Count(6));
         let t = random_motion(seed);
         let moved = mesh.transformed(&t);
-        let d1 = describe_fields(&mesh, &topo, &fields, &o).unwrap();
-        let d2 = describe_fields(&moved, &Topology::new(&moved), &fields, &o).unwrap();
+        let d1 = describe(&surface, Fields::Precomputed { fields: &fields, references: None }, &o).unwrap();
+        let d2 = describe(&Surface::new(moved.clone()), Fields::Precomputed { fields: &fields, references: None }, &o).unwrap();
         let m1 = sorted_by_key_then_mapped(&d1, &t);
         assert_same_up_to(&m1, &d2, &DAffine3::IDENTITY, 1e-9, 1e-9);
     }
@@ -339,18 +380,34 @@ proptest! {
 #[test]
 fn rigid_motion_invariance_of_strip_and_spline() {
     let mesh = icosphere(3);
-    let topo = Topology::new(&mesh);
+    let surface = Surface::new(mesh.clone());
     let fields = vec![
         great_circle_field(&mesh, mesh.position(3), 1.0),
         great_circle_field(&mesh, mesh.position(40), 1.0),
     ];
     let t = random_motion(77);
     let moved = mesh.transformed(&t);
-    let mtopo = Topology::new(&moved);
+    let moved_surface = Surface::new(moved.clone());
     for tangent in [TangentMethod::Strip, TangentMethod::Spline] {
         let o = opts(SelectionRule::All, tangent, LevelSpec::Count(6));
-        let d1 = describe_fields(&mesh, &topo, &fields, &o).unwrap();
-        let d2 = describe_fields(&moved, &mtopo, &fields, &o).unwrap();
+        let d1 = describe(
+            &surface,
+            Fields::Precomputed {
+                fields: &fields,
+                references: None,
+            },
+            &o,
+        )
+        .unwrap();
+        let d2 = describe(
+            &moved_surface,
+            Fields::Precomputed {
+                fields: &fields,
+                references: None,
+            },
+            &o,
+        )
+        .unwrap();
         let m1 = sorted_by_key_then_mapped(&d1, &t);
         assert_same_up_to(&m1, &d2, &DAffine3::IDENTITY, 1e-9, 1e-7);
     }
@@ -358,7 +415,7 @@ fn rigid_motion_invariance_of_strip_and_spline() {
 
 #[test]
 fn vertex_renumbering_does_not_change_the_descriptor() {
-    let (mesh, topo, fields, refs, _) = plane_setup(40, 0.3);
+    let (mesh, surface, fields, refs, _) = plane_setup(40, 0.3);
     let n = mesh.n_vertices();
     // A deterministic permutation and a rotation of each face's corner order, faces reversed.
     let perm: Vec<u32> = (0..n as u32).map(|v| (v * 7919 + 13) % n as u32).collect();
@@ -384,7 +441,7 @@ fn vertex_renumbering_does_not_change_the_descriptor() {
         })
         .collect();
     let m2 = TriMesh::new(pos, tris).unwrap();
-    let t2 = Topology::new(&m2);
+    let t2 = Surface::new(m2.clone());
     let mut f2 = vec![vec![0.0; n]; 2];
     for k in 0..2 {
         for v in 0..n {
@@ -400,8 +457,24 @@ fn vertex_renumbering_does_not_change_the_descriptor() {
         .collect();
     for rule in [SelectionRule::IsoAngle, SelectionRule::All] {
         let o = opts(rule, TangentMethod::Gradient, LevelSpec::Count(5));
-        let d1 = describe_fields_with_refs(&mesh, &topo, &fields, Some(&refs), &o).unwrap();
-        let d2 = describe_fields_with_refs(&m2, &t2, &f2, Some(&refs2), &o).unwrap();
+        let d1 = describe(
+            &surface,
+            Fields::Precomputed {
+                fields: &fields,
+                references: Some(&refs),
+            },
+            &o,
+        )
+        .unwrap();
+        let d2 = describe(
+            &t2,
+            Fields::Precomputed {
+                fields: &f2,
+                references: Some(&refs2),
+            },
+            &o,
+        )
+        .unwrap();
         assert_same_up_to(&d1, &d2, &DAffine3::IDENTITY, 1e-12, 1e-9);
     }
 }
@@ -410,8 +483,8 @@ fn vertex_renumbering_does_not_change_the_descriptor() {
 fn holes_split_curves_and_hold_no_points() {
     let hole = DVec3::new(0.0, 0.6, 0.0);
     let mesh = grid_plane(60, 0.05, -1.5, 0.3, 3, |c| (c - hole).length() < 0.3);
-    let topo = Topology::new(&mesh);
-    assert_eq!(topo.boundary_loops.len(), 2);
+    let surface = Surface::new(mesh.clone());
+    assert_eq!(surface.topology().boundary_loops().len(), 2);
     let r = DVec3::new(-0.5, 0.0, 0.0);
     let q = DVec3::new(0.5, 0.0, 0.0);
     // Euclidean fields (a stand-in: on a holed plane true geodesics bend around the hole).
@@ -423,7 +496,15 @@ fn holes_split_curves_and_hold_no_points() {
             TangentMethod::Strip,
         ] {
             let o = opts(rule, tangent, LevelSpec::Step(0.2));
-            let d = describe_fields(&mesh, &topo, &fields, &o).unwrap();
+            let d = describe(
+                &surface,
+                Fields::Precomputed {
+                    fields: &fields,
+                    references: None,
+                },
+                &o,
+            )
+            .unwrap();
             assert!(!d.is_empty());
             for p in &d.points {
                 assert!(
@@ -438,7 +519,7 @@ fn holes_split_curves_and_hold_no_points() {
 
 #[test]
 fn vertex_mask_limits_the_region() {
-    let (mesh, topo, fields, refs, _) = plane_setup(40, 0.2);
+    let (mesh, surface, fields, refs, _) = plane_setup(40, 0.2);
     let mask: Vec<bool> = mesh.positions().iter().map(|p| p.y >= -0.05).collect();
     let o = DescriptorOptions {
         vertex_mask: Some(mask),
@@ -448,16 +529,25 @@ fn vertex_mask_limits_the_region() {
             LevelSpec::Count(5),
         )
     };
-    let d = describe_fields_with_refs(&mesh, &topo, &fields, Some(&refs), &o).unwrap();
+    let d = describe(
+        &surface,
+        Fields::Precomputed {
+            fields: &fields,
+            references: Some(&refs),
+        },
+        &o,
+    )
+    .unwrap();
     assert!(d
         .points
         .iter()
         .all(|p| p.position.y >= -0.05 && p.key.side == 1 || p.position.y.abs() < 0.1));
-    let full = describe_fields_with_refs(
-        &mesh,
-        &topo,
-        &fields,
-        Some(&refs),
+    let full = describe(
+        &surface,
+        Fields::Precomputed {
+            fields: &fields,
+            references: Some(&refs),
+        },
         &opts(
             SelectionRule::All,
             TangentMethod::Gradient,
@@ -471,7 +561,7 @@ fn vertex_mask_limits_the_region() {
 #[test]
 fn more_than_two_references_give_every_pair() {
     let mesh = icosphere(3);
-    let topo = Topology::new(&mesh);
+    let surface = Surface::new(mesh.clone());
     let refs = [Source::Vertex(0), Source::Vertex(5), Source::Vertex(100)];
     let fields: Vec<Vec<f64>> = refs
         .iter()
@@ -480,11 +570,12 @@ fn more_than_two_references_give_every_pair() {
             _ => unreachable!(),
         })
         .collect();
-    let d = describe_fields_with_refs(
-        &mesh,
-        &topo,
-        &fields,
-        Some(&refs),
+    let d = describe(
+        &surface,
+        Fields::Precomputed {
+            fields: &fields,
+            references: Some(&refs),
+        },
         &DescriptorOptions::default(),
     )
     .unwrap();
@@ -504,7 +595,15 @@ fn describe_with_a_solver() {
         TangentMethod::Gradient,
         LevelSpec::Count(5),
     );
-    let d = describe(&mesh, solver.as_ref(), &refs, &o).unwrap();
+    let d = describe(
+        &Surface::new(mesh.clone()),
+        Fields::Solve {
+            solver: solver.as_ref(),
+            references: &refs,
+        },
+        &o,
+    )
+    .unwrap();
     assert!((d.reference_distance - 1.0).abs() < 1e-9);
     assert!(d.len() > 20);
     // Surface-point references work too.
@@ -513,20 +612,29 @@ fn describe_with_a_solver() {
         .unwrap()
         .0;
     let refs = [Source::Point(sp), Source::Vertex(15 * 31 + 20)];
-    let d = describe(&mesh, solver.as_ref(), &refs, &o).unwrap();
+    let d = describe(
+        &Surface::new(mesh.clone()),
+        Fields::Solve {
+            solver: solver.as_ref(),
+            references: &refs,
+        },
+        &o,
+    )
+    .unwrap();
     assert!((d.references[0] - DVec3::new(-0.47, 0.03, 0.0)).length() < 1e-12);
 }
 
 #[test]
 fn bad_input_gives_clear_errors() {
-    let (mesh, topo, fields, refs, _) = plane_setup(20, 0.0);
+    let (_, surface, fields, refs, _) = plane_setup(20, 0.0);
     let o = DescriptorOptions::default();
     // Coincident references.
-    let r = describe_fields_with_refs(
-        &mesh,
-        &topo,
-        &[fields[0].clone(), fields[0].clone()],
-        Some(&[refs[0], refs[0]]),
+    let r = describe(
+        &surface,
+        Fields::Precomputed {
+            fields: &[fields[0].clone(), fields[0].clone()],
+            references: Some(&[refs[0], refs[0]]),
+        },
         &o,
     );
     assert!(
@@ -539,7 +647,14 @@ fn bad_input_gives_clear_errors() {
     // NaN field.
     let mut bad = fields.clone();
     bad[1][7] = f64::NAN;
-    let r = describe_fields(&mesh, &topo, &bad, &o);
+    let r = describe(
+        &surface,
+        Fields::Precomputed {
+            fields: &bad,
+            references: None,
+        },
+        &o,
+    );
     assert!(matches!(
         r,
         Err(BipolarError::NonFiniteField {
@@ -549,11 +664,25 @@ fn bad_input_gives_clear_errors() {
         })
     ));
     // Wrong length.
-    let r = describe_fields(&mesh, &topo, &[fields[0].clone(), vec![0.0; 3]], &o);
+    let r = describe(
+        &surface,
+        Fields::Precomputed {
+            fields: &[fields[0].clone(), vec![0.0; 3]],
+            references: None,
+        },
+        &o,
+    );
     assert!(matches!(r, Err(BipolarError::FieldLength { field: 1, .. })));
     // One field.
     assert!(matches!(
-        describe_fields(&mesh, &topo, &fields[..1], &o),
+        describe(
+            &surface,
+            Fields::Precomputed {
+                fields: &fields[..1],
+                references: None
+            },
+            &o
+        ),
         Err(BipolarError::ReferenceCount(1))
     ));
     // Step too large: no level fits.
@@ -563,7 +692,14 @@ fn bad_input_gives_clear_errors() {
         LevelSpec::Step(100.0),
     );
     assert!(matches!(
-        describe_fields(&mesh, &topo, &fields, &big),
+        describe(
+            &surface,
+            Fields::Precomputed {
+                fields: &fields,
+                references: None
+            },
+            &big
+        ),
         Err(BipolarError::NoIntersections(_))
     ));
     // Invalid alpha.
@@ -572,7 +708,14 @@ fn bad_input_gives_clear_errors() {
         ..DescriptorOptions::default()
     };
     assert!(matches!(
-        describe_fields(&mesh, &topo, &fields, &a),
+        describe(
+            &surface,
+            Fields::Precomputed {
+                fields: &fields,
+                references: None
+            },
+            &a
+        ),
         Err(BipolarError::InvalidOption(_))
     ));
     // Different components: two disjoint grids.
@@ -588,9 +731,11 @@ fn bad_input_gives_clear_errors() {
     let two = TriMesh::new(p, t).unwrap();
     let solver = geodesic::new_solver(&two, geodesic::Method::Dijkstra).unwrap();
     let r = describe(
-        &two,
-        solver.as_ref(),
-        &[Source::Vertex(0), Source::Vertex(off + 3)],
+        &Surface::new(two.clone()),
+        Fields::Solve {
+            solver: solver.as_ref(),
+            references: &[Source::Vertex(0), Source::Vertex(off + 3)],
+        },
         &o,
     );
     assert!(
@@ -599,9 +744,11 @@ fn bad_input_gives_clear_errors() {
     );
     // Reference out of range.
     let r = describe(
-        &two,
-        solver.as_ref(),
-        &[Source::Vertex(0), Source::Vertex(10_000)],
+        &Surface::new(two.clone()),
+        Fields::Solve {
+            solver: solver.as_ref(),
+            references: &[Source::Vertex(0), Source::Vertex(10_000)],
+        },
         &o,
     );
     assert!(r.is_err());
@@ -609,12 +756,13 @@ fn bad_input_gives_clear_errors() {
 
 #[test]
 fn files_round_trip() {
-    let (mesh, topo, fields, refs, _) = plane_setup(30, 0.3);
-    let d = describe_fields_with_refs(
-        &mesh,
-        &topo,
-        &fields,
-        Some(&refs),
+    let (_, surface, fields, refs, _) = plane_setup(30, 0.3);
+    let d = describe(
+        &surface,
+        Fields::Precomputed {
+            fields: &fields,
+            references: Some(&refs),
+        },
         &DescriptorOptions::default(),
     )
     .unwrap();
@@ -706,7 +854,7 @@ fn a_region_limit_cuts_the_fields_off_without_changing_the_descriptor() {
             0.12,
         ),
     ] {
-        let topo = Topology::new(mesh);
+        let surface = Surface::new(mesh.clone());
         let sp = meshcore::FaceLocator::new(mesh).nearest(c).unwrap().0;
         let refs = [
             Source::Vertex(near(mesh, a)),
@@ -730,8 +878,24 @@ fn a_region_limit_cuts_the_fields_off_without_changing_the_descriptor() {
                     inner: inner.as_ref(),
                     cuts: std::sync::Mutex::new(Vec::new()),
                 };
-                let got = describe(mesh, &rec, &refs, &o).unwrap();
-                let want = describe_fields_with_refs(mesh, &topo, &full, Some(&refs), &o).unwrap();
+                let got = describe(
+                    &surface,
+                    Fields::Solve {
+                        solver: &rec,
+                        references: &refs,
+                    },
+                    &o,
+                )
+                .unwrap();
+                let want = describe(
+                    &surface,
+                    Fields::Precomputed {
+                        fields: &full,
+                        references: Some(&refs),
+                    },
+                    &o,
+                )
+                .unwrap();
                 let cuts = rec.cuts.into_inner().unwrap();
                 assert!(cuts.iter().all(|c| c.is_some()), "{cuts:?}");
                 assert!(cuts.len() >= 3);

@@ -113,7 +113,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let t0 = Instant::now();
     let solver = geodesic::new_solver(&mesh, method)
         .with_context(|| format!("preparing the {} geodesic solver", method.name()))?;
-    let d = bipolar::describe(&mesh, solver.as_ref(), &refs, &opts)?;
+    let surface = bipolar::Surface::new(mesh);
+    let d = bipolar::describe(
+        &surface,
+        bipolar::Fields::Solve {
+            solver: solver.as_ref(),
+            references: &refs,
+        },
+        &opts,
+    )?;
     let elapsed = t0.elapsed();
     bipolar::io::write_auto(&args.out, &d)?;
     let n_amb = d.points.iter().filter(|p| p.ambiguous).count();

@@ -32,23 +32,23 @@ pub fn info_json(loaded: &mesh_io::LoadedMesh, file: &str) -> serde_json::Value 
     let m = &loaded.mesh;
     let topo = Topology::new(m);
     let bb = m.bbox();
-    let mut loops: Vec<usize> = topo.boundary_loops.iter().map(Vec::len).collect();
+    let mut loops: Vec<usize> = topo.boundary_loops().iter().map(Vec::len).collect();
     loops.sort_unstable_by(|a, b| b.cmp(a));
     serde_json::json!({
         "file": file,
         "vertices": m.n_vertices(),
         "faces": m.n_faces(),
-        "edges": topo.edges.len(),
+        "edges": topo.edges().len(),
         "bbox": {"min": [bb.min.x, bb.min.y, bb.min.z], "max": [bb.max.x, bb.max.y, bb.max.z], "diagonal": bb.diagonal()},
         "area": m.area(),
         "mean_edge_length": m.mean_edge_length(),
-        "components": topo.n_components,
-        "isolated_vertices": topo.isolated_vertices,
+        "components": topo.n_components(),
+        "isolated_vertices": topo.isolated_vertices(),
         "boundary_loops": loops.len(),
         "boundary_loop_lengths": loops,
-        "non_manifold_edges": topo.non_manifold_edges.len(),
-        "non_manifold_vertices": topo.non_manifold_vertices.len(),
-        "orientation_conflicts": topo.inconsistent_edges.len(),
+        "non_manifold_edges": topo.non_manifold_edges().len(),
+        "non_manifold_vertices": topo.non_manifold_vertices().len(),
+        "orientation_conflicts": topo.inconsistent_edges().len(),
         "degenerate_faces": mesh_io::count_degenerate_faces(m),
         "duplicate_vertices": mesh_io::count_duplicate_vertices(m),
         "has_colors": loaded.colors.is_some(),

@@ -34,7 +34,7 @@ impl Dijkstra {
         let topo = meshcore::Topology::new(mesh);
         let n = mesh.n_vertices();
         let mut deg = vec![0u32; n + 1];
-        for e in &topo.edges {
+        for e in topo.edges() {
             deg[e.v[0] as usize + 1] += 1;
             deg[e.v[1] as usize + 1] += 1;
         }
@@ -43,7 +43,7 @@ impl Dijkstra {
         }
         let mut fill = deg.clone();
         let mut neighbors = vec![(0u32, 0.0f64); deg[n] as usize];
-        for e in &topo.edges {
+        for e in topo.edges() {
             let (a, b) = (e.v[0], e.v[1]);
             let l = (mesh.position(a) - mesh.position(b)).length();
             neighbors[fill[a as usize] as usize] = (b, l);

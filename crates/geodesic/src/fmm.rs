@@ -333,7 +333,7 @@ impl FastMarching {
                 let (x, y) = (t[k], t[(k + 1) % 3]);
                 (x == p && y == q) || (x == q && y == p)
             })
-            .map(|k| topo.face_edges[g as usize][k])
+            .map(|k| topo.face_edges()[g as usize][k])
     }
 }
 
@@ -602,13 +602,13 @@ fn gaussian_curvature(mesh: &TriMesh, topo: &Topology) -> Vec<f64> {
         }
     }
     let mut skip = vec![false; n];
-    for e in &topo.edges {
+    for e in topo.edges() {
         if e.n_faces != 2 {
             skip[e.v[0] as usize] = true;
             skip[e.v[1] as usize] = true;
         }
     }
-    for &v in &topo.non_manifold_vertices {
+    for &v in topo.non_manifold_vertices() {
         skip[v as usize] = true;
     }
     (0..n)

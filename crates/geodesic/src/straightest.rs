@@ -266,7 +266,7 @@ impl<'a> Walker<'a> {
                 nb[kb] = eps;
                 nb[ka] = 1.0 - eps;
             }
-            let edge = self.topo.face_edges[f as usize][(k_exit + 1) % 3];
+            let edge = self.topo.face_edges()[f as usize][(k_exit + 1) % 3];
             let Some(g) = self.topo.opposite_face(edge, f) else {
                 let end = SurfacePoint::new(f, nb);
                 return Ok(Walk {

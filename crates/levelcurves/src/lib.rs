@@ -243,10 +243,10 @@ fn check_inputs(mesh: &TriMesh, topo: &Topology, field: &[f64]) -> Result<(), Le
             got: field.len(),
         });
     }
-    if topo.face_edges.len() != mesh.n_faces() {
+    if topo.face_edges().len() != mesh.n_faces() {
         return Err(LevelCurveError::TopologyMismatch {
             mesh_faces: mesh.n_faces(),
-            topo_faces: topo.face_edges.len(),
+            topo_faces: topo.face_edges().len(),
         });
     }
     Ok(())
@@ -276,7 +276,7 @@ impl<'a> Extractor<'a> {
             mesh,
             topo,
             field,
-            node_of_edge: vec![NONE; topo.edges.len()],
+            node_of_edge: vec![NONE; topo.edges().len()],
             diag: mesh.bbox().diagonal(),
         }
     }
@@ -292,7 +292,7 @@ impl<'a> Extractor<'a> {
         // Links: (node a, node b, face).
         let mut links: Vec<[u32; 3]> = Vec::with_capacity(faces.len());
         for &f in faces {
-            let fe = self.topo.face_edges[f as usize];
+            let fe = self.topo.face_edges()[f as usize];
             let tri = tris[f as usize];
             let mut ends = [NONE; 2];
             let mut k_found = 0;
@@ -486,7 +486,7 @@ impl<'a> Extractor<'a> {
         let edge_of = keep_n
             .iter()
             .map(|&n| {
-                let e = self.topo.edges[nodes[n as usize].edge as usize].v;
+                let e = self.topo.edges()[nodes[n as usize].edge as usize].v;
                 (e[0], e[1])
             })
             .collect();

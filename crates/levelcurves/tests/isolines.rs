@@ -124,7 +124,7 @@ fn check_structure(mesh: &TriMesh, topo: &Topology, u: &[f64], c: f64, pieces: &
             // Open pieces end on boundary edges (or next to skipped faces).
             for &k in &[0, n - 1] {
                 let (lo, hi) = iso.edge_of[k];
-                let e = topo.edges.iter().find(|e| e.v == [lo, hi]).unwrap();
+                let e = topo.edges().iter().find(|e| e.v == [lo, hi]).unwrap();
                 let usable = |f: u32| {
                     f != meshcore::NO_FACE
                         && mesh.triangles()[f as usize]
@@ -234,7 +234,7 @@ fn sphere_levels_are_single_closed_loops() {
 fn hole_splits_isolines_without_bridging() {
     let mesh = grid(30, 2.0 / 30.0, -1.0, 0.2, 11, |c| c.length() < 0.35);
     let topo = Topology::new(&mesh);
-    assert_eq!(topo.boundary_loops.len(), 2);
+    assert_eq!(topo.boundary_loops().len(), 2);
     // Linear field: the isoline is exact, x = c.
     let u = field(&mesh, |p| p.x);
     let all = isolines(&mesh, &topo, &u, &[0.0, 0.1, 0.6]).unwrap();
@@ -375,7 +375,7 @@ proptest! {
                         prop_assert!(seen.insert(*e), "edge {:?} twice", e);
                     }
                 }
-                let crossed: HashSet<(u32, u32)> = topo.edges.iter()
+                let crossed: HashSet<(u32, u32)> = topo.edges().iter()
                     .filter(|e| (u[e.v[0] as usize] >= c) != (u[e.v[1] as usize] >= c))
                     .map(|e| (e.v[0], e.v[1])).collect();
                 prop_assert_eq!(seen, crossed);

@@ -56,11 +56,11 @@ fn grid_mesh_drops_background_jumps_and_small_components() {
         );
     }
     let t = Topology::new(&m.mesh);
-    assert_eq!(t.n_components, 1);
-    assert!(t.inconsistent_edges.is_empty());
-    assert!(t.non_manifold_edges.is_empty());
+    assert_eq!(t.n_components(), 1);
+    assert!(t.inconsistent_edges().is_empty());
+    assert!(t.non_manifold_edges().is_empty());
     // Outer boundary and the hole left by the island.
-    assert_eq!(t.boundary_loops.len(), 2);
+    assert_eq!(t.boundary_loops().len(), 2);
     // Oriented towards the scanner (+z).
     let mean: DVec3 = (0..m.mesh.n_faces() as u32)
         .map(|f| m.mesh.face_cross(f))
@@ -85,7 +85,7 @@ fn larger_threshold_keeps_the_bridges() {
     };
     let m = bnt_grid_to_mesh(&g, &opts).unwrap();
     assert_eq!(m.mesh.n_vertices(), 31 * 41);
-    assert_eq!(Topology::new(&m.mesh).n_components, 2);
+    assert_eq!(Topology::new(&m.mesh).n_components(), 2);
 }
 
 #[test]

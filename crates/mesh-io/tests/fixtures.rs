@@ -17,10 +17,10 @@ fn load(name: &str) -> LoadedMesh {
 /// Closed, consistently oriented, outward (positive signed volume) surface.
 fn check_closed_outward(m: &LoadedMesh, volume: f64) {
     let t = Topology::new(&m.mesh);
-    assert!(t.boundary_loops.is_empty());
-    assert_eq!(t.n_components, 1);
-    assert!(t.inconsistent_edges.is_empty());
-    assert!(t.non_manifold_edges.is_empty());
+    assert!(t.boundary_loops().is_empty());
+    assert_eq!(t.n_components(), 1);
+    assert!(t.inconsistent_edges().is_empty());
+    assert!(t.non_manifold_edges().is_empty());
     let vol: f64 = (0..m.mesh.n_faces() as u32)
         .map(|f| {
             let [a, b, c] = m.mesh.face_corners(f);

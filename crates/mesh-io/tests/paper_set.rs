@@ -66,20 +66,20 @@ fn paper_set_faces_load() {
         assert_eq!(m.mesh.n_vertices(), 6706, "{}", p.display());
         let t = Topology::new(&m.mesh);
         assert_eq!(components(&m.mesh), 1, "{}", p.display());
-        assert_eq!(t.n_components, 1, "{}", p.display());
-        assert_eq!(t.isolated_vertices, 0);
+        assert_eq!(t.n_components(), 1, "{}", p.display());
+        assert_eq!(t.isolated_vertices(), 0);
         assert_eq!(
-            t.boundary_loops.len(),
+            t.boundary_loops().len(),
             PAPER_SET_BOUNDARY_LOOPS,
             "{}",
             p.display()
         );
         assert!(
-            t.non_manifold_edges.is_empty() && t.inconsistent_edges.is_empty(),
+            t.non_manifold_edges().is_empty() && t.inconsistent_edges().is_empty(),
             "{}",
             p.display()
         );
-        let mut l: Vec<usize> = t.boundary_loops.iter().map(Vec::len).collect();
+        let mut l: Vec<usize> = t.boundary_loops().iter().map(Vec::len).collect();
         l.sort_unstable();
         assert_eq!(l, PAPER_SET_LOOP_LENGTHS, "{}", p.display());
         // Same connectivity in every face: identical loop lengths and face counts.

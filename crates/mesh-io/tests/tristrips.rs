@@ -92,8 +92,8 @@ fn strips_are_decoded_with_alternating_winding_and_restarts() {
             assert!(m.mesh.face_normal(f).z > 0.99, "face {f}");
         }
         let t = Topology::new(&m.mesh);
-        assert!(t.inconsistent_edges.is_empty() && t.non_manifold_edges.is_empty());
-        assert_eq!(t.boundary_loops.len(), 1);
+        assert!(t.inconsistent_edges().is_empty() && t.non_manifold_edges().is_empty());
+        assert_eq!(t.boundary_loops().len(), 1);
         assert!((m.mesh.area() - 6.0).abs() < 1e-12);
     }
 }

@@ -3,7 +3,8 @@
 //! * [`TriMesh`]: f64 positions ([`glam::DVec3`]) and `u32` triangles, validated on construction
 //!   (non-empty, finite coordinates, indices in range).
 //! * [`Topology`]: adjacency built once (vertex-face incidence, unique edges with their faces,
-//!   boundary loops, connected components, manifold and orientation checks).
+//!   boundary loops, connected components, manifold and orientation checks); read-only.
+//! * [`Surface`]: a mesh with its topology, built together (what APIs needing both take).
 //! * [`SurfacePoint`]: a point on the surface as (face, barycentric coordinates), with conversion
 //!   to a position and [`FaceLocator`] for the nearest surface point to an arbitrary 3D point.
 //! * [`linalg`]: the small dense linear algebra of the workspace (3x3 symmetric eigen, SVD,
@@ -22,6 +23,7 @@ mod locate;
 mod mesh;
 pub mod repair;
 pub mod shapes;
+mod surface;
 mod topology;
 pub mod units;
 
@@ -30,4 +32,5 @@ pub use error::MeshError;
 pub use glam::{DAffine3, DMat3, DQuat, DVec3};
 pub use locate::{closest_point_on_triangle, FaceLocator};
 pub use mesh::{Aabb, SurfacePoint, TriMesh};
+pub use surface::Surface;
 pub use topology::{Edge, Topology, NO_FACE};

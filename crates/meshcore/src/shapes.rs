@@ -266,8 +266,8 @@ mod tests {
                 .iter()
                 .all(|p| (p.length() - 1.0).abs() < 1e-12));
             let t = Topology::new(&m);
-            assert!(t.boundary_loops.is_empty());
-            assert!(t.inconsistent_edges.is_empty());
+            assert!(t.boundary_loops().is_empty());
+            assert!(t.inconsistent_edges().is_empty());
         }
     }
 
@@ -287,7 +287,7 @@ mod tests {
         let m = cylinder(1.5, 2.0, 12, 3);
         assert_eq!(m.n_vertices(), 12 * 4);
         let t = Topology::new(&m);
-        assert_eq!(t.boundary_loops.len(), 2);
+        assert_eq!(t.boundary_loops().len(), 2);
         for f in 0..m.n_faces() as u32 {
             let [a, b, c] = m.triangles()[f as usize].map(|v| m.position(v));
             let radial = (a + b + c) * DVec3::new(1.0, 1.0, 0.0);
@@ -308,7 +308,7 @@ mod tests {
         assert_eq!(m.n_vertices(), 2 + 9 * 16);
         assert_eq!(m.position(0), DVec3::Z);
         assert_eq!(m.position((m.n_vertices() - 1) as u32), -DVec3::Z);
-        assert!(Topology::new(&m).boundary_loops.is_empty());
+        assert!(Topology::new(&m).boundary_loops().is_empty());
     }
 
     #[test]
@@ -331,8 +331,8 @@ mod tests {
         );
         for m in [&u, &a] {
             let t = Topology::new(m);
-            assert_eq!(t.boundary_loops.len(), 1);
-            assert!(t.inconsistent_edges.is_empty());
+            assert_eq!(t.boundary_loops().len(), 1);
+            assert!(t.inconsistent_edges().is_empty());
             for f in 0..m.n_faces() as u32 {
                 assert!(m.face_cross(f).z > 0.0, "face {f} is not counter-clockwise");
             }
@@ -350,6 +350,6 @@ mod tests {
         assert_ne!(a.positions(), c.positions());
         let holed = grid_plane(6, 0.5, -1.5, 0.0, 0, |p| p.length() < 0.6);
         assert!(holed.n_faces() < 72);
-        assert_eq!(Topology::new(&holed).boundary_loops.len(), 2);
+        assert_eq!(Topology::new(&holed).boundary_loops().len(), 2);
     }
 }

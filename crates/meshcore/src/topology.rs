@@ -26,34 +26,35 @@ impl Edge {
     }
 }
 
-/// Adjacency of a [`TriMesh`], built once and read many times.
+/// Adjacency of a [`TriMesh`], built once and read many times (read-only: every field is
+/// behind an accessor, so it always describes the mesh it was built from).
 ///
 /// Edge ids are assigned in order of first appearance when scanning faces `0..m` and their
 /// corners `(0,1), (1,2), (2,0)`, so they are deterministic for a given mesh.
 #[derive(Debug, Clone)]
 pub struct Topology {
-    /// CSR offsets into [`Topology::vertex_face_list`], length `n_vertices + 1`.
+    /// CSR offsets into `vertex_face_list`, length `n_vertices + 1`.
     vertex_face_offsets: Vec<u32>,
     vertex_face_list: Vec<u32>,
     /// Unique edges.
-    pub edges: Vec<Edge>,
+    edges: Vec<Edge>,
     /// For each face, the edge id of its sides `(c0,c1), (c1,c2), (c2,c0)`.
-    pub face_edges: Vec<[u32; 3]>,
+    face_edges: Vec<[u32; 3]>,
     /// Boundary loops as ordered vertex lists (each loop listed once, not closed explicitly).
-    pub boundary_loops: Vec<Vec<u32>>,
+    boundary_loops: Vec<Vec<u32>>,
     /// Component id of each vertex (faces connected through shared vertices); isolated vertices
     /// get their own component.
-    pub vertex_component: Vec<u32>,
+    vertex_component: Vec<u32>,
     /// Number of connected components (isolated vertices included).
-    pub n_components: usize,
+    n_components: usize,
     /// Number of vertices used by no face.
-    pub isolated_vertices: usize,
+    isolated_vertices: usize,
     /// Edges used by more than two faces.
-    pub non_manifold_edges: Vec<u32>,
+    non_manifold_edges: Vec<u32>,
     /// Vertices whose incident faces do not form a single fan (bow-ties).
-    pub non_manifold_vertices: Vec<u32>,
+    non_manifold_vertices: Vec<u32>,
     /// Interior edges traversed in the same direction by both faces (orientation conflicts).
-    pub inconsistent_edges: Vec<u32>,
+    inconsistent_edges: Vec<u32>,
 }
 
 impl Topology {
@@ -172,6 +173,52 @@ impl Topology {
         topo.boundary_loops = topo.compute_boundary_loops(mesh);
         topo.non_manifold_vertices = topo.compute_non_manifold_vertices(mesh);
         topo
+    }
+
+    /// Unique edges.
+    pub fn edges(&self) -> &[Edge] {
+        &self.edges
+    }
+
+    /// For each face, the edge id of its sides `(c0,c1), (c1,c2), (c2,c0)`.
+    pub fn face_edges(&self) -> &[[u32; 3]] {
+        &self.face_edges
+    }
+
+    /// Boundary loops as ordered vertex lists (each loop listed once, not closed explicitly).
+    pub fn boundary_loops(&self) -> &[Vec<u32>] {
+        &self.boundary_loops
+    }
+
+    /// Component id of each vertex (faces connected through shared vertices); isolated vertices
+    /// get their own component.
+    pub fn vertex_component(&self) -> &[u32] {
+        &self.vertex_component
+    }
+
+    /// Number of connected components (isolated vertices included).
+    pub fn n_components(&self) -> usize {
+        self.n_components
+    }
+
+    /// Number of vertices used by no face.
+    pub fn isolated_vertices(&self) -> usize {
+        self.isolated_vertices
+    }
+
+    /// Edges used by more than two faces.
+    pub fn non_manifold_edges(&self) -> &[u32] {
+        &self.non_manifold_edges
+    }
+
+    /// Vertices whose incident faces do not form a single fan (bow-ties).
+    pub fn non_manifold_vertices(&self) -> &[u32] {
+        &self.non_manifold_vertices
+    }
+
+    /// Interior edges traversed in the same direction by both faces (orientation conflicts).
+    pub fn inconsistent_edges(&self) -> &[u32] {
+        &self.inconsistent_edges
     }
 
     /// Faces incident to vertex `v`.

@@ -196,10 +196,12 @@ fn describe_impl(
             let s = s.get();
             py.detach(|| {
                 let t = Instant::now();
-                (
-                    bipolar::describe(mesh, s.solver.as_ref(), &sources, &opts),
-                    t.elapsed(),
-                )
+                let surface = bipolar::Surface::new(mesh.clone());
+                let fields = bipolar::Fields::Solve {
+                    solver: s.solver.as_ref(),
+                    references: &sources,
+                };
+                (bipolar::describe(&surface, fields, &opts), t.elapsed())
             })
         }
         None => {
@@ -208,7 +210,13 @@ fn describe_impl(
                 let t = Instant::now();
                 let d = geodesic::new_solver(mesh, method)
                     .map_err(bipolar::BipolarError::from)
-                    .and_then(|solver| bipolar::describe(mesh, solver.as_ref(), &sources, &opts));
+                    .and_then(|solver| {
+                        let fields = bipolar::Fields::Solve {
+                            solver: solver.as_ref(),
+                            references: &sources,
+                        };
+                        bipolar::describe(&bipolar::Surface::new(mesh.clone()), fields, &opts)
+                    });
                 (d, t.elapsed())
             })
         }

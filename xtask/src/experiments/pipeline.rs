@@ -153,8 +153,15 @@ pub fn bipolar(mesh: &TriMesh, refs: &Refs, n: u32, region: Region) -> KeyedPoin
         },
         ..Default::default()
     };
-    let topo = meshcore::Topology::new(mesh);
-    match bipolar::describe_fields(mesh, &topo, &[refs.ur.clone(), refs.uq.clone()], &opts) {
+    let surface = bipolar::Surface::new(mesh.clone());
+    match bipolar::describe(
+        &surface,
+        bipolar::Fields::Precomputed {
+            fields: &[refs.ur.clone(), refs.uq.clone()],
+            references: None,
+        },
+        &opts,
+    ) {
         Ok(d) => from_crate(&d),
         Err(_) => {
             CRATE_FAILURES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);

@@ -17,7 +17,7 @@ impl<'c, 'a> Strip<'c, 'a> {
     pub(super) fn new(ctx: &'c Ctx<'a>) -> Self {
         let n = ctx.mesh.n_vertices();
         let mut deg = vec![0u32; n + 1];
-        for e in &ctx.topo.edges {
+        for e in ctx.topo.edges() {
             deg[e.v[0] as usize + 1] += 1;
             deg[e.v[1] as usize + 1] += 1;
         }
@@ -26,7 +26,7 @@ impl<'c, 'a> Strip<'c, 'a> {
         }
         let mut fill = deg.clone();
         let mut adj = vec![0u32; deg[n] as usize];
-        for e in &ctx.topo.edges {
+        for e in ctx.topo.edges() {
             for (x, y) in [(e.v[0], e.v[1]), (e.v[1], e.v[0])] {
                 adj[fill[x as usize] as usize] = y;
                 fill[x as usize] += 1;
