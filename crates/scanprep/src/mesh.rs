@@ -64,7 +64,7 @@ pub fn remove_small_components(
     let tris = mesh
         .triangles()
         .iter()
-        .filter(|t| keep_comp[topo.vertex_component[t[0] as usize] as usize])
+        .filter(|t| keep_comp[topo.vertex_component()[t[0] as usize] as usize])
         .copied()
         .collect();
     let (m, _) = compact(mesh.positions(), tris, "removing small components")?;
@@ -93,7 +93,7 @@ pub(crate) fn neighbours(mesh: &TriMesh) -> Vec<Vec<u32>> {
 /// Vertices on a boundary edge (an edge with exactly one face) or a non-manifold one.
 pub(crate) fn boundary_vertices(mesh: &TriMesh, topo: &Topology) -> Vec<bool> {
     let mut b = vec![false; mesh.n_vertices()];
-    for e in &topo.edges {
+    for e in topo.edges() {
         if e.n_faces != 2 {
             b[e.v[0] as usize] = true;
             b[e.v[1] as usize] = true;
@@ -177,9 +177,9 @@ pub fn fill_mesh_holes(
     };
     // Outer loop per component: the longest perimeter (ties to the first listed).
     let mut outer: std::collections::BTreeMap<u32, (f64, usize)> = Default::default();
-    for (k, l) in topo.boundary_loops.iter().enumerate() {
+    for (k, l) in topo.boundary_loops().iter().enumerate() {
         let Some(&v0) = l.first() else { continue };
-        let c = topo.vertex_component[v0 as usize];
+        let c = topo.vertex_component()[v0 as usize];
         let per = perimeter(l);
         let e = outer.entry(c).or_insert((per, k));
         if per > e.0 {
@@ -190,7 +190,7 @@ pub fn fill_mesh_holes(
     let mut pos = p.to_vec();
     let mut tris = mesh.triangles().to_vec();
     let mut holes = Vec::new();
-    for (k, l) in topo.boundary_loops.iter().enumerate() {
+    for (k, l) in topo.boundary_loops().iter().enumerate() {
         if outer_ids.contains(&k) || l.len() < 3 {
             continue;
         }
