@@ -207,7 +207,11 @@ fn icp_score(
     }
     let ss: f64 = probe
         .iter()
-        .map(|p| gallery.nearest(m.transform_point3(*p)).map_or(f64::NAN, |(_, d)| d * d))
+        .map(|p| {
+            gallery
+                .nearest(m.transform_point3(*p))
+                .map_or(f64::NAN, |(_, d)| d * d)
+        })
         .sum();
     (ss / probe.len().max(1) as f64).sqrt()
 }

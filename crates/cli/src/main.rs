@@ -2,8 +2,8 @@
 
 use clap::{Parser, Subcommand};
 
-mod cmd_clean;
 mod choice;
+mod cmd_clean;
 mod cmd_convert;
 mod cmd_describe;
 mod cmd_distance;

@@ -275,8 +275,8 @@ mod tests {
         assert!(worst < target * target / (4.0 * r), "{worst}");
         let topo = meshcore::Topology::new(&d);
         assert!(topo.is_oriented_manifold());
-        assert_eq!(topo.boundary_loops.len(), 0);
-        assert_eq!(topo.n_components, 1);
+        assert_eq!(topo.boundary_loops().len(), 0);
+        assert_eq!(topo.n_components(), 1);
         // Deterministic, and a no-op below the current edge length.
         assert_eq!(decimate(&m, target).unwrap().0, d);
         assert_eq!(decimate(&m, 0.1 * before).unwrap().0, m);

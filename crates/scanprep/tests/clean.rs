@@ -191,7 +191,7 @@ fn mesh_holes_are_fanned_and_big_ones_left() {
     assert_eq!(filled.n_vertices(), m.n_vertices() + 1);
     assert_eq!(filled.n_faces(), m.n_faces() + f[0].size);
     let topo = meshcore::Topology::new(&filled);
-    assert_eq!(topo.boundary_loops.len(), 2);
+    assert_eq!(topo.boundary_loops().len(), 2);
     assert!(topo.is_oriented_manifold());
     assert!(filled.positions().iter().all(|p| p.z == 0.0));
 }
@@ -279,7 +279,7 @@ fn decimation_reaches_the_target_and_keeps_the_sphere() {
     assert!(worst < 4.0 / (4.0 * R), "{worst}");
     let topo = meshcore::Topology::new(&d);
     assert!(topo.is_oriented_manifold());
-    assert_eq!(topo.boundary_loops.len(), 1);
+    assert_eq!(topo.boundary_loops().len(), 1);
 }
 
 #[test]

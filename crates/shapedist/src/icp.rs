@@ -21,9 +21,9 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::error::{ShapeDistError, Which};
-use meshcore::linalg::{axis_angle, kabsch_rotation, solve_sym, sym_eigen3};
 use crate::nn::{dist2, NeighbourGraph, PointTree, GROUP};
 use crate::points::{centred, check_spread, outer, principal_axes, radius, validate};
+use meshcore::linalg::{axis_angle, kabsch_rotation, solve_sym, sym_eigen3};
 
 /// Below this many source points the correspondence search runs on one thread (rayon's
 /// overhead dominates; the global search parallelises over starts instead).

@@ -6,8 +6,8 @@ use glam::{DMat3, DVec3};
 use serde::Serialize;
 
 use crate::error::{ShapeDistError, Which};
-use meshcore::linalg::{horn_rotation, kabsch_rotation};
 use crate::points::{check_spread, outer, validate};
+use meshcore::linalg::{horn_rotation, kabsch_rotation};
 
 /// Closed-form solver for the rotation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]

@@ -6,10 +6,10 @@
 mod common;
 
 use common::*;
+use meshcore::linalg::kabsch_rotation;
 use proptest::prelude::*;
 use rand::Rng;
 use shapedist::glam::{DMat3, DVec3};
-use meshcore::linalg::kabsch_rotation;
 use shapedist::nn::{
     dist2, nearest_brute_force, nearest_k_brute_force, NeighbourGraph, PointTree, GRAPH_K, GROUP,
 };
