@@ -49,7 +49,7 @@ fn options(
 
 /// Labelled landmark positions given by the caller: a path (lm3 / JSON, read by
 /// `mesh_io::read_landmark_file`) or a dict `{label: (x, y, z)}`.
-fn given_landmarks(obj: &Bound<'_, PyAny>) -> PyResult<Vec<(String, DVec3)>> {
+pub(crate) fn given_landmarks(obj: &Bound<'_, PyAny>) -> PyResult<Vec<(String, DVec3)>> {
     if let Ok(d) = obj.cast::<PyDict>() {
         let mut out = Vec::new();
         for (k, v) in d.iter() {
@@ -81,7 +81,7 @@ fn snap(mesh: &TriMesh, p: DVec3, what: &str) -> PyResult<Source> {
 /// snapped to the nearest surface point; a landmark name looked up in `given` (any spelling
 /// `landmarks::LandmarkName::parse` knows, or equal ignoring case) or, without `given`,
 /// detected with `landmarks::detect` and the default model (once for all names).
-fn references(
+pub(crate) fn references(
     py: Python<'_>,
     mesh: &TriMesh,
     specs: &[(String, Bound<'_, PyAny>)],

@@ -15,6 +15,7 @@ mod errors;
 mod geodesic;
 mod landmark;
 mod mesh;
+mod polar;
 
 use pyo3::prelude::*;
 
@@ -26,6 +27,7 @@ fn _bipolar(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<geodesic::PyGeodesicSolver>()?;
     m.add_class::<descriptor::PyDescriptor>()?;
     m.add_class::<distance::PyDistanceOptions>()?;
+    m.add_class::<polar::PyPolarDescriptor>()?;
     m.add_function(wrap_pyfunction!(mesh::read_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::read_mesh_bytes, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::write_mesh, m)?)?;
@@ -41,6 +43,9 @@ fn _bipolar(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mesh::_mesh_from_state, m)?)?;
     m.add_function(wrap_pyfunction!(describe::describe, m)?)?;
     m.add_function(wrap_pyfunction!(describe::_describe_profiled, m)?)?;
+    m.add_function(wrap_pyfunction!(polar::describe_polar, m)?)?;
+    m.add_function(wrap_pyfunction!(polar::polar_distance, m)?)?;
+    m.add_function(wrap_pyfunction!(polar::unpack_polar_key, m)?)?;
     m.add_function(wrap_pyfunction!(descriptor::read_descriptor, m)?)?;
     m.add_function(wrap_pyfunction!(descriptor::pack_key, m)?)?;
     m.add_function(wrap_pyfunction!(descriptor::unpack_key, m)?)?;

@@ -1,0 +1,197 @@
+//! `describe_polar`: the single-pole (geodesic polar) descriptor of `bipolar::polar`, and its
+//! keyed distance.
+
+use crate::convert::{points_out, vec_out};
+use crate::describe::{given_landmarks, references};
+use crate::errors;
+use crate::geodesic::PyGeodesicSolver;
+use crate::mesh::mesh_arg;
+use bipolar::{PolarDescriptor, PolarKey, PolarOptions, Source};
+use geodesic::{GeodesicSolver, Method, SolveOptions, Walker};
+use glam::DVec3;
+use pyo3::prelude::*;
+use std::time::Duration;
+
+/// A single-pole descriptor: points at geodesic radius ``level * step`` from the pole on
+/// ``sectors`` straightest-geodesic rays.
+///
+/// Arrays (copies): ``points`` (n, 3), ``keys`` (n,) uint64 (``PolarKey`` packing, never equal
+/// to a bipolar key), ``levels`` (n,) and ``sectors`` (n,) uint32, ``faces`` (n,) uint32 and
+/// ``bary`` (n, 3). Metadata: ``step``, ``n_levels``, ``n_sectors``.
+#[pyclass(module = "bipolar._bipolar", name = "PolarDescriptor", frozen)]
+#[derive(Debug, Clone)]
+pub struct PyPolarDescriptor {
+    pub d: PolarDescriptor,
+}
+
+#[pymethods]
+impl PyPolarDescriptor {
+    /// Point positions, shape (n, 3).
+    #[getter]
+    fn points<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray2<f64>> {
+        points_out(py, &self.d.positions())
+    }
+
+    /// Packed keys, shape (n,), uint64.
+    #[getter]
+    fn keys<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray1<u64>> {
+        vec_out(py, self.d.keys())
+    }
+
+    /// Radius level of each point (1-based), shape (n,), uint32.
+    #[getter]
+    fn levels<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray1<u32>> {
+        vec_out(py, self.d.points.iter().map(|p| p.key.level).collect())
+    }
+
+    /// Angular sector of each point, shape (n,), uint32.
+    #[getter]
+    fn sectors<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray1<u32>> {
+        vec_out(py, self.d.points.iter().map(|p| p.key.sector).collect())
+    }
+
+    /// Face of each point, shape (n,), uint32.
+    #[getter]
+    fn faces<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray1<u32>> {
+        vec_out(py, self.d.points.iter().map(|p| p.face).collect())
+    }
+
+    /// Barycentric coordinates of each point in its face, shape (n, 3).
+    #[getter]
+    fn bary<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray2<f64>> {
+        let b: Vec<DVec3> = self.d.points.iter().map(|p| p.bary).collect();
+        points_out(py, &b)
+    }
+
+    /// Geodesic step between radius levels.
+    #[getter]
+    fn step(&self) -> f64 {
+        self.d.options.step
+    }
+
+    /// Number of radius levels asked for.
+    #[getter]
+    fn n_levels(&self) -> u32 {
+        self.d.options.levels
+    }
+
+    /// Number of rays.
+    #[getter]
+    fn n_sectors(&self) -> u32 {
+        self.d.options.sectors
+    }
+
+    fn __len__(&self) -> usize {
+        self.d.points.len()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "PolarDescriptor({} points, step={}, levels={}, sectors={})",
+            self.d.points.len(),
+            self.d.options.step,
+            self.d.options.levels,
+            self.d.options.sectors
+        )
+    }
+}
+
+/// The single-pole descriptor of a mesh (``bipolar::describe_polar``).
+///
+/// ``pole``: a vertex index, an ``(x, y, z)`` point (snapped to the surface) or a landmark name
+/// (``"nose-tip"``, from ``landmarks`` or detected), as the references of ``describe``.
+/// ``towards``: a second reference of the same kinds fixing the angular origin (for faces the
+/// midpoint of the outer eye corners, given as a point). ``step`` (positive) between radius
+/// levels, ``levels`` of them, on ``sectors`` rays. Geodesic ``method`` or a prepared ``solver``
+/// for this mesh. The GIL is released while it runs. No ray reaching level 1 is an error.
+#[pyfunction]
+#[pyo3(signature = (mesh, pole, towards, *, step, levels=10, sectors=16, method="exact",
+                    landmarks=None, solver=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn describe_polar(
+    py: Python<'_>,
+    mesh: &Bound<'_, PyAny>,
+    pole: &Bound<'_, PyAny>,
+    towards: &Bound<'_, PyAny>,
+    step: f64,
+    levels: u32,
+    sectors: u32,
+    method: &str,
+    landmarks: Option<&Bound<'_, PyAny>>,
+    solver: Option<&Bound<'_, PyGeodesicSolver>>,
+) -> PyResult<PyPolarDescriptor> {
+    let m = mesh_arg(mesh)?;
+    let mesh = m.mesh();
+    let given = landmarks.map(given_landmarks).transpose()?;
+    let specs = vec![
+        ("pole".to_string(), pole.clone()),
+        ("towards".to_string(), towards.clone()),
+    ];
+    let mut in_library = Duration::ZERO;
+    let refs = references(py, mesh, &specs, given.as_deref(), &mut in_library)?;
+    let (pole, towards) = (refs[0], refs[1]);
+    let towards = match towards {
+        Source::Vertex(v) => mesh.try_position(v).map_err(errors::mesh)?,
+        Source::Point(sp) => mesh.point_position(&sp).map_err(errors::mesh)?,
+    };
+    let opts = PolarOptions {
+        step,
+        levels,
+        sectors,
+    };
+    // The method is read only when no prepared solver is given (as in `describe`).
+    let method: Method = match solver {
+        Some(_) => Method::Exact,
+        None => method.parse().map_err(errors::geodesic)?,
+    };
+    let prepared = solver.map(|s| s.get());
+    let d = py.detach(|| {
+        let owned;
+        let solver: &dyn GeodesicSolver = match prepared {
+            Some(s) => s.solver.as_ref(),
+            None => {
+                owned = geodesic::new_solver(mesh, method)?;
+                owned.as_ref()
+            }
+        };
+        let field = solver.distances(&[pole], &SolveOptions::default())?;
+        let walker = Walker::new(mesh);
+        bipolar::describe_polar(&walker, &field, pole, towards, &opts)
+    });
+    Ok(PyPolarDescriptor {
+        d: d.map_err(errors::descriptor)?,
+    })
+}
+
+/// Normalised keyed distance between two single-pole descriptors in [0, 1]: points paired by
+/// ``(level, sector)``, optimal rotation in closed form (``shapedist.keyed_distance`` with the
+/// default options, as the experiments compare them).
+#[pyfunction]
+pub fn polar_distance(
+    py: Python<'_>,
+    a: &Bound<'_, PyPolarDescriptor>,
+    b: &Bound<'_, PyPolarDescriptor>,
+) -> PyResult<f64> {
+    let (da, db) = (&a.get().d, &b.get().d);
+    py.detach(|| {
+        shapedist::keyed_distance(
+            &da.keys(),
+            &da.positions(),
+            &db.keys(),
+            &db.positions(),
+            &shapedist::KeyedOptions::default(),
+        )
+    })
+    .map(|k| k.distance)
+    .map_err(errors::shapedist)
+}
+
+/// `(level, sector)` of a packed polar key.
+#[pyfunction]
+pub fn unpack_polar_key(key: u64) -> PyResult<(u32, u32)> {
+    let k = PolarKey::unpack(key);
+    if k.pack() != key {
+        return Err(errors::input(format!("{key} is not a packed polar key")));
+    }
+    Ok((k.level, k.sector))
+}
