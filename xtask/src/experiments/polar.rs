@@ -9,7 +9,7 @@
 //! The angular origin is the direction towards a second point (here the midpoint of the two
 //! outer eye corners), projected on the tangent plane at the pole.
 
-use super::descriptor::KeyedPoints;
+use super::keyed::KeyedPoints;
 use super::walk::Walker;
 use anyhow::Result;
 use meshcore::{DVec3, SurfacePoint};
@@ -187,7 +187,6 @@ mod tests {
 #[cfg(test)]
 mod face_tests {
     use super::*;
-    use crate::experiments::descriptor::keyed_distance;
     use facemodel::load_face_set;
     use geodesic::{Method, SolveOptions, Source};
 
@@ -224,15 +223,9 @@ mod face_tests {
             .unwrap();
         let a = polar_descriptor(&w, &u1, Pole::Vertex(v), towards, &opts).unwrap();
         let c = polar_descriptor(&w, &u2, Pole::Point(sp), towards, &opts).unwrap();
-        let d = keyed_distance(&a, &c).unwrap();
-        eprintln!(
-            "n {} {} shared {} d {}",
-            a.len(),
-            c.len(),
-            d.shared,
-            d.distance
-        );
-        assert_eq!(d.shared, a.len());
+        let ((ka, pa), (kc, pc)) = (a.unambiguous(), c.unambiguous());
+        let d = shapedist::keyed_distance(&ka, &pa, &kc, &pc, &Default::default()).unwrap();
+        assert_eq!(d.shared_keys, a.len());
         assert!(d.distance < 1e-12, "{}", d.distance);
     }
 }
