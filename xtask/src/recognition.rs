@@ -20,6 +20,7 @@ use crate::paths::{default_model_dir, default_out_dir};
 use anyhow::{bail, Context, Result};
 use facemodel::{face_frame, random_rigid_motion, FaceModel};
 use geodesic::{SolveOptions, Source};
+use meshcore::linalg::fit_rigid;
 use meshcore::{DVec3, FaceLocator, TriMesh};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -167,20 +168,6 @@ fn eer_roc(gen: &[f64], imp: &[f64]) -> (f64, Vec<(f64, f64)>) {
     (eer, roc)
 }
 
-/// Rigid alignment of `src` onto `dst` (paired), with translation: (R, t) with dst ~ R src + t.
-fn rigid(src: &[DVec3], dst: &[DVec3]) -> (meshcore::DMat3, DVec3) {
-    let n = src.len().max(1) as f64;
-    let cs = src.iter().copied().sum::<DVec3>() / n;
-    let cd = dst.iter().copied().sum::<DVec3>() / n;
-    let a: Vec<DVec3> = dst.iter().map(|p| *p - cd).collect();
-    let b: Vec<DVec3> = src.iter().map(|p| *p - cs).collect();
-    let k = a.iter().zip(&b).fold(meshcore::DMat3::ZERO, |k, (p, q)| {
-        k + shapedist::points::outer(*p, *q)
-    });
-    let r = shapedist::linalg::horn_rotation(k).0;
-    (r, cd - r * cs)
-}
-
 /// ICP of the probe points onto the gallery surface (closest points on triangles), started from
 /// the landmark alignment; trims the worst 10 % of pairs; returns the RMS closest-point
 /// distance of all probe points at the final pose (cm).
@@ -190,10 +177,12 @@ fn icp_score(
     gallery: &FaceLocator<'_>,
     gallery_lm: &[DVec3; 3],
 ) -> f64 {
-    let (mut r, mut t) = rigid(probe_lm, gallery_lm);
+    let Some(mut m) = fit_rigid(probe_lm, gallery_lm, None) else {
+        return f64::NAN;
+    };
     let mut prev = f64::INFINITY;
     for _ in 0..6 {
-        let moved: Vec<DVec3> = probe.iter().map(|p| r * *p + t).collect();
+        let moved: Vec<DVec3> = probe.iter().map(|p| m.transform_point3(*p)).collect();
         let mut pairs: Vec<(f64, DVec3, DVec3)> = Vec::with_capacity(probe.len());
         for (k, m) in moved.iter().enumerate() {
             let Ok((sp, d)) = gallery.nearest(*m) else {
@@ -209,7 +198,10 @@ fn icp_score(
         let rms = (pairs[..keep].iter().map(|p| p.0 * p.0).sum::<f64>() / keep as f64).sqrt();
         let src: Vec<DVec3> = pairs[..keep].iter().map(|p| p.1).collect();
         let dst: Vec<DVec3> = pairs[..keep].iter().map(|p| p.2).collect();
-        (r, t) = rigid(&src, &dst);
+        let Some(next) = fit_rigid(&src, &dst, None) else {
+            return f64::NAN;
+        };
+        m = next;
         if (prev - rms).abs() <= 1e-6 * rms.max(1e-12) {
             break;
         }
@@ -217,7 +209,11 @@ fn icp_score(
     }
     let ss: f64 = probe
         .iter()
-        .map(|p| gallery.nearest(r * *p + t).map_or(f64::NAN, |(_, d)| d * d))
+        .map(|p| {
+            gallery
+                .nearest(m.transform_point3(*p))
+                .map_or(f64::NAN, |(_, d)| d * d)
+        })
         .sum();
     (ss / probe.len().max(1) as f64).sqrt()
 }

@@ -14,6 +14,8 @@
 //!   per-face gradient, [`TangentMethod::Strip`] = the paper's method 1,
 //!   [`TangentMethod::Spline`] = the paper's method 2).
 //! * More than two reference points: every pair `a < b` contributes, keys carry the pair.
+//! * [`polar`]: the single-pole descriptor (geodesic polar coordinates around one point,
+//!   [`describe_polar`]), keyed by `(level, sector)`.
 //! * [`io`]: CSV / JSON / PLY files. [`synthetic`]: test meshes with analytic fields.
 //!
 //! Determinism: points are sorted by key, then position. Errors: [`BipolarError`]; an empty
@@ -26,6 +28,7 @@ mod build;
 mod error;
 pub mod io;
 mod key;
+pub mod polar;
 pub mod synthetic;
 mod types;
 
@@ -33,6 +36,7 @@ pub use build::{describe, describe_fields, describe_fields_with_refs};
 pub use error::BipolarError;
 pub use geodesic::Source;
 pub use key::Key;
+pub use polar::{describe_polar, PolarDescriptor, PolarKey, PolarOptions, PolarPoint};
 pub use types::{
     Descriptor, DescriptorOptions, DescriptorPoint, DescriptorStats, LevelSpec, SelectionRule,
     SplineOptions, StripOptions, TangentMethod,

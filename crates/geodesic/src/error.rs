@@ -29,4 +29,16 @@ pub enum GeodesicError {
     /// A negative or NaN cut-off.
     #[error("invalid max_distance {0}: must be positive")]
     InvalidCutoff(f64),
+    /// A straightest-geodesic direction is zero, not finite or normal to the surface.
+    #[error("invalid walk direction: {0}")]
+    InvalidDirection(String),
+    /// A straightest-geodesic length is negative or not finite.
+    #[error("invalid walk length {0}: must be finite and >= 0")]
+    InvalidLength(f64),
+    /// A straightest geodesic entered a zero-area face.
+    #[error("the walk entered degenerate face {0}")]
+    DegenerateFace(u32),
+    /// A straightest geodesic could not continue (inconsistent adjacency, too many crossings).
+    #[error("straightest geodesic: {0}")]
+    WalkFailed(String),
 }

@@ -13,6 +13,9 @@
 //!
 //! Many sources at once (one field each) run in parallel with [`distances_many`].
 //!
+//! Straightest geodesics (walk a length in a tangent direction, unfolding across edges) are in
+//! [`straightest`] ([`Walker`]).
+//!
 //! Unreachable vertices (other components, or beyond the cut-off) get `f64::INFINITY`.
 
 mod dijkstra;
@@ -20,6 +23,7 @@ mod error;
 mod exact;
 mod fmm;
 mod heat;
+pub mod straightest;
 
 pub use dijkstra::Dijkstra;
 pub use error::GeodesicError;
@@ -27,6 +31,7 @@ pub use exact::{ExactGeodesic, ExactMeshReport};
 pub use fmm::{FastMarching, FmmUpdate};
 pub use heat::HeatMethod;
 pub use meshcore::{SurfacePoint, TriMesh};
+pub use straightest::{Walk, WalkSegment, Walker};
 
 /// Where a distance field starts.
 #[derive(Debug, Clone, Copy, PartialEq)]

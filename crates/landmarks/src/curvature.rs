@@ -235,44 +235,6 @@ pub(crate) fn tangent_basis(n: DVec3) -> (DVec3, DVec3) {
     (u, w)
 }
 
-/// Solves the symmetric positive (semi-)definite system `a x = b` by Gaussian elimination with
-/// partial pivoting; `None` when singular.
-pub(crate) fn solve_dense<const N: usize>(
-    mut a: [[f64; N]; N],
-    mut b: [f64; N],
-) -> Option<[f64; N]> {
-    let scale = (0..N)
-        .map(|i| a[i][i].abs())
-        .fold(0.0, f64::max)
-        .max(1e-300);
-    for col in 0..N {
-        let piv = (col..N).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
-        if a[piv][col].abs() <= 1e-13 * scale {
-            return None;
-        }
-        a.swap(col, piv);
-        b.swap(col, piv);
-        for r in col + 1..N {
-            let f = a[r][col] / a[col][col];
-            if f != 0.0 {
-                for c in col..N {
-                    a[r][c] -= f * a[col][c];
-                }
-                b[r] -= f * b[col];
-            }
-        }
-    }
-    let mut x = [0.0; N];
-    for r in (0..N).rev() {
-        let mut s = b[r];
-        for c in r + 1..N {
-            s -= a[r][c] * x[c];
-        }
-        x[r] = s / a[r][r];
-    }
-    Some(x)
-}
-
 /// Principal curvatures of every vertex by weighted least-squares fitting of
 /// `h = a x^2 + b xy + c y^2 + d x + e y + f` in the local frame of the vertex normal, over the
 /// vertices within `options.radius` (reached through edges). Weights `(1 - r^2/R^2)^2`.
@@ -360,7 +322,7 @@ fn fit_vertex(pos: &[DVec3], p: DVec3, n: DVec3, nb: &[u32], radius: f64) -> Opt
             atb[i] += wt * row[i] * h;
         }
     }
-    let c = solve_dense(ata, atb)?;
+    let c = meshcore::linalg::solve_sym_tol(ata, atb, 1e-13)?;
     // Back to mesh units: h = s * H(x/s, y/s): second derivatives divide by s, first unchanged.
     let fxx = 2.0 * c[0] / scale;
     let fxy = c[1] / scale;

@@ -5,9 +5,10 @@
 #![allow(clippy::needless_range_loop)] // Dense small linear algebra reads best with indices.
 
 use crate::curvature::{vertex_curvatures_with, CurvatureOptions, VertexAdjacency};
-use crate::geom::{icp, kabsch, score, FitScore, Rigid, SurfaceIndex};
+use crate::geom::{icp, score, FitScore, SurfaceIndex};
 use crate::model::GenericModel;
 use crate::{Landmark, LandmarkError, LandmarkName, Landmarks};
+use meshcore::linalg::{fit_rigid, rigid_inverse};
 use meshcore::{DAffine3, DMat3, DVec3, TriMesh};
 use rayon::prelude::*;
 
@@ -100,7 +101,7 @@ const NOSE_SEARCH: f64 = 2.0;
 /// A pose hypothesis (model -> mesh) with its fit.
 #[derive(Debug, Clone, Copy)]
 struct Hypothesis {
-    t: Rigid,
+    t: DAffine3,
     fit: FitScore,
 }
 
@@ -111,13 +112,13 @@ struct Hypothesis {
 /// or fitted on a cheek, a chin or a non-face maps the matched region onto empty space or onto
 /// a differently oriented surface. Returns the share of mirrored vertices that are inliers
 /// (distance below `tau`, normals within 60 degrees), in `[0, 1]`.
-fn symmetry(idx: &SurfaceIndex, face: &[(DVec3, DVec3)], t: &Rigid, tau: f64) -> f64 {
+fn symmetry(idx: &SurfaceIndex, face: &[(DVec3, DVec3)], t: &DAffine3, tau: f64) -> f64 {
     let tau2 = tau * tau;
     let mut verts: Vec<u32> = face
         .iter()
         .filter_map(|(p, n)| {
-            let h = idx.query(t.apply(*p));
-            (h.d2 < tau2 && idx.nrm[h.vertex as usize].dot(t.rotate(*n)) > 0.5).then_some(h.vertex)
+            let h = idx.query(t.transform_point3(*p));
+            (h.d2 < tau2 && idx.nrm[h.vertex as usize].dot(t.transform_vector3(*n)) > 0.5).then_some(h.vertex)
         })
         .collect();
     verts.sort_unstable();
@@ -125,13 +126,13 @@ fn symmetry(idx: &SurfaceIndex, face: &[(DVec3, DVec3)], t: &Rigid, tau: f64) ->
     if verts.is_empty() {
         return 0.0;
     }
-    let inv = t.inverse();
+    let inv = rigid_inverse(t);
     let mirror = |v: DVec3| DVec3::new(-v.x, v.y, v.z);
     let ok = verts
         .iter()
         .filter(|&&v| {
-            let q = t.apply(mirror(inv.apply(idx.pos[v as usize])));
-            let nq = t.rotate(mirror(inv.rotate(idx.nrm[v as usize])));
+            let q = t.transform_point3(mirror(inv.transform_point3(idx.pos[v as usize])));
+            let nq = t.transform_vector3(mirror(inv.transform_vector3(idx.nrm[v as usize])));
             let h = idx.query(q);
             h.d2 < tau2 && idx.nrm[h.vertex as usize].dot(nq) > 0.5
         })
@@ -146,7 +147,7 @@ fn symmetry(idx: &SurfaceIndex, face: &[(DVec3, DVec3)], t: &Rigid, tau: f64) ->
 fn diverse(sorted: Vec<Hypothesis>, keys: [DVec3; 3], radius: f64, max: usize) -> Vec<Hypothesis> {
     let mut kept: Vec<(Hypothesis, [DVec3; 3])> = Vec::new();
     for h in sorted {
-        let k = keys.map(|p| h.t.apply(p));
+        let k = keys.map(|p| h.t.transform_point3(p));
         let dup = kept
             .iter()
             .any(|(_, o)| (0..3).all(|i| (o[i] - k[i]).length() < radius));
@@ -272,7 +273,7 @@ pub fn detect_with(
         let m_il = model.landmark(L::InnerEyeLeft);
         let d_nr = (m_ir - m_nose).length();
         let d_nl = (m_il - m_nose).length();
-        let mut hyps: Vec<Rigid> = Vec::new();
+        let mut hyps: Vec<DAffine3> = Vec::new();
         for &n in &noses {
             let pn = idx.pos[n as usize];
             let nn = curv[n as usize].normal;
@@ -296,7 +297,7 @@ pub fn detect_with(
                         }
                         let src = [src_base[0], src_base[1], m_ir, m_il];
                         let dst = [dst_base[0], dst_base[1], a, b];
-                        if let Some(t) = kabsch(&src, &dst, Some(&[1.0, 0.5, 1.0, 1.0])) {
+                        if let Some(t) = fit_rigid(&src, &dst, Some(&[1.0, 0.5, 1.0, 1.0])) {
                             hyps.push(t);
                         }
                     }
@@ -304,12 +305,12 @@ pub fn detect_with(
             }
             // Rotations about the nose normal: pose hypotheses that need no eye candidate (eye
             // corners are weak features under expressions).
-            if let Some(b) = kabsch(&src_base, &dst_base, None) {
+            if let Some(b) = fit_rigid(&src_base, &dst_base, None) {
                 for k in 0..16 {
                     let ang = k as f64 * std::f64::consts::TAU / 16.0;
                     let r = DMat3::from_axis_angle(nn, ang);
-                    let spin = Rigid { r, t: pn - r * pn };
-                    hyps.push(spin.compose(&b));
+                    let spin = DAffine3::from_mat3_translation(r, pn - r * pn);
+                    hyps.push(spin * b);
                 }
             }
         }
@@ -373,7 +374,7 @@ pub fn detect_with(
                     f.h.fit.cost,
                     f.conf,
                     f.sym,
-                    f.h.t.apply(keys[0])
+                    f.h.t.transform_point3(keys[0])
                 );
             }
         }
@@ -449,7 +450,7 @@ pub fn detect_with(
             position: mesh.position(l.vertex),
             ..l
         });
-        let pose = DAffine3::from_mat3_translation(best.t.r, best.t.t * s);
+        let pose = DAffine3::from_mat3_translation(best.t.matrix3, best.t.translation * s);
         return Ok(Landmarks {
             outer_eye_right: out[L::OuterEyeRight as usize],
             inner_eye_right: out[L::InnerEyeRight as usize],
@@ -473,7 +474,7 @@ pub fn detect_with(
 fn refine_all(
     idx: &SurfaceIndex,
     model: &GenericModel,
-    t: &Rigid,
+    t: &DAffine3,
     conf_fit: f64,
     debug: bool,
 ) -> ([Landmark; 5], f64) {
@@ -486,7 +487,7 @@ fn refine_all(
     }; 5];
     let mut weakest = 1.0_f64;
     for name in L::ALL {
-        let pred = t.apply(model.landmark(name));
+        let pred = t.transform_point3(model.landmark(name));
         let tpl = model.patches[name as usize].pairs();
         // The nose tip is a strong feature but far from the eyes that dominate the pose: wider
         // search.
@@ -524,7 +525,7 @@ fn regressed(
     mesh: &TriMesh,
     model: &GenericModel,
     reg: &crate::LandmarkRegressor,
-    t: &Rigid,
+    t: &DAffine3,
     tpl: &[Landmark; 5],
     debug: bool,
 ) -> [Landmark; 5] {
@@ -542,7 +543,7 @@ fn regressed(
         if !(off.is_finite() && off.length() <= 0.5 * model.eye_distance()) {
             continue;
         }
-        let v = idx.query(t.apply(q[k])).vertex;
+        let v = idx.query(t.transform_point3(q[k])).vertex;
         if debug {
             eprintln!(
                 "{name}: regressed to vertex {v} (template search gave {})",
@@ -577,13 +578,13 @@ fn fit_confidence(f: &FitScore, typical_rms: f64, typical_inliers: f64) -> f64 {
 fn refine(
     idx: &SurfaceIndex,
     tpl: &[(DVec3, DVec3)],
-    pose: &Rigid,
+    pose: &DAffine3,
     pred: DVec3,
     radius: f64,
     tau: f64,
 ) -> (u32, f64) {
     let tau2 = tau * tau;
-    let rotated: Vec<DVec3> = tpl.iter().map(|(q, _)| pose.rotate(*q)).collect();
+    let rotated: Vec<DVec3> = tpl.iter().map(|(q, _)| pose.transform_vector3(*q)).collect();
     let eval = |c: DVec3, pts: &mut dyn Iterator<Item = &DVec3>| -> f64 {
         let mut s = 0.0;
         let mut n = 0usize;

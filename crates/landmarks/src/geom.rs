@@ -1,147 +1,11 @@
-//! Small geometric helpers: symmetric eigen-decomposition, weighted Kabsch/Horn fit, nearest
-//! vertex queries with a point-to-surface approximation, point-to-plane ICP.
+//! The surface index of the detector (nearest vertex queries with a point-to-surface
+//! approximation), the fit score of a template pose, and point-to-plane ICP onto the index.
 
 #![allow(clippy::needless_range_loop)] // Dense small linear algebra reads best with indices.
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
-use meshcore::{DMat3, DQuat, DVec3};
-
-/// A rigid motion `x -> r x + t`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Rigid {
-    /// Rotation.
-    pub r: DMat3,
-    /// Translation.
-    pub t: DVec3,
-}
-
-impl Rigid {
-    /// The identity motion.
-    pub const IDENTITY: Self = Self {
-        r: DMat3::IDENTITY,
-        t: DVec3::ZERO,
-    };
-
-    /// Applies the motion to a point.
-    pub fn apply(&self, p: DVec3) -> DVec3 {
-        self.r * p + self.t
-    }
-
-    /// Applies the rotation to a vector.
-    pub fn rotate(&self, v: DVec3) -> DVec3 {
-        self.r * v
-    }
-
-    /// `self` after `other`: `x -> self(other(x))`.
-    pub fn compose(&self, other: &Rigid) -> Rigid {
-        Rigid {
-            r: self.r * other.r,
-            t: self.r * other.t + self.t,
-        }
-    }
-
-    /// The inverse motion.
-    pub fn inverse(&self) -> Rigid {
-        let rt = self.r.transpose();
-        Rigid {
-            r: rt,
-            t: -(rt * self.t),
-        }
-    }
-}
-
-/// Jacobi eigen-decomposition of a symmetric 4x4 matrix: eigenvalues and eigenvectors (columns).
-fn jacobi4(mut a: [[f64; 4]; 4]) -> ([f64; 4], [[f64; 4]; 4]) {
-    let mut v = [[0.0; 4]; 4];
-    for (i, row) in v.iter_mut().enumerate() {
-        row[i] = 1.0;
-    }
-    for _sweep in 0..50 {
-        let mut off = 0.0;
-        for i in 0..4 {
-            for j in i + 1..4 {
-                off += a[i][j] * a[i][j];
-            }
-        }
-        let diag: f64 = (0..4).map(|i| a[i][i] * a[i][i]).sum();
-        if off <= 1e-30 * diag.max(1e-300) {
-            break;
-        }
-        for p in 0..4 {
-            for q in p + 1..4 {
-                if a[p][q].abs() < 1e-300 {
-                    continue;
-                }
-                let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
-                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
-                let t = if theta == 0.0 { 1.0 } else { t };
-                let c = 1.0 / (t * t + 1.0).sqrt();
-                let s = t * c;
-                for k in 0..4 {
-                    let akp = a[k][p];
-                    let akq = a[k][q];
-                    a[k][p] = c * akp - s * akq;
-                    a[k][q] = s * akp + c * akq;
-                }
-                for k in 0..4 {
-                    let apk = a[p][k];
-                    let aqk = a[q][k];
-                    a[p][k] = c * apk - s * aqk;
-                    a[q][k] = s * apk + c * aqk;
-                }
-                for row in v.iter_mut() {
-                    let vkp = row[p];
-                    let vkq = row[q];
-                    row[p] = c * vkp - s * vkq;
-                    row[q] = s * vkp + c * vkq;
-                }
-            }
-        }
-    }
-    ([a[0][0], a[1][1], a[2][2], a[3][3]], v)
-}
-
-/// Least-squares rigid motion (proper rotation) mapping `src[i]` onto `dst[i]` with weights
-/// (Horn's quaternion method). `None` for fewer than one pair or non-positive total weight.
-pub fn kabsch(src: &[DVec3], dst: &[DVec3], w: Option<&[f64]>) -> Option<Rigid> {
-    let n = src.len().min(dst.len());
-    if n == 0 {
-        return None;
-    }
-    let wt = |i: usize| w.map_or(1.0, |w| w[i]);
-    let sw: f64 = (0..n).map(wt).sum();
-    if sw <= 0.0 || !sw.is_finite() {
-        return None;
-    }
-    let cs = (0..n).map(|i| src[i] * wt(i)).sum::<DVec3>() / sw;
-    let cd = (0..n).map(|i| dst[i] * wt(i)).sum::<DVec3>() / sw;
-    let mut s = [[0.0; 3]; 3];
-    for i in 0..n {
-        let a = src[i] - cs;
-        let b = dst[i] - cd;
-        let (a, b) = (a.to_array(), b.to_array());
-        for (j, row) in s.iter_mut().enumerate() {
-            for (k, x) in row.iter_mut().enumerate() {
-                *x += wt(i) * a[j] * b[k];
-            }
-        }
-    }
-    let [[sxx, sxy, sxz], [syx, syy, syz], [szx, szy, szz]] = s;
-    let m = [
-        [sxx + syy + szz, syz - szy, szx - sxz, sxy - syx],
-        [syz - szy, sxx - syy - szz, sxy + syx, szx + sxz],
-        [szx - sxz, sxy + syx, -sxx + syy - szz, syz + szy],
-        [sxy - syx, szx + sxz, syz + szy, -sxx - syy + szz],
-    ];
-    let (vals, vecs) = jacobi4(m);
-    let best = (0..4).max_by(|&a, &b| vals[a].total_cmp(&vals[b]))?;
-    let q = DQuat::from_xyzw(vecs[1][best], vecs[2][best], vecs[3][best], vecs[0][best]);
-    if !q.is_finite() || q.length() < 1e-12 {
-        return None;
-    }
-    let r = DMat3::from_quat(q.normalize());
-    Some(Rigid { r, t: cd - r * cs })
-}
+use meshcore::linalg::solve_sym_tol;
+use meshcore::{DAffine3, DMat3, DQuat, DVec3};
 
 /// Vertex positions and normals with a k-d tree, answering approximate point-to-surface distances.
 #[derive(Debug)]
@@ -227,7 +91,7 @@ pub struct FitScore {
 pub fn score(
     idx: &SurfaceIndex,
     pts: &[(DVec3, DVec3)],
-    t: &Rigid,
+    t: &DAffine3,
     tau: f64,
     min_dot: f64,
 ) -> FitScore {
@@ -236,9 +100,9 @@ pub fn score(
     let mut inl = 0usize;
     let mut sse = 0.0;
     for (p, n) in pts {
-        let q = t.apply(*p);
+        let q = t.transform_point3(*p);
         let h = idx.query(q);
-        let ok = h.d2 < tau2 && idx.nrm[h.vertex as usize].dot(t.rotate(*n)) > min_dot;
+        let ok = h.d2 < tau2 && idx.nrm[h.vertex as usize].dot(t.transform_vector3(*n)) > min_dot;
         if ok {
             cost += h.d2;
             sse += h.d2;
@@ -264,11 +128,11 @@ pub fn score(
 pub fn icp(
     idx: &SurfaceIndex,
     pts: &[(DVec3, DVec3)],
-    t0: &Rigid,
+    t0: &DAffine3,
     iterations: usize,
     tau: f64,
     min_dot: f64,
-) -> Rigid {
+) -> DAffine3 {
     let mut t = *t0;
     let tau2 = tau * tau;
     for _ in 0..iterations {
@@ -276,10 +140,10 @@ pub fn icp(
         let mut atb = [0.0; 6];
         let mut count = 0;
         for (p, n) in pts {
-            let q = t.apply(*p);
+            let q = t.transform_point3(*p);
             let h = idx.query(q);
             let vn = idx.nrm[h.vertex as usize];
-            if h.d2 >= tau2 || vn.dot(t.rotate(*n)) <= min_dot {
+            if h.d2 >= tau2 || vn.dot(t.transform_vector3(*n)) <= min_dot {
                 continue;
             }
             let target = idx.pos[h.vertex as usize];
@@ -303,7 +167,7 @@ pub fn icp(
         for (i, row) in ata.iter_mut().enumerate() {
             row[i] += 1e-9 * tr + 1e-300;
         }
-        let Some(x) = crate::curvature::solve_dense(ata, atb) else {
+        let Some(x) = solve_sym_tol(ata, atb, 1e-13) else {
             break;
         };
         let w = DVec3::new(x[0], x[1], x[2]);
@@ -314,16 +178,12 @@ pub fn icp(
         } else {
             DMat3::IDENTITY
         };
-        let step = Rigid { r: dr, t: dt };
-        t = step.compose(&t);
-        if angle < 1e-7 && dt.length() < 1e-7 * (1.0 + t.t.length()) {
+        t = DAffine3::from_mat3_translation(dr, dt) * t;
+        if angle < 1e-7 && dt.length() < 1e-7 * (1.0 + t.translation.length()) {
             break;
         }
     }
     // Re-orthonormalise the rotation (accumulated round-off).
-    let q = DQuat::from_mat3(&t.r).normalize();
-    Rigid {
-        r: DMat3::from_quat(q),
-        t: t.t,
-    }
+    let q = DQuat::from_mat3(&t.matrix3).normalize();
+    DAffine3::from_mat3_translation(DMat3::from_quat(q), t.translation)
 }

@@ -4,10 +4,10 @@
 #![allow(clippy::needless_range_loop)] // Dense small linear algebra reads best with indices.
 
 use crate::curvature::{vertex_curvatures, CurvatureOptions};
-use crate::geom::{kabsch, Rigid};
 use crate::regress::LandmarkRegressor;
 use crate::{LandmarkError, LandmarkName};
-use meshcore::{DVec3, TriMesh};
+use meshcore::linalg::{fit_rigid, rigid_inverse};
+use meshcore::{DAffine3, DVec3, TriMesh};
 use serde::{Deserialize, Serialize};
 
 /// The default model shipped with the crate, trained by `cargo xtask landmarks-eval --write-default`
@@ -180,8 +180,8 @@ impl DepthMap {
     }
 
     /// Rasterises the triangles of `mesh` moved by `t`, keeping the largest `z` per node.
-    fn rasterise(&mut self, mesh: &TriMesh, t: &Rigid) {
-        let pos: Vec<DVec3> = mesh.positions().iter().map(|p| t.apply(*p)).collect();
+    fn rasterise(&mut self, mesh: &TriMesh, t: &DAffine3) {
+        let pos: Vec<DVec3> = mesh.positions().iter().map(|p| t.transform_point3(*p)).collect();
         self.rasterise_moved(&pos, mesh.triangles());
     }
 
@@ -257,7 +257,7 @@ impl DepthAccumulator {
         }
     }
 
-    fn add(&mut self, mesh: &TriMesh, t: &Rigid) {
+    fn add(&mut self, mesh: &TriMesh, t: &DAffine3) {
         let mut m = DepthMap::new(self.center, self.radius, self.h);
         m.rasterise(mesh, t);
         for k in 0..m.z.len() {
@@ -456,17 +456,17 @@ impl GenericModel {
         }
         // Generalised Procrustes (rigid) of the landmark sets.
         let mut mean: Vec<DVec3> = faces[0].1.to_vec();
-        let mut aligns: Vec<Rigid> = vec![Rigid::IDENTITY; faces.len()];
+        let mut aligns: Vec<DAffine3> = vec![DAffine3::IDENTITY; faces.len()];
         for _ in 0..5 {
             for (k, (_, l)) in faces.iter().enumerate() {
-                aligns[k] = kabsch(l, &mean, None).ok_or_else(|| {
+                aligns[k] = fit_rigid(l, &mean, None).ok_or_else(|| {
                     LandmarkError::InvalidTraining(format!("face {k}: degenerate landmarks"))
                 })?;
             }
             let mut acc = [DVec3::ZERO; 5];
             for (k, (_, l)) in faces.iter().enumerate() {
                 for (a, p) in acc.iter_mut().zip(l) {
-                    *a += aligns[k].apply(*p);
+                    *a += aligns[k].transform_point3(*p);
                 }
             }
             mean = acc.iter().map(|a| *a / faces.len() as f64).collect();
@@ -481,9 +481,9 @@ impl GenericModel {
         for (k, (mesh, _)) in faces.iter().enumerate() {
             for f in 0..mesh.n_faces() as u32 {
                 let [a, b, c] = mesh.face_corners(f);
-                let g = aligns[k].apply((a + b + c) / 3.0);
+                let g = aligns[k].transform_point3((a + b + c) / 3.0);
                 if (g - nose).length() < 2.0 * d0 {
-                    fwd += aligns[k].rotate(mesh.face_cross(f));
+                    fwd += aligns[k].transform_vector3(mesh.face_cross(f));
                 }
             }
         }
@@ -503,12 +503,9 @@ impl GenericModel {
             ));
         }
         let rot = meshcore::DMat3::from_cols(x, y, z).transpose();
-        let to_canon = Rigid {
-            r: rot,
-            t: -(rot * nose),
-        };
-        let canon: Vec<DVec3> = mean.iter().map(|p| to_canon.apply(*p)).collect();
-        let aligns: Vec<Rigid> = aligns.iter().map(|a| to_canon.compose(a)).collect();
+        let to_canon = DAffine3::from_mat3_translation(rot, -(rot * nose));
+        let canon: Vec<DVec3> = mean.iter().map(|p| to_canon.transform_point3(*p)).collect();
+        let aligns: Vec<DAffine3> = aligns.iter().map(|a| to_canon * *a).collect();
         let d = (canon[L::InnerEyeLeft as usize] - canon[L::InnerEyeRight as usize]).length();
         if !(d.is_finite() && d > 0.0) {
             return Err(LandmarkError::InvalidTraining(
@@ -539,7 +536,7 @@ impl GenericModel {
             let vn = nearest_vertex(mesh, l[L::NoseTip as usize]);
             nose_s.push(curv[vn].shape_index());
             nose_c.push(curv[vn].curvedness());
-            nose_n += a.rotate(curv[vn].normal);
+            nose_n += a.transform_vector3(curv[vn].normal);
             for e in [L::InnerEyeRight, L::InnerEyeLeft] {
                 let ve = nearest_vertex(mesh, l[e as usize]);
                 eye_s.push(curv[ve].shape_index());
@@ -585,7 +582,7 @@ impl GenericModel {
         let mut inl = Vec::new();
         for (k, (mesh, _)) in faces.iter().enumerate() {
             let idx = crate::detect::surface_index(mesh);
-            let inv = aligns[k].inverse();
+            let inv = rigid_inverse(&aligns[k]);
             let s = crate::geom::score(
                 &idx,
                 &model.face.pairs(),

@@ -12,9 +12,9 @@
 
 #![allow(clippy::needless_range_loop)] // Dense small linear algebra reads best with indices.
 
-use crate::geom::Rigid;
 use crate::model::{DepthMap, GenericModel};
 use crate::{LandmarkError, LandmarkName};
+use meshcore::linalg::rigid_inverse;
 use meshcore::{DAffine3, DVec3, TriMesh};
 use serde::{Deserialize, Serialize};
 
@@ -163,7 +163,7 @@ fn cholesky_solve(mut a: Vec<f64>, n: usize, mut b: Vec<[f64; 3]>) -> Option<Vec
 /// A deterministic pseudo-random rigid motion: rotation by an angle with standard deviation
 /// `angle` about a random axis through the origin, then a translation with standard deviation
 /// `shift` per coordinate (splitmix64 and Box-Muller on `seed`).
-fn perturbation(seed: u64, angle: f64, shift: f64) -> Rigid {
+fn perturbation(seed: u64, angle: f64, shift: f64) -> DAffine3 {
     let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0xD1B5_4A32_D192_ED03;
     let mut uniform = || {
         state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
@@ -185,15 +185,9 @@ fn perturbation(seed: u64, angle: f64, shift: f64) -> Rigid {
         meshcore::DMat3::from_axis_angle(axis, a)
     };
     let t = DVec3::new(normal(), normal(), normal()) * shift;
-    Rigid { r, t }
+    DAffine3::from_mat3_translation(r, t)
 }
 
-fn rigid_of(a: &DAffine3) -> Rigid {
-    Rigid {
-        r: a.matrix3,
-        t: a.translation,
-    }
-}
 
 impl LandmarkRegressor {
     /// Trains the regression on faces with their true landmarks ([`LandmarkName::ALL`] order)
@@ -238,9 +232,8 @@ impl LandmarkRegressor {
         let mut ys: Vec<Vec<DVec3>> = vec![Vec::new(); 5];
         let mut used = 0;
         for (mesh, truth, pose) in samples {
-            let t = rigid_of(pose);
-            let inv = t.inverse();
-            let canon_truth = truth.map(|p| inv.apply(p));
+            let inv = rigid_inverse(pose);
+            let canon_truth = truth.map(|p| inv.transform_point3(p));
             let wrong = LandmarkName::ALL
                 .iter()
                 .any(|&n| (canon_truth[n as usize] - model.landmark(n)).length() > 0.5 * d);
@@ -248,13 +241,13 @@ impl LandmarkRegressor {
                 continue;
             }
             used += 1;
-            let canon: Vec<DVec3> = mesh.positions().iter().map(|p| inv.apply(*p)).collect();
+            let canon: Vec<DVec3> = mesh.positions().iter().map(|p| inv.transform_point3(*p)).collect();
             // The detected pose, then the same pose moved by small random rigid motions about
             // the nose tip (canonical origin): the regression then learns to correct pose errors
             // too, not only the offsets seen under the detector's typical pose error.
             for j in 0..=opt.perturbations {
                 let delta = if j == 0 {
-                    Rigid::IDENTITY
+                    DAffine3::IDENTITY
                 } else {
                     perturbation(
                         (used as u64) << 16 | j as u64,
@@ -262,11 +255,11 @@ impl LandmarkRegressor {
                         opt.perturb_shift * d,
                     )
                 };
-                let di = delta.inverse();
-                let moved: Vec<DVec3> = canon.iter().map(|p| di.apply(*p)).collect();
+                let di = rigid_inverse(&delta);
+                let moved: Vec<DVec3> = canon.iter().map(|p| di.transform_point3(*p)).collect();
                 for (k, p) in patches.iter().enumerate() {
                     xs[k].push(raw_inputs(&patch_depths(&moved, mesh.triangles(), p)));
-                    ys[k].push(di.apply(canon_truth[k]) - DVec3::from_array(p.center));
+                    ys[k].push(di.transform_point3(canon_truth[k]) - DVec3::from_array(p.center));
                 }
             }
         }
@@ -376,9 +369,9 @@ impl LandmarkRegressor {
 
     /// Predicted landmark positions in the canonical frame, for a mesh (model units) and its
     /// fitted model-to-mesh pose.
-    pub(crate) fn predict(&self, mesh: &TriMesh, pose: &Rigid) -> [DVec3; 5] {
-        let inv = pose.inverse();
-        let canon: Vec<DVec3> = mesh.positions().iter().map(|p| inv.apply(*p)).collect();
+    pub(crate) fn predict(&self, mesh: &TriMesh, pose: &DAffine3) -> [DVec3; 5] {
+        let inv = rigid_inverse(pose);
+        let canon: Vec<DVec3> = mesh.positions().iter().map(|p| inv.transform_point3(*p)).collect();
         let mut out = [DVec3::ZERO; 5];
         for (k, p) in self.patches.iter().enumerate().take(5) {
             let x = raw_inputs(&patch_depths(&canon, mesh.triangles(), p));
@@ -463,7 +456,7 @@ mod tests {
         // off by the whole shift).
         let (mut err, mut base) = (0.0, 0.0);
         for (m, l) in &faces[48..] {
-            let q = reg.predict(m, &Rigid::IDENTITY);
+            let q = reg.predict(m, &DAffine3::IDENTITY);
             for k in 0..5 {
                 let t = DVec3::new(l[k].x, l[k].y, 0.0);
                 err += (DVec3::new(q[k].x, q[k].y, 0.0) - t).length();
@@ -502,8 +495,8 @@ mod tests {
         assert_ne!(a.patches, b.patches, "the perturbed samples change the fit");
         assert_eq!(b, c, "same samples, same regression");
         let p = perturbation(7, 2f64.to_radians(), 0.1);
-        assert!((p.r.determinant() - 1.0).abs() < 1e-12);
-        assert!(p.t.length() < 1.0 && p != Rigid::IDENTITY);
+        assert!((p.matrix3.determinant() - 1.0).abs() < 1e-12);
+        assert!(p.translation.length() < 1.0 && p != DAffine3::IDENTITY);
     }
 
     #[test]

@@ -262,7 +262,7 @@ pub(crate) fn parse_bnt_grid(bytes: &[u8], file: &str) -> Result<BntGrid, IoErro
 pub fn read_bnt_grid(path: impl AsRef<Path>) -> Result<BntGrid, IoError> {
     let path = path.as_ref();
     let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| IoError::io(&name, e))?;
+    let bytes = std::fs::read(path).map_err(|e| IoError::io("read", path, e))?;
     parse_bnt_grid(&bytes, &name)
 }
 
@@ -270,7 +270,7 @@ pub fn read_bnt_grid(path: impl AsRef<Path>) -> Result<BntGrid, IoError> {
 pub fn read_bnt(path: impl AsRef<Path>, options: &BntOptions) -> Result<LoadedMesh, IoError> {
     let path = path.as_ref();
     let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| IoError::io(&name, e))?;
+    let bytes = std::fs::read(path).map_err(|e| IoError::io("read", path, e))?;
     read_bnt_bytes(&bytes, &name, options)
 }
 
@@ -467,7 +467,7 @@ pub fn write_bnt(path: impl AsRef<Path>, grid: &BntGrid) -> Result<(), IoError> 
     let name = path.display().to_string();
     grid.check_writable()
         .map_err(|e| IoError::invalid(&name, e))?;
-    std::fs::write(path, grid.to_bytes()).map_err(|e| IoError::io(&name, e))
+    std::fs::write(path, grid.to_bytes()).map_err(|e| IoError::io("write", path, e))
 }
 
 /// Parses the bytes of a `.bnt` file into a grid (`file` names it in errors).

@@ -1,5 +1,6 @@
 use meshcore::MeshError;
 use std::fmt;
+use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 /// Where in a file a problem was found.
@@ -26,11 +27,13 @@ impl fmt::Display for Location {
 /// Errors of the mesh readers and writers. Every variant names the file.
 #[derive(Debug, Error)]
 pub enum IoError {
-    /// The operating system could not read or write the file.
-    #[error("{file}: {source}")]
+    /// The operating system could not read or write the file (the OS error is the source).
+    #[error("cannot {action} {}", path.display())]
     Io {
+        /// What was being done: `"read"` or `"write"`.
+        action: &'static str,
         /// The file.
-        file: String,
+        path: PathBuf,
         /// The underlying error.
         #[source]
         source: std::io::Error,
@@ -104,9 +107,10 @@ impl IoError {
         Self::malformed(file, Location::File, problem)
     }
 
-    pub(crate) fn io(file: &str, source: std::io::Error) -> Self {
+    pub(crate) fn io(action: &'static str, path: &Path, source: std::io::Error) -> Self {
         IoError::Io {
-            file: file.to_string(),
+            action,
+            path: path.to_path_buf(),
             source,
         }
     }

@@ -626,7 +626,7 @@ pub fn write_glb(path: impl AsRef<Path>, scene: &GltfScene) -> Result<(), IoErro
     let path = path.as_ref();
     let name = path.display().to_string();
     let bytes = glb_bytes(scene, &name)?;
-    std::fs::write(path, bytes).map_err(|e| IoError::io(&name, e))
+    std::fs::write(path, bytes).map_err(|e| IoError::io("write", path, e))
 }
 
 /// Serialises a scene as GLB bytes in memory.

@@ -114,7 +114,7 @@ pub fn parse_lm3(bytes: &[u8], file: &str) -> Result<Landmarks3d, IoError> {
 pub fn read_lm3(path: impl AsRef<Path>) -> Result<Landmarks3d, IoError> {
     let path = path.as_ref();
     let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| IoError::io(&name, e))?;
+    let bytes = std::fs::read(path).map_err(|e| IoError::io("read", path, e))?;
     parse_lm3(&bytes, &name)
 }
 
@@ -171,7 +171,7 @@ pub fn parse_lm2(bytes: &[u8], file: &str) -> Result<Landmarks2d, IoError> {
 pub fn read_lm2(path: impl AsRef<Path>) -> Result<Landmarks2d, IoError> {
     let path = path.as_ref();
     let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| IoError::io(&name, e))?;
+    let bytes = std::fs::read(path).map_err(|e| IoError::io("read", path, e))?;
     parse_lm2(&bytes, &name)
 }
 
@@ -251,5 +251,5 @@ pub fn write_lm3_with_notes(
         push_f64(&mut s, p.z);
         s.push('\n');
     }
-    std::fs::write(path, s).map_err(|e| IoError::io(&name, e))
+    std::fs::write(path, s).map_err(|e| IoError::io("write", path, e))
 }

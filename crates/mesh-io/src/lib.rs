@@ -47,7 +47,6 @@ pub use npy::{parse_npy_f32, read_npy_f32};
 pub use ply::{PlyEncoding, PlyWriteOptions};
 
 use meshcore::{DVec3, TriMesh};
-use std::collections::HashMap;
 use std::path::Path;
 
 /// The mesh file formats known to [`read_mesh`] and [`write_mesh`].
@@ -132,16 +131,9 @@ pub struct LoadedMesh {
     pub warnings: Vec<String>,
 }
 
-/// What [`LoadedMesh::weld`] or [`LoadedMesh::drop_degenerate`] changed.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct RepairSummary {
-    /// Vertices merged into an earlier one.
-    pub welded_vertices: usize,
-    /// Faces removed (degenerate, or collapsed by welding).
-    pub removed_faces: usize,
-    /// Vertices removed because no face used them any more.
-    pub removed_vertices: usize,
-}
+/// What [`LoadedMesh::weld`] or [`LoadedMesh::drop_degenerate`] changed (the report of
+/// [`meshcore::repair`], which does the work).
+pub use meshcore::repair::RepairReport;
 
 impl LoadedMesh {
     /// A loaded mesh without extras; computes the warnings.
@@ -158,90 +150,45 @@ impl LoadedMesh {
 
     /// Merges vertices closer than `tol` (absolute length; `0` merges exact duplicates only),
     /// keeping the first occurrence and its extras, then removes faces that collapsed and
-    /// unused vertices.
-    pub fn weld(&mut self, tol: f64) -> RepairSummary {
-        let p = self.mesh.positions();
-        let remap = weld_map(p, tol.max(0.0));
-        let welded = remap
-            .iter()
-            .enumerate()
-            .filter(|(i, &j)| *i != j as usize)
-            .count();
-        let tris: Vec<[u32; 3]> = self
-            .mesh
-            .triangles()
-            .iter()
-            .map(|t| t.map(|v| remap[v as usize]))
-            .collect();
-        let mut s = self.compact(tris, 0.0);
-        s.welded_vertices = welded;
-        s.removed_vertices = s.removed_vertices.saturating_sub(welded);
-        s
+    /// unused vertices ([`meshcore::repair::weld_vertices`]). When no face would remain, the
+    /// mesh is left unchanged, a warning says so and the report is all zeros.
+    pub fn weld(&mut self, tol: f64) -> RepairReport {
+        let r = meshcore::repair::weld_vertices(&self.mesh, tol);
+        self.apply(r)
     }
 
     /// Removes faces with a repeated vertex or an area `<= rel_tol * bbox_diagonal^2`, then
-    /// unused vertices (extras follow their vertices).
-    pub fn drop_degenerate(&mut self, rel_tol: f64) -> RepairSummary {
-        let d = self.mesh.bbox().diagonal();
-        let tris = self.mesh.triangles().to_vec();
-        self.compact(tris, rel_tol * d * d)
+    /// unused vertices, extras following their vertices
+    /// ([`meshcore::repair::remove_degenerate_faces`]). When no face would remain, the mesh is
+    /// left unchanged, a warning says so and the report is all zeros.
+    pub fn drop_degenerate(&mut self, rel_tol: f64) -> RepairReport {
+        let r = meshcore::repair::remove_degenerate_faces(&self.mesh, rel_tol);
+        self.apply(r)
     }
 
-    fn compact(&mut self, tris: Vec<[u32; 3]>, area_thr: f64) -> RepairSummary {
-        let pos = self.mesh.positions();
-        let n_before = tris.len();
-        let kept: Vec<[u32; 3]> = tris
-            .into_iter()
-            .filter(|t| {
-                if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
-                    return false;
-                }
-                let [a, b, c] = t.map(|v| pos[v as usize]);
-                0.5 * (b - a).cross(c - a).length() > area_thr
-            })
-            .collect();
-        if kept.is_empty() {
+    fn apply(
+        &mut self,
+        r: Result<meshcore::repair::Repaired, meshcore::MeshError>,
+    ) -> RepairReport {
+        let Ok(r) = r else {
             // Refuse to produce an invalid (empty) mesh: leave it unchanged.
             self.warnings
                 .push("repair would remove every face; mesh left unchanged".into());
-            return RepairSummary::default();
-        }
-        let mut new_index = vec![u32::MAX; pos.len()];
-        let mut order = Vec::new();
-        let mut out = Vec::with_capacity(kept.len());
-        for t in &kept {
-            let mut nt = [0u32; 3];
-            for k in 0..3 {
-                let v = t[k] as usize;
-                if new_index[v] == u32::MAX {
-                    new_index[v] = order.len() as u32;
-                    order.push(v);
-                }
-                nt[k] = new_index[v];
-            }
-            out.push(nt);
-        }
-        let summary = RepairSummary {
-            welded_vertices: 0,
-            removed_faces: n_before - out.len(),
-            removed_vertices: pos.len() - order.len(),
+            return RepairReport::default();
         };
-        let new_pos: Vec<DVec3> = order.iter().map(|&v| pos[v]).collect();
+        let order = &r.source_vertices;
         if let Some(g) = &mut self.grid_index {
-            *g = order.iter().map(|&v| g[v]).collect();
+            *g = order.iter().map(|&v| g[v as usize]).collect();
         }
         if let Some(c) = &mut self.colors {
-            *c = order.iter().map(|&v| c[v]).collect();
+            *c = order.iter().map(|&v| c[v as usize]).collect();
         }
         for s in &mut self.scalars {
-            s.values = order.iter().map(|&v| s.values[v]).collect();
+            s.values = order.iter().map(|&v| s.values[v as usize]).collect();
         }
-        // Valid by construction: non-empty, indices in range, positions already finite.
-        if let Ok(m) = TriMesh::new(new_pos, out) {
-            self.mesh = m;
-        }
+        self.mesh = r.mesh;
         self.warnings = diagnose(&self.mesh);
-        summary
+        r.report
     }
 
     /// Checks that the extras have one entry per vertex.
@@ -271,91 +218,7 @@ impl LoadedMesh {
     }
 }
 
-/// For each vertex, the index of the first vertex within `tol` of it (itself if none).
-fn weld_map(p: &[DVec3], tol: f64) -> Vec<u32> {
-    let mut remap: Vec<u32> = (0..p.len() as u32).collect();
-    if tol == 0.0 {
-        // Sort (coordinates, index) and give every run of equal coordinates its first index:
-        // cache-friendly, unlike a hash table of half a million random probes.
-        let mut keyed: Vec<([u64; 3], u32)> = p
-            .iter()
-            .enumerate()
-            // +0.0 and -0.0 are the same point.
-            .map(|(i, q)| {
-                (
-                    [q.x + 0.0, q.y + 0.0, q.z + 0.0].map(f64::to_bits),
-                    i as u32,
-                )
-            })
-            .collect();
-        keyed.sort_unstable();
-        let mut start = 0;
-        while start < keyed.len() {
-            let mut end = start + 1;
-            while end < keyed.len() && keyed[end].0 == keyed[start].0 {
-                remap[keyed[end].1 as usize] = keyed[start].1;
-                end += 1;
-            }
-            start = end;
-        }
-        return remap;
-    }
-    let inv = 1.0 / tol;
-    let cell = |q: DVec3| {
-        [
-            (q.x * inv).floor() as i64,
-            (q.y * inv).floor() as i64,
-            (q.z * inv).floor() as i64,
-        ]
-    };
-    let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
-    for (i, &q) in p.iter().enumerate() {
-        let k = cell(q);
-        let mut found = None;
-        'outer: for dx in -1..=1 {
-            for dy in -1..=1 {
-                for dz in -1..=1 {
-                    if let Some(list) = grid.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) {
-                        if let Some(&j) =
-                            list.iter().find(|&&j| (p[j as usize] - q).length() <= tol)
-                        {
-                            found = Some(j);
-                            break 'outer;
-                        }
-                    }
-                }
-            }
-        }
-        match found {
-            Some(j) => remap[i] = j,
-            None => grid.entry(k).or_default().push(i as u32),
-        }
-    }
-    remap
-}
-
-/// Number of vertices that exactly repeat the position of an earlier vertex.
-pub fn count_duplicate_vertices(mesh: &TriMesh) -> usize {
-    weld_map(mesh.positions(), 0.0)
-        .iter()
-        .enumerate()
-        .filter(|(i, &j)| *i != j as usize)
-        .count()
-}
-
-/// Faces with a repeated vertex index or zero area (exactly).
-pub fn count_degenerate_faces(mesh: &TriMesh) -> usize {
-    mesh.triangles()
-        .iter()
-        .filter(|t| {
-            if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
-                return true;
-            }
-            let [a, b, c] = t.map(|v| mesh.positions()[v as usize]);
-            (b - a).cross(c - a) == DVec3::ZERO
-        })
-        .count()
-}
+pub use meshcore::repair::{count_degenerate_faces, count_duplicate_vertices};
 
 /// The warnings every reader attaches: exact duplicate vertices and degenerate faces.
 pub fn diagnose(mesh: &TriMesh) -> Vec<String> {
@@ -380,7 +243,7 @@ pub fn read_mesh(path: impl AsRef<Path>) -> Result<LoadedMesh, IoError> {
     let path = path.as_ref();
     let format = Format::from_path(path)?;
     let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| IoError::io(&name, e))?;
+    let bytes = std::fs::read(path).map_err(|e| IoError::io("read", path, e))?;
     let base = path.parent();
     read_bytes_named(&bytes, format, &name, base)
 }
@@ -447,7 +310,7 @@ pub fn write_mesh(path: impl AsRef<Path>, mesh: &LoadedMesh) -> Result<(), IoErr
     let name = path.display().to_string();
     let format = Format::from_path(path)?;
     let bytes = write_named(mesh, format, &name)?;
-    std::fs::write(path, bytes).map_err(|e| IoError::io(&name, e))
+    std::fs::write(path, bytes).map_err(|e| IoError::io("write", path, e))
 }
 
 /// Writes a PLY file with explicit options (encoding, colours, scalar properties).
@@ -459,7 +322,7 @@ pub fn write_ply(
     let path = path.as_ref();
     let name = path.display().to_string();
     let bytes = ply::write_ply(mesh, options, &name)?;
-    std::fs::write(path, bytes).map_err(|e| IoError::io(&name, e))
+    std::fs::write(path, bytes).map_err(|e| IoError::io("write", path, e))
 }
 
 /// Serialises a PLY file with explicit options into memory.

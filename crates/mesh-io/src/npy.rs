@@ -8,7 +8,7 @@ use std::path::Path;
 pub fn read_npy_f32(path: impl AsRef<Path>) -> Result<(Vec<usize>, Vec<f32>), IoError> {
     let path = path.as_ref();
     let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| IoError::io(&name, e))?;
+    let bytes = std::fs::read(path).map_err(|e| IoError::io("read", path, e))?;
     parse_npy_f32(&bytes, &name)
 }
 

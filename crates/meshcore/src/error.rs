@@ -58,4 +58,7 @@ pub enum MeshError {
     /// A query point is not finite.
     #[error("query point ({0}, {1}, {2}) is not finite")]
     NonFinitePoint(f64, f64, f64),
+    /// An option name that is none of the valid names (they are listed).
+    #[error(transparent)]
+    UnknownChoice(#[from] crate::UnknownChoice),
 }

@@ -6,17 +6,26 @@
 //!   boundary loops, connected components, manifold and orientation checks).
 //! * [`SurfacePoint`]: a point on the surface as (face, barycentric coordinates), with conversion
 //!   to a position and [`FaceLocator`] for the nearest surface point to an arbitrary 3D point.
-//! * [`repair`]: explicit, opt-in repairs (drop degenerate faces, weld duplicate vertices).
+//! * [`linalg`]: the small dense linear algebra of the workspace (3x3 symmetric eigen, SVD,
+//!   Kabsch and Horn rotations, the one rigid fit [`linalg::fit_rigid`]).
+//! * [`repair`]: explicit, opt-in repairs (drop degenerate faces, weld duplicate vertices),
+//!   the one implementation every reader and binary uses.
+//! * [`Choice`] and [`choice!`]: option enums that parse by name, with [`UnknownChoice`]
+//!   listing the valid names.
 //!
 //! Nothing here panics on user data: constructors return [`MeshError`].
 
+pub mod choice;
 mod error;
+pub mod linalg;
 mod locate;
 mod mesh;
 pub mod repair;
 pub mod shapes;
 mod topology;
+pub mod units;
 
+pub use choice::{Choice, UnknownChoice};
 pub use error::MeshError;
 pub use glam::{DAffine3, DMat3, DQuat, DVec3};
 pub use locate::{closest_point_on_triangle, FaceLocator};

@@ -16,6 +16,10 @@ pub enum Diagonals {
     /// Chequerboard: `a b c`, `a c d` where `i + j` is even, else along `b-d`: `a b d`, `b c d`.
     Alternating,
 }
+crate::choice!(Diagonals, "diagonal layout", MeshError {
+    Uniform = "uniform",
+    Alternating = "alternating",
+});
 
 /// Grid of `nx x ny` squares, counter-clockwise in the `(i, j)` parameter plane. Vertex
 /// `(i, j)`, `0 <= i <= nx`, `0 <= j <= ny`, has id `j * (nx + 1) + i` and the position

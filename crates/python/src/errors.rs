@@ -108,8 +108,15 @@ fn geodesic_kind(e: &geodesic::GeodesicError) -> Kind {
         | E::Mesh(meshcore::MeshError::FaceOutOfRange { .. })
         | E::Mesh(meshcore::MeshError::VertexOutOfRange { .. })
         | E::SourceOutOfRange { .. } => Kind::Index,
-        E::Mesh(_) | E::NoSource | E::UnknownMethod(_) | E::InvalidCutoff(_) => Kind::Input,
-        E::NotImplemented(_) | E::Numerical(_) => Kind::Computation,
+        E::Mesh(_)
+        | E::NoSource
+        | E::UnknownMethod(_)
+        | E::InvalidCutoff(_)
+        | E::InvalidDirection(_)
+        | E::InvalidLength(_) => Kind::Input,
+        E::NotImplemented(_) | E::Numerical(_) | E::DegenerateFace(_) | E::WalkFailed(_) => {
+            Kind::Computation
+        }
     }
 }
 

@@ -4,7 +4,7 @@ use crate::convert::{self, points_out, rows_out, vec_out};
 use crate::errors;
 use glam::DVec3;
 use mesh_io::{
-    Format, LoadedMesh, PlyEncoding, PlyWriteOptions, RepairSummary, ScalarField, ScalarType,
+    Format, LoadedMesh, PlyEncoding, PlyWriteOptions, RepairReport, ScalarField, ScalarType,
 };
 use meshcore::{FaceLocator, TriMesh};
 use numpy::PyArrayMethods;
@@ -29,7 +29,7 @@ impl PyMesh {
     }
 }
 
-fn summary_dict<'py>(py: Python<'py>, s: RepairSummary) -> PyResult<Bound<'py, PyDict>> {
+fn summary_dict<'py>(py: Python<'py>, s: RepairReport) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("welded_vertices", s.welded_vertices)?;
     d.set_item("removed_faces", s.removed_faces)?;

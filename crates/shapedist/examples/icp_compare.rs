@@ -145,7 +145,7 @@ fn main() {
                 println!("{name}: {ms:.2} ms, {iters} iterations");
                 return;
             }
-            let err = linalg::rotation_angle_between(r, rtrue).to_degrees();
+            let err = meshcore::linalg::rotation_angle_between(r, rtrue).to_degrees();
             let st = closest_point_stats(&a, &b, r, DVec3::ZERO);
             let nn = {
                 // source -> target RMSE only (as the peers' NN-RMSE)

@@ -21,7 +21,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::error::{ShapeDistError, Which};
-use crate::linalg::{axis_angle, kabsch_rotation, solve_sym, sym_eigen3};
+use meshcore::linalg::{axis_angle, kabsch_rotation, solve_sym, sym_eigen3};
 use crate::nn::{dist2, NeighbourGraph, PointTree, GROUP};
 use crate::points::{centred, check_spread, outer, principal_axes, radius, validate};
 
@@ -647,7 +647,7 @@ fn plane_step(
         }
     };
     let dr = axis_angle(w, w.length());
-    let nr = crate::linalg::orthonormalise(dr * r);
+    let nr = meshcore::linalg::orthonormalise(dr * r);
     let nt = if translation { dr * t + d } else { DVec3::ZERO };
     (nr, nt)
 }
@@ -846,7 +846,7 @@ pub fn global_icp(
             break;
         }
         if cands.iter().all(|d| {
-            crate::linalg::rotation_angle_between(d.rotation, c.rotation) > 10f64.to_radians()
+            meshcore::linalg::rotation_angle_between(d.rotation, c.rotation) > 10f64.to_radians()
         }) {
             cands.push(*c);
         }

@@ -6,7 +6,7 @@ use glam::{DMat3, DVec3};
 use serde::Serialize;
 
 use crate::error::{ShapeDistError, Which};
-use crate::linalg::{horn_rotation, kabsch_rotation};
+use meshcore::linalg::{horn_rotation, kabsch_rotation};
 use crate::points::{check_spread, outer, validate};
 
 /// Closed-form solver for the rotation.

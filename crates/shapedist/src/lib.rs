@@ -24,7 +24,6 @@
 mod error;
 pub mod icp;
 pub mod keyed;
-pub mod linalg;
 mod matrix;
 pub mod nn;
 pub mod points;

@@ -3,7 +3,7 @@
 use glam::{DMat3, DVec3};
 
 use crate::error::{ShapeDistError, Which};
-use crate::linalg::sym_eigen3;
+use meshcore::linalg::sym_eigen3;
 
 /// Checks that a set is non-empty and finite.
 pub fn validate(points: &[DVec3], which: Which) -> Result<(), ShapeDistError> {

@@ -128,7 +128,7 @@ fn distance_matches_the_singular_value_formula_and_kabsch_equals_horn() {
         .iter()
         .zip(&b)
         .fold(DMat3::ZERO, |m, (&x, &y)| m + points::outer(x - ca, y - cb));
-    let s = linalg::svd3(k);
+    let s = meshcore::linalg::svd3(k);
     let na: f64 = a.iter().map(|p| (*p - ca).length_squared()).sum();
     let nb: f64 = b.iter().map(|p| (*p - cb).length_squared()).sum();
     let expect = ((na + nb - 2.0 * (s.s[0] + s.s[1] + s.s[2])) / (na + nb)).sqrt();

@@ -9,7 +9,7 @@ use common::*;
 use proptest::prelude::*;
 use rand::Rng;
 use shapedist::glam::{DMat3, DVec3};
-use shapedist::linalg::kabsch_rotation;
+use meshcore::linalg::kabsch_rotation;
 use shapedist::nn::{
     dist2, nearest_brute_force, nearest_k_brute_force, NeighbourGraph, PointTree, GRAPH_K, GROUP,
 };
@@ -413,5 +413,5 @@ fn icp_results_do_not_depend_on_the_thread_count() {
     assert_eq!(one.rmse.to_bits(), two.rmse.to_bits());
     assert_eq!(one.iterations, 8);
     // And the iterations did move the source (the comparison is not between two no-ops).
-    assert!(shapedist::linalg::rotation_angle_between(one.rotation, DMat3::IDENTITY) > 0.1);
+    assert!(meshcore::linalg::rotation_angle_between(one.rotation, DMat3::IDENTITY) > 0.1);
 }

@@ -74,5 +74,5 @@ pub fn patch(r: &mut ChaCha8Rng, n: usize, shape_seed: u64) -> Vec<DVec3> {
 }
 
 pub fn angle_deg(a: DMat3, b: DMat3) -> f64 {
-    shapedist::linalg::rotation_angle_between(a, b).to_degrees()
+    meshcore::linalg::rotation_angle_between(a, b).to_degrees()
 }

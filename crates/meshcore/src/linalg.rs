@@ -1,12 +1,15 @@
-//! Small dense linear algebra: symmetric eigen-solvers (cyclic Jacobi), a robust 3x3 SVD,
-//! and the two closed-form rotation fits (Kabsch with the reflection guard, Horn's quaternions).
+//! Small dense linear algebra shared by the workspace: symmetric eigen-solvers (cyclic
+//! Jacobi), a robust 3x3 SVD, the two closed-form rotation fits (Kabsch with the reflection
+//! guard, Horn's quaternions), the one weighted rigid fit of paired points ([`fit_rigid`]),
+//! and a small dense solver.
 //!
 //! glam has no SVD or eigen-solver; these are tiny, allocation-free and accurate to a few ulps
-//! relative to the matrix norm.
+//! relative to the matrix norm. Rigid motions are [`glam::DAffine3`] with an orthonormal
+//! `matrix3`.
 
 #![allow(clippy::needless_range_loop)] // index loops read best in small dense linear algebra
 
-use glam::{DMat3, DQuat, DVec3};
+use glam::{DAffine3, DMat3, DQuat, DVec3};
 
 /// Eigen-decomposition of a symmetric `N x N` matrix by cyclic Jacobi rotations.
 ///
@@ -228,8 +231,20 @@ pub fn axis_angle(axis: DVec3, angle: f64) -> DMat3 {
 }
 
 /// Solves the symmetric positive (semi-)definite system `A x = b` (size `N`) by Gaussian
-/// elimination with partial pivoting; returns `None` when singular.
+/// elimination with partial pivoting; returns `None` when singular (a pivot at most
+/// `1e-14` times the largest entry). See [`solve_sym_tol`].
 pub fn solve_sym<const N: usize>(a: [[f64; N]; N], b: [f64; N]) -> Option<[f64; N]> {
+    solve_sym_tol(a, b, 1e-14)
+}
+
+/// [`solve_sym`] with the singularity threshold `rel_pivot`: `None` when a pivot is at most
+/// `rel_pivot` times the largest absolute entry of `A` (for a positive semi-definite `A`, the
+/// largest diagonal entry), or when `A` is zero or not finite.
+pub fn solve_sym_tol<const N: usize>(
+    a: [[f64; N]; N],
+    b: [f64; N],
+    rel_pivot: f64,
+) -> Option<[f64; N]> {
     let mut m = a;
     let mut r = b;
     let scale = m.iter().flatten().fold(0.0f64, |s, x| s.max(x.abs()));
@@ -238,7 +253,7 @@ pub fn solve_sym<const N: usize>(a: [[f64; N]; N], b: [f64; N]) -> Option<[f64; 
     }
     for c in 0..N {
         let piv = (c..N).max_by(|&i, &j| m[i][c].abs().total_cmp(&m[j][c].abs()))?;
-        if m[piv][c].abs() <= scale * 1e-14 {
+        if m[piv][c].abs() <= scale * rel_pivot {
             return None;
         }
         m.swap(c, piv);
@@ -260,6 +275,50 @@ pub fn solve_sym<const N: usize>(a: [[f64; N]; N], b: [f64; N]) -> Option<[f64; 
         x[i] = acc / m[i][i];
     }
     Some(x)
+}
+
+/// The inverse of a rigid motion (`matrix3` orthonormal): `x -> R^T (x - t)`, with the
+/// transpose instead of a general inverse.
+pub fn rigid_inverse(m: &DAffine3) -> DAffine3 {
+    let rt = m.matrix3.transpose();
+    DAffine3::from_mat3_translation(rt, -(rt * m.translation))
+}
+
+/// Least-squares rigid motion `x -> R x + t` (proper rotation, `det R = +1`) mapping `src[i]`
+/// onto `dst[i]`, minimising `sum w_i |R src_i + t - dst_i|^2`: the weighted centroids are
+/// matched and `R` is the Kabsch rotation of the centred cross-covariance
+/// `K = sum w_i (dst_i - c_dst)(src_i - c_src)^T` ([`kabsch_rotation`], reflection guard
+/// included, so a mirror image is never returned).
+///
+/// `None` when the slices are empty or of different lengths, when `weights` has another
+/// length, a negative or non-finite weight or a zero total, or when the input is not finite.
+/// With fewer than three non-collinear points the rotation is not unique; one of the optimal
+/// rotations is returned.
+pub fn fit_rigid(src: &[DVec3], dst: &[DVec3], weights: Option<&[f64]>) -> Option<DAffine3> {
+    let n = src.len();
+    if n == 0 || dst.len() != n || weights.is_some_and(|w| w.len() != n) {
+        return None;
+    }
+    if weights.is_some_and(|w| w.iter().any(|x| !(x.is_finite() && *x >= 0.0))) {
+        return None;
+    }
+    let wt = |i: usize| weights.map_or(1.0, |w| w[i]);
+    let sw: f64 = (0..n).map(wt).sum();
+    if !(sw > 0.0 && sw.is_finite()) {
+        return None;
+    }
+    let cs = (0..n).map(|i| src[i] * wt(i)).sum::<DVec3>() / sw;
+    let cd = (0..n).map(|i| dst[i] * wt(i)).sum::<DVec3>() / sw;
+    let k = (0..n).fold(DMat3::ZERO, |k, i| {
+        let (a, b) = ((dst[i] - cd) * wt(i), src[i] - cs);
+        k + DMat3::from_cols(a * b.x, a * b.y, a * b.z)
+    });
+    if !k.is_finite() || !cs.is_finite() || !cd.is_finite() {
+        return None;
+    }
+    let (r, _) = kabsch_rotation(k);
+    r.is_finite()
+        .then(|| DAffine3::from_mat3_translation(r, cd - r * cs))
 }
 
 #[cfg(test)]
@@ -361,5 +420,109 @@ mod tests {
             assert!((y[i] - x[i]).abs() < 1e-14);
         }
         assert!(solve_sym([[1.0, 1.0], [1.0, 1.0]], [1.0, 2.0]).is_none());
+    }
+
+    #[test]
+    fn rigid_inverse_undoes_the_motion() {
+        let m = DAffine3::from_mat3_translation(
+            rot(DVec3::new(0.2, -1.0, 0.4), 2.2),
+            DVec3::new(3.0, -1.0, 0.5),
+        );
+        let p = DVec3::new(0.3, 0.7, -2.0);
+        let back = rigid_inverse(&m).transform_point3(m.transform_point3(p));
+        assert!((back - p).length() < 1e-14);
+    }
+
+    #[test]
+    fn fit_rigid_rejects_bad_input() {
+        let p = [DVec3::X, DVec3::Y, DVec3::Z];
+        assert!(fit_rigid(&[], &[], None).is_none());
+        assert!(fit_rigid(&p, &p[..2], None).is_none());
+        assert!(fit_rigid(&p, &p, Some(&[1.0, 1.0])).is_none());
+        assert!(fit_rigid(&p, &p, Some(&[1.0, -1.0, 1.0])).is_none());
+        assert!(fit_rigid(&p, &p, Some(&[0.0, 0.0, 0.0])).is_none());
+        assert!(fit_rigid(&p, &[DVec3::X, DVec3::Y, DVec3::NAN], None).is_none());
+    }
+
+    mod props {
+        use super::super::*;
+        use proptest::prelude::*;
+
+        fn vec3() -> impl Strategy<Value = DVec3> {
+            (-10.0..10.0f64, -10.0..10.0f64, -10.0..10.0f64).prop_map(|(x, y, z)| DVec3::new(x, y, z))
+        }
+
+        fn motion() -> impl Strategy<Value = DAffine3> {
+            (vec3(), 0.0..std::f64::consts::PI, vec3()).prop_filter_map("axis", |(ax, ang, t)| {
+                (ax.length() > 1e-3).then(|| {
+                    DAffine3::from_mat3_translation(axis_angle(ax, ang), t * 10.0)
+                })
+            })
+        }
+
+        /// Points spread in 3D (a tetrahedron plus random points).
+        fn cloud() -> impl Strategy<Value = Vec<DVec3>> {
+            proptest::collection::vec(vec3(), 0..20).prop_map(|mut v| {
+                v.extend([
+                    DVec3::new(4.0, 0.0, 0.0),
+                    DVec3::new(0.0, 5.0, 0.0),
+                    DVec3::new(0.0, 0.0, 6.0),
+                    DVec3::new(-3.0, -3.0, -3.0),
+                ]);
+                v
+            })
+        }
+
+        fn close(a: &DAffine3, b: &DAffine3, tol: f64) -> bool {
+            rotation_angle_between(a.matrix3, b.matrix3) < tol
+                && (a.translation - b.translation).length() < tol * (1.0 + b.translation.length())
+        }
+
+        proptest! {
+            #[test]
+            fn fit_rigid_recovers_a_random_motion(m in motion(), pts in cloud()) {
+                let dst: Vec<DVec3> = pts.iter().map(|p| m.transform_point3(*p)).collect();
+                let f = fit_rigid(&pts, &dst, None).unwrap();
+                prop_assert!(close(&f, &m, 1e-9), "{f:?} vs {m:?}");
+                prop_assert!((f.matrix3.determinant() - 1.0).abs() < 1e-12);
+            }
+
+            #[test]
+            fn fit_rigid_never_returns_a_reflection(pts in cloud(), axis in 0usize..3) {
+                // The mirror image of a cloud has no proper rigid fit; the result must still
+                // be a rotation.
+                let mut flip = DVec3::ONE;
+                flip[axis] = -1.0;
+                let dst: Vec<DVec3> = pts.iter().map(|p| *p * flip).collect();
+                let f = fit_rigid(&pts, &dst, None).unwrap();
+                prop_assert!((f.matrix3.determinant() - 1.0).abs() < 1e-12);
+                let rtr = f.matrix3.transpose() * f.matrix3;
+                prop_assert!(rtr.abs_diff_eq(DMat3::IDENTITY, 1e-12));
+            }
+
+            #[test]
+            fn fit_rigid_weights_select_the_pairs(
+                m in motion(),
+                other in motion(),
+                pts in cloud(),
+                w in proptest::collection::vec(0.1..3.0f64, 24),
+            ) {
+                // Inliers follow `m`, outliers (weight 0) follow `other`: the weighted fit is
+                // `m`; scaling all weights changes nothing.
+                let n_in = 4.min(pts.len());
+                let k = pts.len() - n_in;
+                let dst: Vec<DVec3> = pts
+                    .iter()
+                    .enumerate()
+                    .map(|(i, p)| if i < k { other.transform_point3(*p) } else { m.transform_point3(*p) })
+                    .collect();
+                let wts: Vec<f64> = (0..pts.len()).map(|i| if i < k { 0.0 } else { w[i] }).collect();
+                let f = fit_rigid(&pts, &dst, Some(&wts)).unwrap();
+                prop_assert!(close(&f, &m, 1e-8), "{f:?} vs {m:?}");
+                let w2: Vec<f64> = wts.iter().map(|x| x * 4.0).collect();
+                let g = fit_rigid(&pts, &dst, Some(&w2)).unwrap();
+                prop_assert!(close(&f, &g, 1e-12));
+            }
+        }
     }
 }

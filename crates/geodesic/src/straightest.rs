@@ -7,9 +7,38 @@
 //! walk ends at the Euclidean position; on a fine sphere mesh at the great-circle position.
 //! A path that reaches a boundary edge stops there (`truncated`). A path that hits a vertex
 //! exactly is nudged along the crossed edge by 1e-9 of its length (a measure-zero event).
+//!
+//! Bad input is an error, never a panic: a start vertex or surface point not on the mesh
+//! ([`GeodesicError::Mesh`]), a zero, non-finite or normal direction
+//! ([`GeodesicError::InvalidDirection`]), a negative or non-finite length
+//! ([`GeodesicError::InvalidLength`]), a walk into a zero-area face
+//! ([`GeodesicError::DegenerateFace`]).
 
-use anyhow::{bail, Result};
+use crate::GeodesicError;
 use meshcore::{DVec3, SurfacePoint, Topology, TriMesh};
+
+type Result<T> = std::result::Result<T, GeodesicError>;
+
+fn direction_error(message: impl Into<String>) -> GeodesicError {
+    GeodesicError::InvalidDirection(message.into())
+}
+
+fn walk_error(message: impl Into<String>) -> GeodesicError {
+    GeodesicError::WalkFailed(message.into())
+}
+
+/// Checks the inputs every walk shares: a finite non-zero direction and a finite length >= 0.
+fn check_walk_input(dir: DVec3, length: f64) -> Result<()> {
+    if !dir.is_finite() || dir == DVec3::ZERO {
+        return Err(direction_error(format!(
+            "walk direction {dir} must be finite and non-zero"
+        )));
+    }
+    if !(length.is_finite() && length >= 0.0) {
+        return Err(GeodesicError::InvalidLength(length));
+    }
+    Ok(())
+}
 
 /// One straight piece of a walk, inside one face (barycentric end points in that face).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -41,7 +70,7 @@ pub struct Walk {
     pub segments: Vec<WalkSegment>,
 }
 
-/// Prepared walker for one mesh (topology and normals built once).
+/// Prepared walker for one mesh (topology and normals built once); borrows the mesh.
 #[derive(Debug)]
 pub struct Walker<'a> {
     mesh: &'a TriMesh,
@@ -90,12 +119,21 @@ impl<'a> Walker<'a> {
     }
 
     /// Tangent direction at a point with normal `n`: `towards - p` projected on the tangent
-    /// plane, then rotated by `theta` (radians, counter-clockwise about `n`).
+    /// plane, then rotated by `theta` (radians, counter-clockwise about `n`). Errors
+    /// ([`GeodesicError::InvalidDirection`]) when an input is not finite or `towards - p` is zero
+    /// or along `n`.
     pub fn tangent_direction(p: DVec3, n: DVec3, towards: DVec3, theta: f64) -> Result<DVec3> {
+        if !(p.is_finite() && n.is_finite() && towards.is_finite() && theta.is_finite()) {
+            return Err(direction_error(format!(
+                "tangent direction inputs must be finite (p {p}, n {n}, towards {towards}, theta {theta})"
+            )));
+        }
         let d = towards - p;
         let r = (d - d.dot(n) * n).normalize_or_zero();
         if r == DVec3::ZERO {
-            bail!("reference direction is normal to the surface or zero");
+            return Err(direction_error(
+                "reference direction is normal to the surface or zero",
+            ));
         }
         let s = n.cross(r);
         Ok(theta.cos() * r + theta.sin() * s)
@@ -103,6 +141,7 @@ impl<'a> Walker<'a> {
 
     /// Walks `length` from vertex `v` along the tangent direction `dir`.
     pub fn walk_from_vertex(&self, v: u32, dir: DVec3, length: f64) -> Result<Walk> {
+        check_walk_input(dir, length)?;
         self.mesh.try_position(v)?;
         let p = self.mesh.position(v);
         let mut best: Option<(u32, usize, DVec3)> = None;
@@ -131,7 +170,9 @@ impl<'a> Walker<'a> {
             }
         }
         let Some((f, k, dp)) = best else {
-            bail!("vertex {v} has no usable incident face");
+            return Err(direction_error(format!(
+                "no face incident to vertex {v} has a tangent plane the direction is not normal to"
+            )));
         };
         let mut bary = DVec3::ZERO;
         bary[k] = 1.0;
@@ -140,19 +181,20 @@ impl<'a> Walker<'a> {
 
     /// Walks `length` from a surface point along `dir` (projected on the start face's plane).
     pub fn walk_from_point(&self, sp: SurfacePoint, dir: DVec3, length: f64) -> Result<Walk> {
+        check_walk_input(dir, length)?;
         self.mesh.check_surface_point(&sp)?;
         let n = self.face_normals[sp.face as usize];
         let dp = (dir - dir.dot(n) * n).normalize_or_zero();
         if dp == DVec3::ZERO {
-            bail!("walk direction is normal to face {}", sp.face);
+            return Err(direction_error(format!(
+                "walk direction is normal to face {}",
+                sp.face
+            )));
         }
         self.walk(sp, dp, length)
     }
 
     fn walk(&self, start: SurfacePoint, dir: DVec3, length: f64) -> Result<Walk> {
-        if !(length.is_finite() && length >= 0.0) {
-            bail!("walk length {length} must be finite and >= 0");
-        }
         let tris = self.mesh.triangles();
         let mut f = start.face;
         let mut b = start.bary;
@@ -166,7 +208,7 @@ impl<'a> Walker<'a> {
             let (g11, g12, g22) = (e1.dot(e1), e1.dot(e2), e2.dot(e2));
             let det = g11 * g22 - g12 * g12;
             if det.abs() <= 1e-300 {
-                bail!("walk entered degenerate face {f}");
+                return Err(GeodesicError::DegenerateFace(f));
             }
             let (r1, r2) = (d.dot(e1), d.dot(e2));
             let db1 = (g22 * r1 - g12 * r2) / det;
@@ -241,7 +283,9 @@ impl<'a> Walker<'a> {
                 tg.iter().position(|&x| x == va),
                 tg.iter().position(|&x| x == vb),
             ) else {
-                bail!("faces {f} and {g} do not share edge ({va}, {vb})");
+                return Err(walk_error(format!(
+                    "faces {f} and {g} do not share edge ({va}, {vb})"
+                )));
             };
             let mut gbary = DVec3::ZERO;
             gbary[ga] = nb[ka];
@@ -252,13 +296,17 @@ impl<'a> Walker<'a> {
             let (wf, wg) = (nf.cross(e), ng.cross(e));
             let nd = (d.dot(e) * e + d.dot(wf) * wg).normalize_or_zero();
             if nd == DVec3::ZERO {
-                bail!("walk direction vanished crossing into face {g}");
+                return Err(walk_error(format!(
+                    "walk direction vanished crossing into face {g}"
+                )));
             }
             d = nd;
             f = g;
             b = gbary;
         }
-        bail!("walk did not finish within {max_steps} face crossings")
+        Err(walk_error(format!(
+            "walk did not finish within {max_steps} face crossings"
+        )))
     }
 }
 
@@ -273,40 +321,86 @@ fn clamp_bary(b: DVec3) -> DVec3 {
 }
 
 #[cfg(test)]
-pub(crate) mod tests {
+mod tests {
     use super::*;
-    use meshcore::shapes::icosphere;
+    use meshcore::shapes::{grid, icosphere, Diagonals};
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
     /// Jittered planar grid on [0, 1]^2 (z = 0), `n` cells a side.
-    pub(crate) fn plane(n: usize, jitter: f64, seed: u64) -> TriMesh {
+    fn plane(n: usize, jitter: f64, seed: u64) -> TriMesh {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let h = 1.0 / n as f64;
-        let mut p = Vec::new();
-        for j in 0..=n {
-            for i in 0..=n {
-                let inner = i > 0 && j > 0 && i < n && j < n;
-                let (dx, dy) = if inner && jitter > 0.0 {
-                    (
-                        rng.random_range(-jitter..jitter) * h,
-                        rng.random_range(-jitter..jitter) * h,
-                    )
-                } else {
-                    (0.0, 0.0)
-                };
-                p.push(DVec3::new(i as f64 * h + dx, j as f64 * h + dy, 0.0));
-            }
+        grid(n, n, Diagonals::Uniform, |i, j| {
+            let inner = i > 0 && j > 0 && i < n && j < n;
+            let (dx, dy) = if inner && jitter > 0.0 {
+                (
+                    rng.random_range(-jitter..jitter) * h,
+                    rng.random_range(-jitter..jitter) * h,
+                )
+            } else {
+                (0.0, 0.0)
+            };
+            DVec3::new(i as f64 * h + dx, j as f64 * h + dy, 0.0)
+        })
+        .unwrap()
+    }
+
+    #[test]
+    fn bad_input_is_an_error() {
+        let m = plane(4, 0.0, 1);
+        let w = Walker::new(&m);
+        let v = 2 * 5 + 2;
+        let inside = SurfacePoint::new(0, DVec3::splat(1.0 / 3.0));
+        // Off the mesh: a vertex or face that does not exist, barycentrics that do not sum to 1.
+        assert!(matches!(
+            w.walk_from_vertex(99, DVec3::X, 0.1),
+            Err(GeodesicError::Mesh(_))
+        ));
+        for sp in [
+            SurfacePoint::new(999, DVec3::splat(1.0 / 3.0)),
+            SurfacePoint::new(0, DVec3::new(2.0, 0.0, 0.0)),
+            SurfacePoint::new(0, DVec3::new(f64::NAN, 0.5, 0.5)),
+        ] {
+            assert!(matches!(
+                w.walk_from_point(sp, DVec3::X, 0.1),
+                Err(GeodesicError::Mesh(_))
+            ));
         }
-        let idx = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-        let mut t = Vec::new();
-        for j in 0..n {
-            for i in 0..n {
-                t.push([idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)]);
-                t.push([idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)]);
-            }
+        // Zero, NaN, infinite and normal directions.
+        for d in [
+            DVec3::ZERO,
+            DVec3::new(f64::NAN, 0.0, 0.0),
+            DVec3::new(f64::INFINITY, 0.0, 0.0),
+            DVec3::Z,
+        ] {
+            assert!(matches!(
+                w.walk_from_vertex(v, d, 0.1),
+                Err(GeodesicError::InvalidDirection(_))
+            ));
+            assert!(matches!(
+                w.walk_from_point(inside, d, 0.1),
+                Err(GeodesicError::InvalidDirection(_))
+            ));
         }
-        TriMesh::new(p, t).unwrap()
+        // Negative and non-finite lengths.
+        for len in [-0.1, f64::NAN, f64::INFINITY] {
+            assert!(matches!(
+                w.walk_from_vertex(v, DVec3::X, len),
+                Err(GeodesicError::InvalidLength(_))
+            ));
+            assert!(matches!(
+                w.walk_from_point(inside, DVec3::X, len),
+                Err(GeodesicError::InvalidLength(_))
+            ));
+        }
+        let p = m.position(v);
+        assert!(Walker::tangent_direction(p, DVec3::Z, p, 0.0).is_err());
+        assert!(Walker::tangent_direction(p, DVec3::Z, p + DVec3::Z, 0.0).is_err());
+        assert!(Walker::tangent_direction(p, DVec3::Z, p + DVec3::X, f64::NAN).is_err());
+        // A zero length is a walk that stays where it started.
+        let r = w.walk_from_vertex(v, DVec3::X, 0.0).unwrap();
+        assert!((r.position - p).length() < 1e-12 && !r.truncated);
     }
 
     #[test]

@@ -1,0 +1,759 @@
+//! One solve of the exact solver: seeding, the vertex-ordered window propagation with its sound
+//! pruning rules, and the resulting distances.
+
+use super::window::{pair_trim, BoundStats, Trim, TAU};
+use super::*;
+use std::cmp::Ordering;
+use std::collections::{BinaryHeap, VecDeque};
+
+/// How a vertex got its current distance (recorded for path tracing).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Pred {
+    /// Not reached.
+    None,
+    /// A source vertex.
+    Source,
+    /// Straight line from the point source with this index.
+    Point(u32),
+    /// Along an edge from a pseudo-source vertex.
+    Vertex(u32),
+    /// As the apex of a window record, via the edge point at parameter `t`.
+    Window(u32, f64),
+}
+
+/// Where a recorded window came from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Origin {
+    /// Child of another record.
+    Window(u32),
+    /// Emitted by a pseudo-source (or source) vertex.
+    Vertex(u32),
+    /// Emitted by the point source with this index.
+    Point(u32),
+}
+
+/// A window as emitted, with its half-edge and origin (path-tracing mode).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Record {
+    pub h: u32,
+    pub w: Window,
+    pub origin: Origin,
+}
+
+#[derive(PartialEq)]
+struct Item(f64, u32);
+impl Eq for Item {}
+impl Ord for Item {
+    fn cmp(&self, o: &Self) -> Ordering {
+        o.0.total_cmp(&self.0).then_with(|| o.1.cmp(&self.1))
+    }
+}
+impl PartialOrd for Item {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+
+/// [`Solve::flags`] bit: the half-edge is in the FIFO.
+const QUEUED: u8 = 1;
+/// [`Solve::flags`] bit: the half-edge's window list is not empty.
+const FILLED: u8 = 2;
+
+const OUTSIDE: u8 = 0;
+const FRONT: u8 = 1;
+const INSIDE: u8 = 2;
+
+/// A validated source after barycentric snapping.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Seed {
+    Vertex(u32),
+    /// A point in a live face (barycentrics snapped); `skip` is the host half-edge of an edge
+    /// point (no window is started on it).
+    Face {
+        face: u32,
+        bary: [f64; 3],
+        skip: u32,
+    },
+    /// A point on a dropped (degenerate) face: only the corners get straight-line distances.
+    Degenerate {
+        face: u32,
+        pos: DVec3,
+    },
+}
+
+/// State of one solve.
+pub(crate) struct Solve<'a> {
+    g: &'a ExactGeodesic,
+    cut: f64,
+    pub(crate) d: Vec<f64>,
+    state: Vec<u8>,
+    emitted: Vec<f64>,
+    emit_flag: Vec<bool>,
+    lists: Vec<Vec<Window>>,
+    /// Per half-edge: [`QUEUED`] (in `fifo`) and [`FILLED`] (its list is not empty), one byte
+    /// so that the queue checks do not load the list headers.
+    flags: Vec<u8>,
+    fifo: VecDeque<u32>,
+    heap: BinaryHeap<Item>,
+    pool: Vec<Vec<Window>>,
+    pending_emit: Vec<u32>,
+    tc_buf: Vec<f64>,
+    bound_stats: BoundStats,
+    draining: bool,
+    /// Pairwise trim and apex split enabled (off only in the differential tests' oracle mode,
+    /// which keeps just the vertex filter).
+    prune: bool,
+    pub(super) propagations: u64,
+    /// Path-tracing mode: every emitted window, and how each vertex got its distance.
+    pub(crate) records: Option<Vec<Record>>,
+    pub(crate) pred: Vec<Pred>,
+    /// Point sources (position), indexed by `Pred::Point` / `Origin::Point`.
+    pub(crate) points: Vec<(u32, [f64; 3], DVec3)>,
+    cur_origin: Origin,
+}
+
+impl<'a> Solve<'a> {
+    pub(crate) fn new(g: &'a ExactGeodesic, cut: f64, record: bool) -> Self {
+        let n = g.positions.len();
+        let nh = g.twin.len();
+        Self {
+            g,
+            cut,
+            d: vec![f64::INFINITY; n],
+            state: vec![OUTSIDE; n],
+            emitted: vec![f64::NAN; n],
+            emit_flag: g.pseudo.clone(),
+            lists: (0..nh).map(|_| Vec::new()).collect(),
+            flags: vec![0; nh],
+            fifo: VecDeque::new(),
+            heap: BinaryHeap::new(),
+            pool: Vec::new(),
+            pending_emit: Vec::new(),
+            tc_buf: Vec::new(),
+            bound_stats: BoundStats::default(),
+            draining: false,
+            prune: true,
+            propagations: 0,
+            records: if record { Some(Vec::new()) } else { None },
+            pred: if record {
+                vec![Pred::None; n]
+            } else {
+                Vec::new()
+            },
+            points: Vec::new(),
+            cur_origin: Origin::Vertex(0),
+        }
+    }
+
+    /// Validates and snaps one source.
+    pub(crate) fn classify(g: &ExactGeodesic, s: &Source) -> Result<Seed, GeodesicError> {
+        match *s {
+            Source::Vertex(v) => {
+                if v as usize >= g.positions.len() {
+                    return Err(GeodesicError::SourceOutOfRange {
+                        vertex: v,
+                        vertices: g.positions.len(),
+                    });
+                }
+                Ok(Seed::Vertex(v))
+            }
+            Source::Point(sp) => classify_point(g, &sp),
+        }
+    }
+
+    pub(crate) fn seed(&mut self, sources: &[Source]) -> Result<(), GeodesicError> {
+        if sources.is_empty() {
+            return Err(GeodesicError::NoSource);
+        }
+        let seeds = sources
+            .iter()
+            .map(|s| Self::classify(self.g, s))
+            .collect::<Result<Vec<_>, _>>()?;
+        for s in seeds {
+            match s {
+                Seed::Vertex(v) => {
+                    self.emit_flag[v as usize] = true;
+                    self.relax(v, 0.0, Pred::Source);
+                }
+                Seed::Face { face, bary, skip } => self.seed_face_point(face, bary, skip),
+                Seed::Degenerate { face, pos } => {
+                    let i = self.points.len() as u32;
+                    self.points.push((face, [f64::NAN; 3], pos));
+                    for &v in &self.g.tris[face as usize] {
+                        let dv = (self.g.positions[v as usize] - pos).length();
+                        self.emit_flag[v as usize] = true;
+                        self.relax(v, dv, Pred::Point(i));
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn seed_face_point(&mut self, face: u32, bary: [f64; 3], skip: u32) {
+        let g = self.g;
+        let t = g.tris[face as usize];
+        let pos = bary[0] * g.positions[t[0] as usize]
+            + bary[1] * g.positions[t[1] as usize]
+            + bary[2] * g.positions[t[2] as usize];
+        let idx = self.points.len() as u32;
+        self.points.push((face, bary, pos));
+        let mut faces = vec![(face, bary, skip)];
+        if skip != NONE {
+            let tw = g.twin[skip as usize];
+            if tw != NONE {
+                let h2 = tw & IDX;
+                let f2 = h2 / 3;
+                let t2 = g.tris[f2 as usize];
+                let mut b2 = [0.0; 3];
+                for k in 0..3 {
+                    if let Some(j) = t.iter().position(|&v| v == t2[k]) {
+                        b2[k] = bary[j];
+                    }
+                }
+                faces.push((f2, b2, h2));
+            }
+        }
+        self.cur_origin = Origin::Point(idx);
+        for (f, b, sk) in faces {
+            let tf = g.tris[f as usize];
+            for k in 0..3u32 {
+                let h = 3 * f + k;
+                if h == sk {
+                    continue;
+                }
+                let geo = g.geom[h as usize];
+                let (k0, k1, k2) = (k as usize, ((k + 1) % 3) as usize, ((k + 2) % 3) as usize);
+                let _ = k0;
+                let px = b[k1] * geo.l + b[k2] * geo.cx;
+                let py = b[k2] * geo.cy;
+                self.emit_vertex_like(h, px, py, 0.0);
+            }
+            for &v in &tf {
+                let dv = (g.positions[v as usize] - pos).length();
+                self.relax(v, dv, Pred::Point(idx));
+            }
+        }
+    }
+
+    /// Starts a full-edge window on the twin of `h` from the point `(px, py)` of `h`'s frame
+    /// (a point of face(h)) with distance `sigma`.
+    fn emit_vertex_like(&mut self, h: u32, px: f64, py: f64, sigma: f64) {
+        let g = self.g;
+        let tw = g.twin[h as usize];
+        if tw == NONE {
+            return;
+        }
+        let th = tw & IDX;
+        let geo = &g.geom[h as usize];
+        let l = geo.l;
+        let sx = if tw & REV != 0 { px } else { l - px };
+        let sy = (-py).min(-1e-14 * l);
+        let w = Window {
+            b0: 0.0,
+            b1: l,
+            sigma,
+            sx,
+            sy,
+            id: u32::MAX,
+        };
+        if w.min_dist() > self.cut {
+            return;
+        }
+        self.add_window(th, w, self.cur_origin);
+    }
+
+    #[inline]
+    fn add_window(&mut self, h: u32, mut w: Window, origin: Origin) {
+        if let Some(rec) = self.records.as_mut() {
+            w.id = rec.len() as u32;
+            rec.push(Record { h, w, origin });
+        }
+        let list = &mut self.lists[h as usize];
+        if list.capacity() == 0 {
+            if let Some(v) = self.pool.pop() {
+                *list = v;
+            }
+        }
+        list.push(w);
+        let f = &mut self.flags[h as usize];
+        *f |= FILLED;
+        if *f & QUEUED == 0 {
+            let g = self.g;
+            if self.draining
+                || self.state[g.tail(h) as usize] == INSIDE
+                || self.state[g.head(h) as usize] == INSIDE
+            {
+                self.flags[h as usize] |= QUEUED;
+                self.fifo.push_back(h);
+            }
+        }
+    }
+
+    #[inline]
+    fn relax(&mut self, v: u32, dist: f64, pred: Pred) {
+        let vi = v as usize;
+        if dist < self.d[vi] {
+            self.d[vi] = dist;
+            if !self.pred.is_empty() {
+                self.pred[vi] = pred;
+            }
+            if self.state[vi] != INSIDE {
+                self.state[vi] = FRONT;
+                self.heap.push(Item(dist, v));
+            } else if self.emit_flag[vi] {
+                self.pending_emit.push(v);
+            }
+        }
+    }
+
+    /// Emits the pseudo-source windows of `v` (and relaxes its neighbours along edges).
+    fn emit_from_vertex(&mut self, v: u32) {
+        let dv = self.d[v as usize];
+        if self.emitted[v as usize] == dv || dv > self.cut {
+            return;
+        }
+        self.emitted[v as usize] = dv;
+        let g = self.g;
+        self.cur_origin = Origin::Vertex(v);
+        for &gh in g.opp(v) {
+            let geo = g.geom[gh as usize];
+            self.emit_vertex_like(gh, geo.cx, geo.cy, dv);
+            self.relax(g.tail(gh), dv + geo.lac, Pred::Vertex(v));
+            self.relax(g.head(gh), dv + geo.lbc, Pred::Vertex(v));
+        }
+    }
+
+    fn push_list(&mut self, h: u32) {
+        if self.flags[h as usize] == FILLED {
+            self.flags[h as usize] = FILLED | QUEUED;
+            self.fifo.push_back(h);
+        }
+    }
+
+    fn pop_vertex(&mut self, v: u32) {
+        let g = self.g;
+        self.state[v as usize] = INSIDE;
+        if self.emit_flag[v as usize] {
+            self.emit_from_vertex(v);
+        }
+        for &gh in g.opp(v) {
+            for h in [next(gh), prev(gh)] {
+                self.push_list(h);
+                let t = g.twin[h as usize];
+                if t != NONE {
+                    self.push_list(t & IDX);
+                }
+            }
+            for u in [g.tail(gh), g.head(gh)] {
+                if self.state[u as usize] == OUTSIDE {
+                    self.state[u as usize] = FRONT;
+                }
+            }
+            let t = g.twin[gh as usize];
+            let ok = t == NONE || self.state[g.apex(t & IDX) as usize] != OUTSIDE;
+            if ok {
+                self.push_list(gh);
+                if t != NONE {
+                    self.push_list(t & IDX);
+                }
+            }
+        }
+    }
+
+    pub(crate) fn run(&mut self) {
+        loop {
+            if let Some(v) = self.pending_emit.pop() {
+                self.emit_from_vertex(v);
+                continue;
+            }
+            if let Some(h) = self.fifo.pop_front() {
+                self.flags[h as usize] &= !QUEUED;
+                self.process(h);
+                continue;
+            }
+            let mut popped = false;
+            while let Some(&Item(dv, v)) = self.heap.peek() {
+                if dv != self.d[v as usize] || self.state[v as usize] == INSIDE {
+                    self.heap.pop();
+                    continue;
+                }
+                if dv > self.cut {
+                    break;
+                }
+                self.heap.pop();
+                self.pop_vertex(v);
+                popped = true;
+                break;
+            }
+            if popped {
+                continue;
+            }
+            // Heap exhausted (or beyond the cut-off): drain every list still holding windows.
+            self.draining = true;
+            let mut any = false;
+            for (h, f) in self.flags.iter_mut().enumerate() {
+                if *f == FILLED {
+                    *f = FILLED | QUEUED;
+                    self.fifo.push_back(h as u32);
+                    any = true;
+                }
+            }
+            if !any {
+                break;
+            }
+        }
+    }
+
+    pub(crate) fn finish(mut self) -> Vec<f64> {
+        if self.cut.is_finite() {
+            for d in &mut self.d {
+                if *d > self.cut {
+                    *d = f64::INFINITY;
+                }
+            }
+        }
+        self.d
+    }
+
+    /// The triangle step: filters the list of `h` and pushes its windows across face(h).
+    fn process(&mut self, h: u32) {
+        let mut ws = std::mem::take(&mut self.lists[h as usize]);
+        self.flags[h as usize] &= !FILLED;
+        if ws.is_empty() {
+            return;
+        }
+        let g = self.g;
+        let geo = g.geom[h as usize];
+        let (a, b, c) = (g.tail(h), g.head(h), g.apex(h));
+        let (da, db) = (self.d[a as usize], self.d[b as usize]);
+        let l = geo.l;
+        // P0: vertex filter.
+        ws.retain(|w| {
+            !(vertex_beats(da + w.b1, w, w.b1) || vertex_beats(db + (l - w.b0), w, w.b0))
+        });
+        // P1: sorted lower-envelope trim (dead windows are skipped below, not removed).
+        let mut alive = ws.len();
+        if self.prune && ws.len() > 1 {
+            sort_by_start(&mut ws);
+            let mut cur = 0;
+            let mut cur_s = ws[0].scale();
+            for j in 1..ws.len() {
+                let (lo, hi) = ws.split_at_mut(j);
+                let s2 = hi[0].scale();
+                match pair_trim(&mut lo[cur], cur_s, &mut hi[0], s2, &mut self.bound_stats) {
+                    Trim::FirstDead => {
+                        (cur, cur_s) = (j, s2);
+                        alive -= 1;
+                    }
+                    Trim::SecondDead => alive -= 1,
+                    Trim::Both => {
+                        if hi[0].b1 > lo[cur].b1 {
+                            (cur, cur_s) = (j, s2);
+                        }
+                    }
+                }
+            }
+        }
+        if alive == 0 {
+            self.recycle(ws);
+            return;
+        }
+        // P2: best window for the apex and the split point.
+        let geo = geo.frame();
+        let (cx, cy) = (geo.cx, geo.cy);
+        let mut tcs = std::mem::take(&mut self.tc_buf);
+        tcs.clear();
+        let mut best = f64::INFINITY;
+        let mut p_star = 0.0;
+        let mut best_id = u32::MAX;
+        let mut best_sigma = f64::INFINITY;
+        for w in &ws {
+            let tc = w.sx + (-w.sy) * (cx - w.sx) / (cy - w.sy);
+            tcs.push(tc);
+            if w.is_dead() {
+                continue;
+            }
+            let t = tc.clamp(w.b0, w.b1);
+            let dc = if t == tc {
+                w.sigma + ((cx - w.sx) * (cx - w.sx) + (cy - w.sy) * (cy - w.sy)).sqrt()
+            } else {
+                w.dist(t) + ((cx - t) * (cx - t) + cy * cy).sqrt()
+            };
+            if dc < best || (dc == best && w.sigma < best_sigma) {
+                best = dc;
+                p_star = t;
+                best_id = w.id;
+                best_sigma = w.sigma;
+            }
+        }
+        if best < self.d[c as usize] {
+            self.relax(c, best, Pred::Window(best_id, p_star));
+        }
+        // P3: split rule and propagation.
+        if !self.prune {
+            // Oracle mode: every ray goes to the side it actually exits through.
+            p_star = f64::NAN;
+        }
+        let tl_tw = g.twin[prev(h) as usize];
+        let tr_tw = g.twin[next(h) as usize];
+        for (i, w) in ws.iter().enumerate() {
+            if w.is_dead() {
+                continue;
+            }
+            let tc = tcs[i];
+            if tl_tw != NONE {
+                let tl = w.b1.min(tc).min(if p_star.is_nan() { tc } else { p_star });
+                if tl > w.b0 {
+                    self.emit_left(&geo, tl_tw, w, w.b0, tl, tl == tc);
+                }
+            }
+            if tr_tw != NONE {
+                let tr = w.b0.max(tc).max(if p_star.is_nan() { tc } else { p_star });
+                if tr < w.b1 {
+                    self.emit_right(&geo, tr_tw, w, tr, w.b1, tr == tc);
+                }
+            }
+        }
+        self.tc_buf = tcs;
+        self.recycle(ws);
+    }
+
+    fn recycle(&mut self, mut ws: Vec<Window>) {
+        ws.clear();
+        if ws.capacity() > 0 && self.pool.len() < 4096 {
+            self.pool.push(ws);
+        }
+    }
+
+    /// Child on the left edge a -> c: frame origin a, x towards c.
+    #[inline]
+    fn emit_left(&mut self, geo: &Frame, tw: u32, w: &Window, t0: f64, t1: f64, apex_end: bool) {
+        let (cs, sn) = (geo.cos_a, geo.sin_a);
+        let ell = geo.lac;
+        let sx = w.sx * cs + w.sy * sn;
+        let sy = -w.sx * sn + w.sy * cs;
+        // T' = (t cos, -t sin).
+        let x_of = |t: f64| -> f64 {
+            let (tx, ty) = (t * cs, -t * sn);
+            let den = sy - ty;
+            if den > -1e-15 * ell {
+                if tx > sx {
+                    ell
+                } else {
+                    0.0
+                }
+            } else {
+                sx + (tx - sx) * sy / den
+            }
+        };
+        let x0 = if t0 <= 0.0 { 0.0 } else { x_of(t0) };
+        let x1 = if apex_end { ell } else { x_of(t1) };
+        self.push_child(tw, ell, w, sx, sy, x0, x1);
+    }
+
+    /// Child on the right edge c -> b: frame origin c, x towards b.
+    #[inline]
+    fn emit_right(&mut self, geo: &Frame, tw: u32, w: &Window, t0: f64, t1: f64, apex_end: bool) {
+        let (ux, uy) = (geo.ux, geo.uy);
+        let ell = geo.lbc;
+        let (dx, dy) = (w.sx - geo.cx, w.sy - geo.cy);
+        let sx = dx * ux + dy * uy;
+        let sy = -dx * uy + dy * ux;
+        let x_of = |t: f64| -> f64 {
+            let (ex, ey) = (t - geo.cx, -geo.cy);
+            let (tx, ty) = (ex * ux + ey * uy, -ex * uy + ey * ux);
+            let den = sy - ty;
+            if den > -1e-15 * ell {
+                if tx > sx {
+                    ell
+                } else {
+                    0.0
+                }
+            } else {
+                sx + (tx - sx) * sy / den
+            }
+        };
+        let x0 = if apex_end { 0.0 } else { x_of(t0) };
+        let x1 = if t1 >= geo.l { ell } else { x_of(t1) };
+        self.push_child(tw, ell, w, sx, sy, x0, x1);
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn push_child(&mut self, tw: u32, ell: f64, w: &Window, sx: f64, sy: f64, x0: f64, x1: f64) {
+        let mut x0 = x0.clamp(0.0, ell);
+        let x1 = x1.clamp(0.0, ell);
+        if x0 > x1 {
+            x0 = x1;
+        }
+        let sy = sy.min(-1e-14 * ell);
+        let (b0, b1, sx) = if tw & REV != 0 {
+            (ell - x1, ell - x0, ell - sx)
+        } else {
+            (x0, x1, sx)
+        };
+        let child = Window {
+            b0,
+            b1,
+            sigma: w.sigma,
+            sx,
+            sy,
+            id: u32::MAX,
+        };
+        if self.cut.is_finite() && child.min_dist() > self.cut {
+            return;
+        }
+        self.propagations += 1;
+        let origin = Origin::Window(w.id);
+        self.add_window(tw & IDX, child, origin);
+    }
+}
+
+/// The vertex filter's test `p < D(x) (1 - TAU)` (a vertex path of length `p` beats the window
+/// at `x`), with the same result as evaluating it directly but usually without the square
+/// root: when `p / (1 - TAU) - sigma` exceeds `|S - x|` by more than `1e-13 p` (checked by
+/// squaring, far above the few ulps of rounding in either evaluation), the test is false.
+#[inline]
+fn vertex_beats(p: f64, w: &Window, x: f64) -> bool {
+    const K: f64 = 1.0 / (1.0 - TAU);
+    let dx = x - w.sx;
+    let a = dx * dx + w.sy * w.sy;
+    let t = p * K - w.sigma - 1e-13 * p;
+    if t > 0.0 && t * t > a {
+        return false;
+    }
+    p < w.dist(x) * (1.0 - TAU)
+}
+
+/// Stable sort of a window list by start (`total_cmp`): insertion sort for the short lists of
+/// a solve (same order as `sort_by`, which is stable too), `sort_by` for long ones.
+#[inline]
+fn sort_by_start(ws: &mut [Window]) {
+    if ws.len() > 24 {
+        ws.sort_by(|x, y| x.b0.total_cmp(&y.b0));
+        return;
+    }
+    for i in 1..ws.len() {
+        let mut j = i;
+        while j > 0 && ws[j - 1].b0.total_cmp(&ws[j].b0) == Ordering::Greater {
+            ws.swap(j - 1, j);
+            j -= 1;
+        }
+    }
+}
+
+pub(super) fn classify_point(g: &ExactGeodesic, sp: &SurfacePoint) -> Result<Seed, GeodesicError> {
+    let m = g.tris.len();
+    if sp.face as usize >= m {
+        return Err(meshcore::MeshError::FaceOutOfRange {
+            face: sp.face,
+            faces: m,
+        }
+        .into());
+    }
+    let b = sp.bary;
+    if !b.is_finite() || b.min_element() < -1e-9 || (b.element_sum() - 1.0).abs() > 1e-9 {
+        return Err(meshcore::MeshError::InvalidBarycentric(b.x, b.y, b.z).into());
+    }
+    let t = g.tris[sp.face as usize];
+    if !g.live[sp.face as usize] {
+        let pos = b.x * g.positions[t[0] as usize]
+            + b.y * g.positions[t[1] as usize]
+            + b.z * g.positions[t[2] as usize];
+        return Ok(Seed::Degenerate { face: sp.face, pos });
+    }
+    let mut bb = [b.x.max(0.0), b.y.max(0.0), b.z.max(0.0)];
+    for x in &mut bb {
+        if *x < BARY_SNAP {
+            *x = 0.0;
+        }
+    }
+    let s: f64 = bb.iter().sum();
+    if s <= 0.0 {
+        return Err(meshcore::MeshError::InvalidBarycentric(b.x, b.y, b.z).into());
+    }
+    bb.iter_mut().for_each(|x| *x /= s);
+    let zeros: Vec<usize> = (0..3).filter(|&k| bb[k] == 0.0).collect();
+    match zeros.len() {
+        0 => Ok(Seed::Face {
+            face: sp.face,
+            bary: bb,
+            skip: NONE,
+        }),
+        1 => {
+            // Edge point: the host half-edge is the one opposite the zero corner.
+            let k = zeros[0] as u32;
+            Ok(Seed::Face {
+                face: sp.face,
+                bary: bb,
+                skip: 3 * sp.face + (k + 1) % 3,
+            })
+        }
+        _ => {
+            let k = (0..3).find(|&k| bb[k] > 0.0).unwrap_or(0);
+            Ok(Seed::Vertex(t[k]))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+
+    /// Icosphere of `level` with radial jitter `amp` (relative).
+    fn jittered_sphere(level: u32, amp: f64, seed: u64) -> TriMesh {
+        let ico = meshcore::shapes::icosphere(level);
+        let (mut v, f) = (ico.positions().to_vec(), ico.triangles().to_vec());
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        for p in &mut v {
+            *p *= 1.0 + rng.random_range(-amp..=amp);
+        }
+        TriMesh::new(v, f).unwrap()
+    }
+
+    /// The pruned propagation equals the oracle mode (vertex filter only, no pairwise trim,
+    /// no apex split) on small jittered spheres: the spec's most effective bug finders.
+    #[test]
+    fn pruning_is_sound_on_jittered_spheres() {
+        let (mut total_pruned, mut total_oracle) = (0u64, 0u64);
+        for (level, amp, seed) in [
+            (2, 0.0, 0),
+            (2, 0.005, 1),
+            (2, 0.01, 2),
+            (2, 0.03, 3),
+            (3, 0.01, 4),
+        ] {
+            let m = jittered_sphere(level, amp, seed);
+            let g = ExactGeodesic::new(&m).unwrap();
+            for src in [0u32, 7, 100] {
+                let run = |prune: bool| {
+                    let mut s = Solve::new(&g, f64::INFINITY, false);
+                    s.prune = prune;
+                    s.seed(&[Source::Vertex(src)]).unwrap();
+                    s.run();
+                    (s.propagations, s.finish())
+                };
+                let (np, fast) = run(true);
+                let (no, slow) = run(false);
+                assert!(np <= no, "pruning should not add work: {np} > {no}");
+                total_pruned += np;
+                total_oracle += no;
+                for v in 0..fast.len() {
+                    assert!(
+                        (fast[v] - slow[v]).abs() <= 1e-12 * slow[v].max(1.0),
+                        "level {level} amp {amp} src {src} vertex {v}: {} vs {}",
+                        fast[v],
+                        slow[v]
+                    );
+                }
+            }
+        }
+        // The oracle mode really propagates more (the rules under test were active).
+        assert!(
+            2 * total_pruned < total_oracle,
+            "{total_pruned} vs {total_oracle}"
+        );
+    }
+}

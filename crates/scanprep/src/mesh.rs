@@ -1,0 +1,295 @@
+//! Steps on a triangle mesh (mm): spikes, small components, hole filling, cropping, smoothing.
+
+use crate::{Hole, ScanPrepError};
+use meshcore::{DVec3, Topology, TriMesh};
+
+/// Rebuilds a mesh from positions and the triangles kept, dropping the vertices no triangle
+/// uses (the others keep their order). Returns the mesh and, per old vertex, its new index
+/// (`u32::MAX` if dropped). An error when no triangle is left.
+pub fn compact(
+    pos: &[DVec3],
+    tris: Vec<[u32; 3]>,
+    what: &str,
+) -> Result<(TriMesh, Vec<u32>), ScanPrepError> {
+    if tris.is_empty() {
+        return Err(ScanPrepError::NothingLeft(what.to_string()));
+    }
+    let mut used = vec![false; pos.len()];
+    for t in &tris {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    let mut map = vec![u32::MAX; pos.len()];
+    let mut out = Vec::new();
+    for (v, &u) in used.iter().enumerate() {
+        if u {
+            map[v] = out.len() as u32;
+            out.push(pos[v]);
+        }
+    }
+    let tris = tris.iter().map(|t| t.map(|v| map[v as usize])).collect();
+    Ok((TriMesh::new(out, tris)?, map))
+}
+
+/// Removes the connected components with fewer than `min_ratio` times the vertices of the
+/// largest one (`min_ratio = 1` keeps the largest alone, plus any as large; ties are kept).
+/// Returns the mesh, the number of components and of vertices removed.
+pub fn remove_small_components(
+    mesh: &TriMesh,
+    min_ratio: f64,
+) -> Result<(TriMesh, usize, usize), ScanPrepError> {
+    if !(min_ratio.is_finite() && (0.0..=1.0).contains(&min_ratio)) {
+        return Err(ScanPrepError::InvalidOption(format!(
+            "min component ratio {min_ratio} (expected 0 to 1)"
+        )));
+    }
+    let topo = Topology::new(mesh);
+    let comps = topo.components();
+    let largest = comps.iter().map(Vec::len).max().unwrap_or(0);
+    let keep_comp: Vec<bool> = comps
+        .iter()
+        .map(|c| c.len() as f64 >= min_ratio * largest as f64)
+        .collect();
+    let removed_c = keep_comp.iter().filter(|&&k| !k).count();
+    if removed_c == 0 {
+        return Ok((mesh.clone(), 0, 0));
+    }
+    let removed_v: usize = comps
+        .iter()
+        .zip(&keep_comp)
+        .filter(|(_, &k)| !k)
+        .map(|(c, _)| c.len())
+        .sum();
+    let tris = mesh
+        .triangles()
+        .iter()
+        .filter(|t| keep_comp[topo.vertex_component[t[0] as usize] as usize])
+        .copied()
+        .collect();
+    let (m, _) = compact(mesh.positions(), tris, "removing small components")?;
+    Ok((m, removed_c, removed_v))
+}
+
+/// Vertex neighbours (sorted, unique) from the mesh's triangles.
+pub(crate) fn neighbours(mesh: &TriMesh) -> Vec<Vec<u32>> {
+    let mut nb = vec![Vec::new(); mesh.n_vertices()];
+    for t in mesh.triangles() {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            if a != b {
+                nb[a as usize].push(b);
+                nb[b as usize].push(a);
+            }
+        }
+    }
+    for l in &mut nb {
+        l.sort_unstable();
+        l.dedup();
+    }
+    nb
+}
+
+/// Vertices on a boundary edge (an edge with exactly one face) or a non-manifold one.
+pub(crate) fn boundary_vertices(mesh: &TriMesh, topo: &Topology) -> Vec<bool> {
+    let mut b = vec![false; mesh.n_vertices()];
+    for e in &topo.edges {
+        if e.n_faces != 2 {
+            b[e.v[0] as usize] = true;
+            b[e.v[1] as usize] = true;
+        }
+    }
+    b
+}
+
+/// Removes spike vertices of a mesh (with their faces): a vertex is a spike when its distance
+/// to the mean of its neighbours exceeds `factor` times the mean length of the edges among
+/// those neighbours (the ring around it). On a smooth surface that distance is about `h^2 k`
+/// (edge length `h`, curvature `k`), and half an edge at a boundary; a spike sticks out by
+/// its height. Decisions are taken on the input mesh. Returns the mesh and the count removed.
+pub fn remove_mesh_spikes(mesh: &TriMesh, factor: f64) -> Result<(TriMesh, usize), ScanPrepError> {
+    if !(factor.is_finite() && factor > 0.0) {
+        return Err(ScanPrepError::InvalidOption(format!(
+            "mesh spike factor {factor} (expected > 0)"
+        )));
+    }
+    let p = mesh.positions();
+    let nb = neighbours(mesh);
+    let mut spike = vec![false; p.len()];
+    for (v, l) in nb.iter().enumerate() {
+        if l.len() < 3 {
+            continue;
+        }
+        let mean = l.iter().map(|&w| p[w as usize]).sum::<DVec3>() / l.len() as f64;
+        // Mean length of the ring edges: edges between two neighbours of v.
+        let (mut sum, mut cnt) = (0.0, 0usize);
+        for &a in l {
+            for &b in &nb[a as usize] {
+                if b > a && l.binary_search(&b).is_ok() {
+                    sum += (p[a as usize] - p[b as usize]).length();
+                    cnt += 1;
+                }
+            }
+        }
+        if cnt == 0 {
+            continue;
+        }
+        if (p[v] - mean).length() > factor * sum / cnt as f64 {
+            spike[v] = true;
+        }
+    }
+    let n = spike.iter().filter(|&&s| s).count();
+    if n == 0 {
+        return Ok((mesh.clone(), 0));
+    }
+    let tris = mesh
+        .triangles()
+        .iter()
+        .filter(|t| t.iter().all(|&v| !spike[v as usize]))
+        .copied()
+        .collect();
+    let (m, _) = compact(p, tris, "removing mesh spikes")?;
+    Ok((m, n))
+}
+
+/// Fills the holes of a mesh up to `max_diameter_mm` and reports every hole.
+///
+/// Holes are the boundary loops other than the outer boundary of each component (the loop of
+/// largest perimeter in it; a closed component has none). The diameter of a loop is the largest
+/// distance between two of its vertices. A hole is closed by a fan around a new vertex at the
+/// mean of the loop's vertices; on a curved surface that vertex lies off the surface by about
+/// `d^2 / (8 R)` (diameter `d`, radius of curvature `R`), which the optional smoothing evens out.
+pub fn fill_mesh_holes(
+    mesh: &TriMesh,
+    max_diameter_mm: f64,
+) -> Result<(TriMesh, Vec<Hole>), ScanPrepError> {
+    if !(max_diameter_mm.is_finite() && max_diameter_mm >= 0.0) {
+        return Err(ScanPrepError::InvalidOption(format!(
+            "max hole diameter {max_diameter_mm} mm (expected a finite value >= 0)"
+        )));
+    }
+    let topo = Topology::new(mesh);
+    let p = mesh.positions();
+    let perimeter = |l: &[u32]| -> f64 {
+        (0..l.len())
+            .map(|k| (p[l[k] as usize] - p[l[(k + 1) % l.len()] as usize]).length())
+            .sum()
+    };
+    // Outer loop per component: the longest perimeter (ties to the first listed).
+    let mut outer: std::collections::BTreeMap<u32, (f64, usize)> = Default::default();
+    for (k, l) in topo.boundary_loops.iter().enumerate() {
+        let Some(&v0) = l.first() else { continue };
+        let c = topo.vertex_component[v0 as usize];
+        let per = perimeter(l);
+        let e = outer.entry(c).or_insert((per, k));
+        if per > e.0 {
+            *e = (per, k);
+        }
+    }
+    let outer_ids: std::collections::BTreeSet<usize> = outer.values().map(|&(_, k)| k).collect();
+    let mut pos = p.to_vec();
+    let mut tris = mesh.triangles().to_vec();
+    let mut holes = Vec::new();
+    for (k, l) in topo.boundary_loops.iter().enumerate() {
+        if outer_ids.contains(&k) || l.len() < 3 {
+            continue;
+        }
+        let pts: Vec<DVec3> = l.iter().map(|&v| p[v as usize]).collect();
+        let diameter = if pts.len() <= 4000 {
+            let mut d = 0.0f64;
+            for i in 0..pts.len() {
+                for j in i + 1..pts.len() {
+                    d = d.max((pts[i] - pts[j]).length());
+                }
+            }
+            d
+        } else {
+            meshcore::Aabb::from_points(&pts).map_or(0.0, |b| b.diagonal())
+        };
+        let centre = pts.iter().sum::<DVec3>() / pts.len() as f64;
+        let filled = diameter <= max_diameter_mm;
+        if filled {
+            let c = pos.len() as u32;
+            pos.push(centre);
+            // The loop follows its faces' winding; the fan runs the other way along each edge.
+            for i in 0..l.len() {
+                let (a, b) = (l[i], l[(i + 1) % l.len()]);
+                tris.push([b, a, c]);
+            }
+        }
+        holes.push(Hole {
+            size: l.len(),
+            diameter_mm: diameter,
+            centre,
+            filled,
+        });
+    }
+    if holes.iter().all(|h| !h.filled) {
+        return Ok((mesh.clone(), holes));
+    }
+    Ok((TriMesh::new(pos, tris)?, holes))
+}
+
+/// Keeps the faces whose three vertices lie within `radius` of `centre` (then drops unused
+/// vertices). Returns the mesh and the number of vertices removed; an error when nothing is
+/// left or the centre or radius is not finite.
+pub fn crop_sphere(
+    mesh: &TriMesh,
+    centre: DVec3,
+    radius: f64,
+) -> Result<(TriMesh, usize), ScanPrepError> {
+    if !(centre.is_finite() && radius.is_finite() && radius > 0.0) {
+        return Err(ScanPrepError::InvalidOption(format!(
+            "crop sphere centre {:?}, radius {radius} (expected finite, radius > 0)",
+            centre.to_array()
+        )));
+    }
+    let p = mesh.positions();
+    let r2 = radius * radius;
+    let inside: Vec<bool> = p.iter().map(|q| q.distance_squared(centre) <= r2).collect();
+    let tris: Vec<[u32; 3]> = mesh
+        .triangles()
+        .iter()
+        .filter(|t| t.iter().all(|&v| inside[v as usize]))
+        .copied()
+        .collect();
+    let (m, _) = compact(
+        p,
+        tris,
+        &format!(
+            "cropping to {radius} mm around ({:.3}, {:.3}, {:.3}): no face inside the sphere",
+            centre.x, centre.y, centre.z
+        ),
+    )?;
+    let removed = mesh.n_vertices() - m.n_vertices();
+    Ok((m, removed))
+}
+
+/// Taubin's λ|μ smoothing (λ = 0.5, μ = -0.53, uniform weights), `iterations` pairs of steps;
+/// boundary and non-manifold vertices stay fixed. Removes noise with little shrinkage.
+pub fn taubin_smooth(mesh: &TriMesh, iterations: usize) -> Result<TriMesh, ScanPrepError> {
+    const LAMBDA: f64 = 0.5;
+    const MU: f64 = -0.53;
+    if iterations == 0 {
+        return Ok(mesh.clone());
+    }
+    let topo = Topology::new(mesh);
+    let fixed = boundary_vertices(mesh, &topo);
+    let nb = neighbours(mesh);
+    let mut p = mesh.positions().to_vec();
+    let mut next = p.clone();
+    for _ in 0..iterations {
+        for f in [LAMBDA, MU] {
+            for (v, l) in nb.iter().enumerate() {
+                if fixed[v] || l.is_empty() {
+                    next[v] = p[v];
+                    continue;
+                }
+                let mean = l.iter().map(|&w| p[w as usize]).sum::<DVec3>() / l.len() as f64;
+                next[v] = p[v] + f * (mean - p[v]);
+            }
+            std::mem::swap(&mut p, &mut next);
+        }
+    }
+    Ok(TriMesh::new(p, mesh.triangles().to_vec())?)
+}
