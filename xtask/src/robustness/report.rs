@@ -262,9 +262,9 @@ fn resolution(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
         ] {
             let fname = format!("fig7_matrix_{file}_{}.svg", res.name);
             heatmap(
-                &rep.path(&fname),
+                rep.path(&fname),
                 &format!("pairwise distances, {label}, N = {n} ({})", res.name),
-                &labels,
+                labels,
                 m,
                 "distance",
             )?;
@@ -515,9 +515,9 @@ fn random_errors(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
         ] {
             let fname = format!("{file}_{}.svg", res.name);
             heatmap(
-                &rep.path(&fname),
+                rep.path(&fname),
                 &format!("{label}, static area, N = {n} ({})", res.name),
-                &labels,
+                labels,
                 m,
                 "distance",
             )?;
@@ -610,9 +610,9 @@ fn single_pole(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
             if !file.is_empty() {
                 let fname = format!("{file}_{}.svg", res.name);
                 heatmap(
-                    &rep.path(&fname),
+                    rep.path(&fname),
                     &format!("{label} ({})", res.name),
-                    &labels,
+                    labels,
                     m,
                     "distance",
                 )?;
