@@ -496,8 +496,8 @@ pub fn run(args: Args) -> Result<()> {
         .zip(&per)
         .map(|(n, e)| (n.to_string(), e.iter().map(|x| x.min(15.0)).collect()))
         .collect();
-    write_histogram_svg(
-        &out.join("errors-histogram.svg"),
+    viz::histogram(
+        out.join("errors-histogram.svg"),
         "Landmark errors on sampled ICT faces",
         "error (mm, clipped at 15)",
         &series,
@@ -511,88 +511,4 @@ pub fn run(args: Args) -> Result<()> {
 fn thread_cpu_ns() -> Option<u64> {
     let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
     s.split_whitespace().next()?.parse().ok()
-}
-
-/// A minimal SVG histogram (one outlined series per landmark) used until the viz crate lands.
-fn write_histogram_svg(
-    path: &std::path::Path,
-    title: &str,
-    x_label: &str,
-    series: &[(String, Vec<f64>)],
-    bins: usize,
-) -> Result<()> {
-    let (w, h, ml, mb, mt, mr) = (760.0, 420.0, 60.0, 50.0, 40.0, 170.0);
-    let xmax = series
-        .iter()
-        .flat_map(|s| s.1.iter())
-        .copied()
-        .filter(|x| x.is_finite())
-        .fold(1e-9_f64, f64::max);
-    let counts: Vec<Vec<usize>> = series
-        .iter()
-        .map(|(_, v)| {
-            let mut c = vec![0; bins];
-            for &x in v {
-                let b = ((x / xmax * bins as f64) as usize).min(bins - 1);
-                c[b] += 1;
-            }
-            c
-        })
-        .collect();
-    let cmax = counts.iter().flatten().copied().max().unwrap_or(1).max(1) as f64;
-    let colors = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd"];
-    let pw = w - ml - mr;
-    let ph = h - mt - mb;
-    let mut s = format!(
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n<text x=\"{}\" y=\"22\" text-anchor=\"middle\" font-size=\"15\">{title}</text>\n",
-        ml + pw / 2.0
-    );
-    s += &format!(
-        "<line x1=\"{ml}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" stroke=\"black\"/>\n<line x1=\"{ml}\" y1=\"{mt}\" x2=\"{ml}\" y2=\"{}\" stroke=\"black\"/>\n",
-        mt + ph, ml + pw, mt + ph, mt + ph
-    );
-    for k in 0..=5 {
-        let x = xmax * k as f64 / 5.0;
-        let px = ml + pw * k as f64 / 5.0;
-        s += &format!(
-            "<text x=\"{px}\" y=\"{}\" text-anchor=\"middle\">{x:.1}</text>\n",
-            mt + ph + 16.0
-        );
-        let c = cmax * k as f64 / 5.0;
-        let py = mt + ph - ph * k as f64 / 5.0;
-        s += &format!(
-            "<text x=\"{}\" y=\"{}\" text-anchor=\"end\">{c:.0}</text>\n",
-            ml - 6.0,
-            py + 4.0
-        );
-    }
-    s += &format!(
-        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{x_label}</text>\n<text x=\"16\" y=\"{}\" transform=\"rotate(-90 16 {})\" text-anchor=\"middle\">faces</text>\n",
-        ml + pw / 2.0,
-        h - 10.0,
-        mt + ph / 2.0,
-        mt + ph / 2.0
-    );
-    for (k, ((name, _), c)) in series.iter().zip(&counts).enumerate() {
-        let col = colors[k % colors.len()];
-        let mut d = format!("M {ml} {}", mt + ph);
-        for (b, &n) in c.iter().enumerate() {
-            let x0 = ml + pw * b as f64 / bins as f64;
-            let x1 = ml + pw * (b + 1) as f64 / bins as f64;
-            let y = mt + ph - ph * n as f64 / cmax;
-            d += &format!(" L {x0:.1} {y:.1} L {x1:.1} {y:.1}");
-        }
-        d += &format!(" L {} {}", ml + pw, mt + ph);
-        s += &format!("<path d=\"{d}\" fill=\"none\" stroke=\"{col}\" stroke-width=\"1.5\"/>\n");
-        let ly = mt + 14.0 + 18.0 * k as f64;
-        s += &format!(
-            "<rect x=\"{}\" y=\"{}\" width=\"12\" height=\"12\" fill=\"{col}\"/><text x=\"{}\" y=\"{}\">{name}</text>\n",
-            ml + pw + 15.0,
-            ly - 10.0,
-            ml + pw + 32.0,
-            ly
-        );
-    }
-    s += "</svg>\n";
-    std::fs::write(path, s).with_context(|| format!("writing {}", path.display()))
 }

@@ -9,8 +9,10 @@
 //! probe x gallery pairs, and the ROC curve. Results: `report.md`, `summary.json`, `roc.svg` (and `roc.png`),
 //! CSV tables, in the output folder printed on the last line.
 
-use crate::experiments::descriptor::KeyedPoints;
-use crate::experiments::pipeline::{bar, bipolar, dist, resolve_methods, Refs, Region};
+use crate::experiments::keyed::KeyedPoints;
+use crate::experiments::pipeline::{
+    bar, bipolar, dist, resolve_methods, DescriptorRule, Refs, Region,
+};
 use crate::experiments::polar::{polar_descriptor, PolarOptions, Pole};
 use crate::experiments::report::{f4, line_plot, Report, Series};
 use crate::experiments::walk::Walker;
@@ -77,7 +79,7 @@ struct Lm {
 /// Per face and landmark set: descriptors and landmark positions.
 #[derive(Debug, Clone)]
 struct Described {
-    bip: KeyedPoints,
+    bip: Option<bipolar::Descriptor>,
     pol: KeyedPoints,
     lm_pos: [DVec3; 3],
 }
@@ -337,7 +339,14 @@ pub fn run(args: Args) -> Result<()> {
                     nose,
                     frame,
                 };
-                let bip = bipolar(&s.mesh, &refs, args.levels, Region::Static);
+                let bip = bipolar(
+                    &s.mesh,
+                    &refs,
+                    args.levels,
+                    Region::Static,
+                    DescriptorRule::CrateAll,
+                )
+                .ok();
                 let opts = PolarOptions {
                     step: d / f64::from(args.levels),
                     levels: args.levels,
@@ -391,8 +400,8 @@ pub fn run(args: Args) -> Result<()> {
                     let dg = described[g][k].as_ref();
                     match (dp, dg) {
                         (Some(x), Some(y)) => {
-                            b.push(dist(&x.bip, &y.bip));
-                            s.push(dist(&x.pol, &y.pol));
+                            b.push(dist(&x.bip, &y.bip).unwrap_or(f64::NAN));
+                            s.push(dist(&x.pol, &y.pol).unwrap_or(f64::NAN));
                             c.push(icp_score(&pts, &x.lm_pos, &locators[gi], &y.lm_pos));
                         }
                         _ => {
@@ -466,7 +475,7 @@ pub fn run(args: Args) -> Result<()> {
     let series: Vec<Series> = all
         .iter()
         .map(|m| Series {
-            label: format!("{} ({})", m.descriptor, m.landmarks),
+            name: format!("{} ({})", m.descriptor, m.landmarks),
             points: m.roc.clone(),
             dashed: m.landmarks == "detected",
         })

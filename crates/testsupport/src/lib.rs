@@ -9,8 +9,10 @@
 //! * **Meshes**: [`read_mesh`] (through `mesh-io`, the project's one reader) and the generators
 //!   of [`meshcore::shapes`], re-exported as [`shapes`].
 //! * **Analytic distance fields**: [`fields`].
+//! * **The independent descriptor and distance** the crates are checked against: [`oracle`].
 
 pub mod fields;
+pub mod oracle;
 
 pub use facemodel::{MODEL, PAPER_SET};
 pub use meshcore::shapes;

@@ -1,9 +1,9 @@
-//! Shared pieces of `cargo xtask robustness` and `cargo xtask recognition`: the keyed
-//! descriptors with their distance, the pipeline and report writing. Straightest geodesics are
+//! Shared pieces of `cargo xtask robustness` and `cargo xtask recognition`: the single-pole
+//! point set, the pipeline glue around `bipolar` and `shapedist`, and report writing. Straightest geodesics are
 //! `geodesic::straightest`, the single-pole descriptor is `bipolar::polar`; face-set loading,
 //! the face frame and the static-area mask are in the `facemodel` crate.
 
-pub mod descriptor;
+pub mod keyed;
 pub mod pipeline;
 pub mod report;
 
@@ -42,7 +42,7 @@ pub mod walk {
 
 /// The single-pole descriptor of `bipolar::polar`, as the experiments' keyed point sets.
 pub mod polar {
-    use super::descriptor::KeyedPoints;
+    use super::keyed::KeyedPoints;
     use anyhow::Result;
     use bipolar::{BipolarError, PolarKey};
     use geodesic::Walker;

@@ -1,15 +1,15 @@
-//! Pipeline pieces shared by the experiments: reference configurations, descriptors per
-//! region, distance matrices, reference-point perturbation, geodesic method resolution and
-//! progress bars.
+//! Pipeline pieces shared by the experiments: reference configurations, the bipolar descriptor
+//! per region (built by the `bipolar` crate), keyed distances (`shapedist`), reference-point
+//! perturbation, geodesic method resolution and progress bars.
 
-use super::descriptor::{bipolar_grid, keyed_distance, GridOptions, KeyedPoints};
+use super::keyed::KeyedPoints;
 use super::walk::Walker;
 use anyhow::{bail, Context, Result};
 use facemodel::{static_mask, FaceFrame};
 use geodesic::{GeodesicSolver, Method, SolveOptions, Source};
 use indicatif::{ProgressBar, ProgressStyle};
 use meshcore::{DVec3, SurfacePoint, TriMesh};
-use rayon::prelude::*;
+use shapedist::ShapeDistError;
 
 /// Which area a bipolar descriptor covers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -51,72 +51,27 @@ pub fn field_at(mesh: &TriMesh, u: &[f64], sp: &SurfacePoint) -> f64 {
     sp.bary.x * u[t[0] as usize] + sp.bary.y * u[t[1] as usize] + sp.bary.z * u[t[2] as usize]
 }
 
-/// Which implementation builds the bipolar descriptor.
+/// Which `bipolar` selection rule builds the face descriptors (`--descriptor`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum DescriptorImpl {
-    /// The `bipolar` crate, every intersection of the two level families (rule `All`, keys
-    /// `(i, j, side)`): the grid reading of the paper.
+pub enum DescriptorRule {
+    /// Every intersection of the two level families (rule `All`, keys `(i, j, side)`): the grid
+    /// reading of the paper.
     CrateAll,
-    /// The `bipolar` crate, exact iso-angle points (rule B, keys `(i, k, side, sign)`), K = 8,
-    /// alpha = 0.95, gradient tangents.
+    /// Exact iso-angle points (rule B, keys `(i, k, side, sign)`), K = 8, alpha = 0.95,
+    /// gradient tangents.
     CrateIsoAngle,
-    /// The local grid implementation of `experiments::descriptor` (cross-check).
-    Local,
-}
-
-static DESCRIPTOR_IMPL: std::sync::atomic::AtomicU8 = std::sync::atomic::AtomicU8::new(0);
-static CRATE_FAILURES: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-
-/// Selects the descriptor implementation for the whole process.
-pub fn set_descriptor_impl(d: DescriptorImpl) {
-    DESCRIPTOR_IMPL.store(d as u8, std::sync::atomic::Ordering::Relaxed);
-}
-
-/// The selected descriptor implementation.
-pub fn descriptor_impl() -> DescriptorImpl {
-    match DESCRIPTOR_IMPL.load(std::sync::atomic::Ordering::Relaxed) {
-        0 => DescriptorImpl::CrateAll,
-        1 => DescriptorImpl::CrateIsoAngle,
-        _ => DescriptorImpl::Local,
-    }
-}
-
-/// Number of descriptors the crate could not build (they count as empty descriptors).
-pub fn crate_failures() -> usize {
-    CRATE_FAILURES.load(std::sync::atomic::Ordering::Relaxed)
-}
-
-/// Converts a crate descriptor to a keyed set (sorted by packed key; a key found twice is
-/// ambiguous).
-pub fn from_crate(d: &bipolar::Descriptor) -> KeyedPoints {
-    let mut v: Vec<(u64, DVec3, bool)> = d
-        .points
-        .iter()
-        .map(|p| (p.key.pack(), p.position, p.ambiguous))
-        .collect();
-    v.sort_by(|a, b| {
-        a.0.cmp(&b.0)
-            .then(a.1.x.total_cmp(&b.1.x))
-            .then(a.1.y.total_cmp(&b.1.y))
-    });
-    let mut out = KeyedPoints::default();
-    for (k, p, amb) in v {
-        if out.keys.last() == Some(&k) {
-            if let Some(last) = out.ambiguous.last_mut() {
-                *last = true;
-            }
-            continue;
-        }
-        out.keys.push(k);
-        out.points.push(p);
-        out.ambiguous.push(amb);
-    }
-    out
 }
 
 /// The bipolar descriptor of a configuration at `n` levels between the references (step
-/// `D / n`; static region: levels up to n with the static mask; whole: levels up to 2n).
-pub fn bipolar(mesh: &TriMesh, refs: &Refs, n: u32, region: Region) -> KeyedPoints {
+/// `D / n`; static region: levels up to n with the static mask; whole: levels up to 2n), built
+/// by `bipolar::describe` (precomputed fields) with `rule`.
+pub fn bipolar(
+    mesh: &TriMesh,
+    refs: &Refs,
+    n: u32,
+    region: Region,
+    rule: DescriptorRule,
+) -> Result<bipolar::Descriptor, bipolar::BipolarError> {
     let step = refs.d / f64::from(n);
     let (max_level, mask) = match region {
         Region::Static => (
@@ -132,71 +87,64 @@ pub fn bipolar(mesh: &TriMesh, refs: &Refs, n: u32, region: Region) -> KeyedPoin
         ),
         Region::Whole => (2 * n, None),
     };
-    let imp = descriptor_impl();
-    if imp == DescriptorImpl::Local {
-        return bipolar_grid(
-            mesh,
-            &refs.ur,
-            &refs.uq,
-            &GridOptions { step, max_level },
-            mask.as_deref(),
-        );
-    }
     let opts = bipolar::DescriptorOptions {
         levels: bipolar::LevelSpec::Step(step),
         max_level: Some(max_level),
         vertex_mask: mask,
-        rule: if imp == DescriptorImpl::CrateAll {
-            bipolar::SelectionRule::All
-        } else {
-            bipolar::SelectionRule::IsoAngle
+        rule: match rule {
+            DescriptorRule::CrateAll => bipolar::SelectionRule::All,
+            DescriptorRule::CrateIsoAngle => bipolar::SelectionRule::IsoAngle,
         },
         ..Default::default()
     };
     let surface = bipolar::Surface::new(mesh.clone());
-    match bipolar::describe(
+    bipolar::describe(
         &surface,
         bipolar::Fields::Precomputed {
             fields: &[refs.ur.clone(), refs.uq.clone()],
             references: None,
         },
         &opts,
-    ) {
-        Ok(d) => from_crate(&d),
-        Err(_) => {
-            CRATE_FAILURES.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            KeyedPoints::default()
-        }
+    )
+}
+
+/// A keyed point set as `shapedist::keyed_distance` takes it.
+pub trait Keyed {
+    /// Packed keys and positions of the points that may be paired (ambiguous points left out).
+    fn unambiguous(&self) -> (Vec<u64>, Vec<DVec3>);
+}
+
+impl Keyed for bipolar::Descriptor {
+    fn unambiguous(&self) -> (Vec<u64>, Vec<DVec3>) {
+        self.points
+            .iter()
+            .filter(|p| !p.ambiguous)
+            .map(|p| (p.key.pack(), p.position))
+            .unzip()
     }
 }
 
-/// Keyed distance (NaN when fewer than 3 keys are shared): `shapedist::keyed_distance`
-/// (Kabsch closed form, no gate) on the unambiguous points.
-pub fn dist(a: &KeyedPoints, b: &KeyedPoints) -> f64 {
+impl Keyed for KeyedPoints {
+    fn unambiguous(&self) -> (Vec<u64>, Vec<DVec3>) {
+        KeyedPoints::unambiguous(self)
+    }
+}
+
+/// A descriptor that could not be built counts as a set without points.
+impl<T: Keyed> Keyed for Option<T> {
+    fn unambiguous(&self) -> (Vec<u64>, Vec<DVec3>) {
+        self.as_ref()
+            .map_or_else(|| (Vec::new(), Vec::new()), Keyed::unambiguous)
+    }
+}
+
+/// Keyed distance of the unambiguous points: `shapedist::keyed_distance` (Kabsch closed form,
+/// no gate). Fewer than 3 shared keys is `ShapeDistError::TooFewPairs`.
+pub fn dist<A: Keyed + ?Sized, B: Keyed + ?Sized>(a: &A, b: &B) -> Result<f64, ShapeDistError> {
     let (ka, pa) = a.unambiguous();
     let (kb, pb) = b.unambiguous();
-    match shapedist::keyed_distance(&ka, &pa, &kb, &pb, &shapedist::KeyedOptions::default()) {
-        Ok(k) => k.distance,
-        Err(_) => keyed_distance(a, b).map_or(f64::NAN, |k| k.distance),
-    }
-}
-
-/// Symmetric pairwise distance matrix (rayon over pairs).
-pub fn matrix(descs: &[KeyedPoints]) -> Vec<Vec<f64>> {
-    let n = descs.len();
-    let pairs: Vec<(usize, usize)> = (0..n)
-        .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
-        .collect();
-    let vals: Vec<f64> = pairs
-        .par_iter()
-        .map(|&(i, j)| dist(&descs[i], &descs[j]))
-        .collect();
-    let mut m = vec![vec![0.0; n]; n];
-    for (&(i, j), v) in pairs.iter().zip(vals) {
-        m[i][j] = v;
-        m[j][i] = v;
-    }
-    m
+    shapedist::keyed_distance(&ka, &pa, &kb, &pb, &shapedist::KeyedOptions::default())
+        .map(|k| k.distance)
 }
 
 /// Moves vertex `v` by `radius` along a straightest geodesic leaving at angle `theta` from the

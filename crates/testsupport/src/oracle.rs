@@ -1,11 +1,16 @@
-//! Keyed point sets, the bipolar grid descriptor used by the experiments, isoline segments for
-//! renders, and the keyed closed-form shape distance.
+//! The independent implementation of the bipolar grid descriptor and the keyed distance, kept
+//! as a test oracle (not used by any experiment): `crates/bipolar/tests/oracle.rs` checks that
+//! `bipolar`'s `SelectionRule::All` descriptor equals [`bipolar_grid`] on faces of the paper
+//! set, and the shape-distance tests can compare `shapedist::keyed_distance` with
+//! [`keyed_distance`].
 //!
-//! Until the `bipolar` and `shapedist` crates land, the descriptor here is the grid reading of
-//! the paper (selection rule A without angle filter: every intersection of level `i` of `U_r`
-//! with level `j` of `U_q`, key `(i, j, side)`), and the distance is the keyed L2 distance
-//! after the optimal rotation (Horn's quaternion closed form), normalised to [0, 1]:
+//! The descriptor is the grid reading of the paper (selection rule A without angle filter:
+//! every intersection of level `i` of `U_r` with level `j` of `U_q`, key `(i, j, side)`, one
+//! 2x2 solve per face), and the distance is the keyed L2 distance after the optimal rotation
+//! (Horn's quaternion closed form with its own 4x4 Jacobi solver), normalised to [0, 1]:
 //! `d = sqrt((|A|^2 + |B|^2 - 2 max_R sum a.Rb) / (|A|^2 + |B|^2))` on centred paired points.
+//! Written apart from the crates on purpose: it shares no code with `bipolar`, `levelcurves`
+//! or `shapedist`.
 
 use meshcore::{DVec3, TriMesh};
 
@@ -53,7 +58,6 @@ impl KeyedPoints {
     }
 
     /// True if there is no point.
-    #[allow(dead_code)] // pairs with `len`
     pub fn is_empty(&self) -> bool {
         self.keys.is_empty()
     }
@@ -78,7 +82,6 @@ pub fn grid_key(i: u32, j: u32, side: bool) -> u64 {
 }
 
 /// Unpacks a grid key.
-#[allow(dead_code)] // used by tests and kept for readers of the CSV keys
 pub fn grid_key_parts(k: u64) -> (u32, u32, bool) {
     (
         (k >> 33) as u32,
@@ -250,21 +253,6 @@ pub fn paired_distance(a: &[DVec3], b: &[DVec3]) -> Option<f64> {
     Some(((na + nb - 2.0 * lmax).max(0.0) / (na + nb)).sqrt())
 }
 
-#[allow(dead_code)] // used by `recognition` (wired once the face model lands)
-/// Optimal rotation aligning paired centred sets, `R` with `a ~ R b` (Horn's quaternion method).
-pub fn best_rotation(a: &[DVec3], b: &[DVec3]) -> meshcore::DMat3 {
-    let mut s = [[0.0f64; 3]; 3];
-    for (p, q) in a.iter().zip(b) {
-        for r in 0..3 {
-            for c in 0..3 {
-                s[r][c] += q[r] * p[c];
-            }
-        }
-    }
-    let (_, v) = horn_eigen(&s);
-    meshcore::DMat3::from_quat(meshcore::DQuat::from_xyzw(v[1], v[2], v[3], v[0]).normalize())
-}
-
 /// `max_R sum a_i . R b_i` from `S = sum b_i a_i^T` (largest eigenvalue of Horn's matrix).
 fn max_rotation_correlation(s: &[[f64; 3]; 3]) -> f64 {
     horn_eigen(s).0
@@ -344,10 +332,15 @@ fn jacobi4(mut a: [[f64; 4]; 4]) -> ([f64; 4], [[f64; 4]; 4]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::experiments::walk::tests::plane;
+    use meshcore::shapes::grid_plane;
     use meshcore::{DMat3, DQuat};
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
+
+    /// Unit square of `n x n` cells, interior vertices jittered by up to `jitter * h`.
+    fn plane(n: usize, jitter: f64, seed: u64) -> TriMesh {
+        grid_plane(n, 1.0 / n as f64, 0.0, 2.0 * jitter, seed, |_| false)
+    }
 
     fn random_set(n: usize, seed: u64) -> Vec<DVec3> {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -368,18 +361,6 @@ mod tests {
             .map(|p| r * *p + DVec3::new(3.0, -1.0, 7.0))
             .collect();
         assert!(paired_distance(&a, &b).unwrap() < 1e-7);
-        let rot = best_rotation(
-            &a.iter()
-                .map(|p| *p - a.iter().copied().sum::<DVec3>() / 50.0)
-                .collect::<Vec<_>>(),
-            &b.iter()
-                .map(|p| *p - b.iter().copied().sum::<DVec3>() / 50.0)
-                .collect::<Vec<_>>(),
-        );
-        assert!((rot * r - DMat3::IDENTITY)
-            .to_cols_array()
-            .iter()
-            .all(|x| x.abs() < 1e-9));
         let m: Vec<DVec3> = a.iter().map(|p| DVec3::new(-p.x, p.y, p.z)).collect();
         assert!(paired_distance(&a, &m).unwrap() > 0.1);
         let mut rng = ChaCha8Rng::seed_from_u64(3);

@@ -1,0 +1,165 @@
+//! Figures 9-11: the left outer eye corner (and, for the single pole, the nose tip) of the test
+//! face moved by radius x direction; the distance to the unperturbed descriptor per cell, and
+//! the paper's three cases against resolution.
+
+use super::base::Base;
+use super::stats::{max, mean, min};
+use super::{eye_mid, Ctx, MethodResults, Prepared, N_DIRS, RADII_PCT, RESOLUTIONS};
+use crate::experiments::keyed::KeyedPoints;
+use crate::experiments::pipeline::{bar, field, field_at, perturb, Refs, Region};
+use crate::experiments::polar::{polar_descriptor, Pole};
+use anyhow::Result;
+use facemodel::face_frame;
+use geodesic::Source;
+use rayon::prelude::*;
+
+/// One perturbation cell: moved-corner references, moved-pole polar descriptor, and whether
+/// each walk met the boundary.
+struct Cell {
+    refs: Refs,
+    polar: KeyedPoints,
+    cut_q: bool,
+    cut_nose: bool,
+}
+
+/// Moves q and the nose tip of the test face for every (radius, direction) cell.
+fn perturbed(ctx: &Ctx<'_>, prep: &Prepared, cells: &[(f64, f64)]) -> Result<Vec<Cell>> {
+    let test = ctx.test;
+    let tf = &ctx.faces[test];
+    let tr = &prep.refs[test];
+    let tsolver = prep.solvers[test].as_ref();
+    let pb = bar(cells.len(), &format!("{}: perturbation grid", ctx.mname()));
+    let grid = cells
+        .par_iter()
+        .map(|&(pct, theta)| -> Result<_> {
+            let radius = pct / 100.0 * tr.d;
+            let lm = tf.landmarks;
+            let w = &ctx.walkers[test];
+            let (sp, cut_q) = perturb(w, lm.left_eye_outer, tr.r, radius, theta)?;
+            let uq = field(tsolver, Source::Point(sp))?;
+            let q = tf.mesh.point_position(&sp)?;
+            let d = 0.5 * (uq[lm.right_eye_outer as usize] + field_at(&tf.mesh, &tr.ur, &sp));
+            let frame = face_frame(&tf.mesh, tr.r, q, tr.nose);
+            let refs = Refs {
+                ur: tr.ur.clone(),
+                uq,
+                d,
+                r: tr.r,
+                q,
+                nose: tr.nose,
+                frame,
+            };
+            let (spn, cut_nose) = perturb(w, lm.nose_tip, eye_mid(tr), radius, theta)?;
+            let un = field(tsolver, Source::Point(spn))?;
+            let polar =
+                polar_descriptor(w, &un, Pole::Point(spn), eye_mid(tr), &ctx.polar_opts(tr))?;
+            pb.inc(1);
+            Ok(Cell {
+                refs,
+                polar,
+                cut_q,
+                cut_nose,
+            })
+        })
+        .collect::<Result<_>>()?;
+    pb.finish();
+    Ok(grid)
+}
+
+/// Fills the perturbation grid (figures 9, 10, 17) and the three cases (figure 11).
+pub(super) fn run(
+    ctx: &Ctx<'_>,
+    prep: &Prepared,
+    base: &Base,
+    res: &mut MethodResults,
+) -> Result<()> {
+    let (faces, test, n) = (ctx.faces, ctx.test, ctx.args.levels);
+    let tf = &faces[test];
+    let cells: Vec<(f64, f64)> = RADII_PCT
+        .iter()
+        .flat_map(|&p| {
+            (0..N_DIRS).map(move |k| (p, std::f64::consts::TAU * k as f64 / N_DIRS as f64))
+        })
+        .collect();
+    let grid = perturbed(ctx, prep, &cells)?;
+    let cell_name = |c: &(f64, f64)| {
+        format!(
+            "{} (q moved {} % at {:.1} deg)",
+            tf.name,
+            c.0,
+            c.1.to_degrees()
+        )
+    };
+    // Walks stopped by the boundary (the eye opening) did not move the point by the radius:
+    // their cells are left out (NaN) and counted.
+    for (c, g) in cells.iter().zip(&grid) {
+        let db = if g.cut_q {
+            f64::NAN
+        } else {
+            let moved = ctx.describe(&tf.mesh, &g.refs, n, Region::Static, || cell_name(c));
+            ctx.dist(&base.static_[test], &moved, || cell_name(c))
+        };
+        res.grid_bip.push((c.0, c.1, db));
+        let dp = if g.cut_nose {
+            f64::NAN
+        } else {
+            ctx.dist_pole(&base.polar[test], &g.polar, || {
+                format!(
+                    "{} (nose tip moved {} % at {:.1} deg)",
+                    tf.name,
+                    c.0,
+                    c.1.to_degrees()
+                )
+            })
+        };
+        res.grid_pol.push((c.0, c.1, dp));
+    }
+    res.truncated = (
+        grid.iter().filter(|g| g.cut_q).count(),
+        grid.iter().filter(|g| g.cut_nose).count(),
+    );
+    // Figure 11: the three cases against resolution.
+    let same: Vec<usize> = (0..faces.len())
+        .filter(|&j| j != test && faces[j].person == faces[test].person)
+        .collect();
+    let other: Vec<usize> = (0..faces.len())
+        .filter(|&j| faces[j].person != faces[test].person)
+        .collect();
+    for (ds, &nl) in base.sweep.iter().zip(&RESOLUTIONS) {
+        let pert: Vec<f64> = grid
+            .par_iter()
+            .zip(&cells)
+            .filter(|(g, _)| !g.cut_q)
+            .map(|(g, c)| {
+                let what = || format!("{}, N = {nl}", cell_name(c));
+                let moved = ctx.describe(&tf.mesh, &g.refs, nl, Region::Static, what);
+                ctx.dist(&ds[test], &moved, what)
+            })
+            .collect();
+        let to = |js: &[usize]| -> Vec<f64> {
+            js.iter()
+                .map(|&j| {
+                    ctx.dist(&ds[test], &ds[j], || {
+                        format!(
+                            "static, N = {nl}: {} vs {}",
+                            faces[test].name, faces[j].name
+                        )
+                    })
+                })
+                .collect()
+        };
+        let (e, o) = (to(&same), to(&other));
+        res.fig11.push((
+            nl,
+            [
+                mean(&pert),
+                max(&pert),
+                mean(&e),
+                min(&e),
+                mean(&o),
+                min(&o),
+            ],
+        ));
+    }
+    Ok(())
+}

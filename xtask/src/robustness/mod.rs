@@ -1,0 +1,405 @@
+//! `cargo xtask robustness`: the paper's sections 4-6 on the face set, as one report.
+//!
+//! For every requested geodesic method (default: exact and Dijkstra), on the 12 faces of the
+//! paper set: renders of the level curves and descriptor points, the shape distance against
+//! resolution and the 12 x 12 matrix (`base`), the robustness to reference-point errors (grid
+//! of radius x direction and the three cases of figure 11, `grid`; matrices with random errors
+//! on one and on both corners, `random`), and the single-pole comparison (figure 17) with the
+//! figure-15 argument (`pole`); `report` writes it all. Descriptors come from `bipolar`,
+//! distances from `shapedist`; a crate error is listed in the report with the face's name and
+//! counted, its cells are NaN. See `docs/experiments.md` for every choice made.
+
+mod base;
+mod grid;
+mod pole;
+mod random;
+mod report;
+mod stats;
+
+use crate::experiments::keyed::KeyedPoints;
+use crate::experiments::pipeline::{
+    bipolar, dist, field, resolve_methods, DescriptorRule, Refs, Region,
+};
+use crate::experiments::polar::PolarOptions;
+use crate::experiments::walk::Walker;
+use crate::paths::{default_out_dir, default_paper_set};
+use anyhow::{bail, Result};
+use facemodel::{face_frame, load_face_set, Face};
+use geodesic::{GeodesicSolver, Method, Source};
+use meshcore::{DVec3, TriMesh};
+use rayon::prelude::*;
+use shapedist::ShapeDistError;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::time::Instant;
+
+/// Arguments of `cargo xtask robustness`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct Args {
+    /// Folder of the face set (OBJ files + landmarks.json); default
+    /// `$BIPOLAR_SHARED/faces/ict-facekit/paper-set` (BIPOLAR_SHARED defaults to `../shared`).
+    #[arg(long)]
+    pub faces: Option<PathBuf>,
+    /// Report folder (default `target/robustness`).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Geodesic methods to run, comma separated (exact, fmm, heat, dijkstra).
+    #[arg(long, default_value = "exact,dijkstra")]
+    pub methods: String,
+    /// Number of levels between the two reference points (the default resolution).
+    #[arg(long, default_value_t = 10)]
+    pub levels: u32,
+    /// Angular sectors of the single-pole representation.
+    #[arg(long, default_value_t = 16)]
+    pub sectors: u32,
+    /// Seed of the random reference-point errors.
+    #[arg(long, default_value_t = 2013)]
+    pub seed: u64,
+    /// Selection rule of the `bipolar` descriptor.
+    #[arg(long, value_enum, default_value = "crate-all")]
+    pub descriptor: DescriptorRule,
+}
+
+/// Resolutions of the sweeps (levels between the references).
+const RESOLUTIONS: [u32; 9] = [3, 4, 5, 6, 8, 10, 12, 15, 20];
+/// Perturbation radii in percent of the corner-to-corner geodesic.
+const RADII_PCT: [f64; 5] = [1.0, 2.0, 3.0, 4.0, 5.0];
+/// Number of perturbation directions.
+const N_DIRS: usize = 8;
+
+/// A face descriptor, `None` where `bipolar` refused it (the refusal is in [`Failures`]).
+type Desc = Option<bipolar::Descriptor>;
+
+/// Everything measured with one geodesic method.
+#[derive(Debug, Default)]
+struct MethodResults {
+    name: String,
+    d: Vec<f64>,
+    n_points: Vec<(usize, usize)>,
+    sweep: Vec<(u32, Vec<f64>)>,
+    m_static: Vec<Vec<f64>>,
+    m_whole: Vec<Vec<f64>>,
+    m_polar: Vec<Vec<f64>>,
+    grid_bip: Vec<(f64, f64, f64)>,
+    grid_pol: Vec<(f64, f64, f64)>,
+    fig11: Vec<(u32, [f64; 6])>,
+    m_rand_one: Vec<Vec<f64>>,
+    m_rand_both: Vec<Vec<f64>>,
+    m_rand_nose: Vec<Vec<f64>>,
+    rand_one_pct: Vec<f64>,
+    truncated: (usize, usize),
+    seconds: f64,
+}
+
+/// Crate errors met during the run: every refused descriptor and every distance error other
+/// than "fewer than 3 shared keys" is listed (with the faces' names); the pairs with too few
+/// shared keys are counted. Their cells are NaN.
+#[derive(Debug, Default)]
+struct Failures {
+    listed: Mutex<Vec<String>>,
+    too_few_pairs: Mutex<usize>,
+}
+
+impl Failures {
+    fn list(&self, msg: String) {
+        self.listed
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .push(msg);
+    }
+
+    /// The listed failures, sorted (the run is parallel), and the too-few-pairs count.
+    fn summary(&self) -> (Vec<String>, usize) {
+        let mut v = self
+            .listed
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .clone();
+        v.sort();
+        let n = *self
+            .too_few_pairs
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        (v, n)
+    }
+}
+
+/// What every part of one method's run reads.
+struct Ctx<'a> {
+    args: &'a Args,
+    faces: &'a [Face],
+    walkers: &'a [Walker<'a>],
+    test: usize,
+    method: Method,
+    failures: &'a Failures,
+}
+
+impl Ctx<'_> {
+    fn mname(&self) -> &'static str {
+        self.method.name()
+    }
+
+    /// The bipolar descriptor of `refs` on `mesh`; a refusal is listed under `what`.
+    fn describe(
+        &self,
+        mesh: &TriMesh,
+        refs: &Refs,
+        n: u32,
+        region: Region,
+        what: impl FnOnce() -> String,
+    ) -> Desc {
+        match bipolar(mesh, refs, n, region, self.args.descriptor) {
+            Ok(d) => Some(d),
+            Err(e) => {
+                self.failures
+                    .list(format!("{}: descriptor of {}: {e}", self.mname(), what()));
+                None
+            }
+        }
+    }
+
+    /// Distance of two face descriptors (NaN when either was refused or the distance failed).
+    fn dist(&self, a: &Desc, b: &Desc, what: impl FnOnce() -> String) -> f64 {
+        match (a, b) {
+            (Some(a), Some(b)) => self.score(dist(a, b), what),
+            _ => f64::NAN,
+        }
+    }
+
+    /// Distance of two single-pole descriptors.
+    fn dist_pole(&self, a: &KeyedPoints, b: &KeyedPoints, what: impl FnOnce() -> String) -> f64 {
+        self.score(dist(a, b), what)
+    }
+
+    fn score(&self, r: Result<f64, ShapeDistError>, what: impl FnOnce() -> String) -> f64 {
+        match r {
+            Ok(d) => d,
+            Err(ShapeDistError::TooFewPairs { .. }) => {
+                *self
+                    .failures
+                    .too_few_pairs
+                    .lock()
+                    .unwrap_or_else(std::sync::PoisonError::into_inner) += 1;
+                f64::NAN
+            }
+            Err(e) => {
+                self.failures
+                    .list(format!("{}: distance {}: {e}", self.mname(), what()));
+                f64::NAN
+            }
+        }
+    }
+
+    /// The pairwise matrix of face descriptors (`shapedist::pairwise_matrix`; failed cells NaN).
+    fn matrix(&self, descs: &[Desc], label: &str) -> Vec<Vec<f64>> {
+        let items: Vec<(&str, &Desc)> = self
+            .faces
+            .iter()
+            .map(|f| f.name.as_str())
+            .zip(descs)
+            .collect();
+        let m = shapedist::pairwise_matrix(&items, |a, b| {
+            Ok::<f64, std::convert::Infallible>(
+                self.dist(a.1, b.1, || format!("{label}: {} vs {}", a.0, b.0)),
+            )
+        });
+        match m {
+            Ok(m) => m,
+            Err(e) => match e.error {},
+        }
+    }
+
+    /// The pairwise matrix of single-pole descriptors.
+    fn matrix_pole(&self, descs: &[KeyedPoints], label: &str) -> Vec<Vec<f64>> {
+        let items: Vec<(&str, &KeyedPoints)> = self
+            .faces
+            .iter()
+            .map(|f| f.name.as_str())
+            .zip(descs)
+            .collect();
+        let m = shapedist::pairwise_matrix(&items, |a, b| {
+            Ok::<f64, std::convert::Infallible>(
+                self.dist_pole(a.1, b.1, || format!("{label}: {} vs {}", a.0, b.0)),
+            )
+        });
+        match m {
+            Ok(m) => m,
+            Err(e) => match e.error {},
+        }
+    }
+
+    /// Options of the single-pole descriptor for a configuration.
+    fn polar_opts(&self, r: &Refs) -> PolarOptions {
+        PolarOptions {
+            step: r.d / f64::from(self.args.levels),
+            levels: self.args.levels,
+            sectors: self.args.sectors,
+        }
+    }
+}
+
+/// Midpoint of the two outer eye corners (angular origin of the single pole).
+fn eye_mid(r: &Refs) -> DVec3 {
+    0.5 * (r.r + r.q)
+}
+
+/// Number of distinct keys of a descriptor (a key found twice counts once; 0 if refused).
+fn n_keys(d: &Desc) -> usize {
+    d.as_ref().map_or(0, |d| {
+        let mut k = d.packed_keys();
+        k.dedup();
+        k.len()
+    })
+}
+
+/// Runs the task; prints the report folder on the last line.
+pub fn run(args: Args) -> Result<()> {
+    let t0 = Instant::now();
+    let dir = args.faces.clone().unwrap_or_else(default_paper_set);
+    let faces = load_face_set(&dir)?;
+    let test = faces
+        .iter()
+        .position(|f| f.name == "id1_neutral")
+        .unwrap_or(0);
+    if args.levels < 2 || args.sectors < 3 {
+        bail!("--levels must be >= 2 and --sectors >= 3");
+    }
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| default_out_dir("robustness"));
+    eprintln!(
+        "{} faces from {}; test face {}",
+        faces.len(),
+        dir.display(),
+        faces[test].name
+    );
+    let walkers: Vec<Walker<'_>> = faces.par_iter().map(|f| Walker::new(&f.mesh)).collect();
+    let methods = resolve_methods(&args.methods, &faces[test].mesh)?;
+    let failures = Failures::default();
+    let mut results = Vec::new();
+    for mu in &methods {
+        if let Some(n) = &mu.note {
+            eprintln!(
+                "note: {} requested: {n}; using {}",
+                mu.requested.name(),
+                mu.used.name()
+            );
+        }
+        let ctx = Ctx {
+            args: &args,
+            faces: &faces,
+            walkers: &walkers,
+            test,
+            method: mu.used,
+            failures: &failures,
+        };
+        results.push(run_method(&ctx, &out)?);
+    }
+    let fig15 = pole::figure15(&args, &faces, test, methods[0].used, &out)?;
+    report::write_report(
+        &args, &faces, test, &methods, &results, &fig15, &failures, &out, t0,
+    )?;
+    println!("{}", out.display());
+    Ok(())
+}
+
+/// One method's solvers, reference configurations and nose-tip fields.
+struct Prepared {
+    solvers: Vec<Box<dyn GeodesicSolver>>,
+    refs: Vec<Refs>,
+    nose_fields: Vec<Vec<f64>>,
+}
+
+fn prepare(ctx: &Ctx<'_>) -> Result<Prepared> {
+    let pb = crate::experiments::pipeline::bar(
+        ctx.faces.len(),
+        &format!("{}: base fields", ctx.mname()),
+    );
+    let prepared: Vec<(Box<dyn GeodesicSolver>, Refs, Vec<f64>)> = ctx
+        .faces
+        .par_iter()
+        .map(|f| -> Result<_> {
+            let solver = geodesic::new_solver(&f.mesh, ctx.method)?;
+            let lm = f.landmarks;
+            let ur = field(solver.as_ref(), Source::Vertex(lm.right_eye_outer))?;
+            let uq = field(solver.as_ref(), Source::Vertex(lm.left_eye_outer))?;
+            let un = field(solver.as_ref(), Source::Vertex(lm.nose_tip))?;
+            let d = 0.5 * (ur[lm.left_eye_outer as usize] + uq[lm.right_eye_outer as usize]);
+            let (r, q, nose) = (
+                f.mesh.position(lm.right_eye_outer),
+                f.mesh.position(lm.left_eye_outer),
+                f.mesh.position(lm.nose_tip),
+            );
+            let frame = face_frame(&f.mesh, r, q, nose);
+            pb.inc(1);
+            Ok((
+                solver,
+                Refs {
+                    ur,
+                    uq,
+                    d,
+                    r,
+                    q,
+                    nose,
+                    frame,
+                },
+                un,
+            ))
+        })
+        .collect::<Result<_>>()?;
+    pb.finish();
+    let mut out = Prepared {
+        solvers: Vec::new(),
+        refs: Vec::new(),
+        nose_fields: Vec::new(),
+    };
+    for (s, r, u) in prepared {
+        out.solvers.push(s);
+        out.refs.push(r);
+        out.nose_fields.push(u);
+    }
+    Ok(out)
+}
+
+fn run_method(ctx: &Ctx<'_>, out: &Path) -> Result<MethodResults> {
+    let t0 = Instant::now();
+    std::fs::create_dir_all(out)?;
+    let prep = prepare(ctx)?;
+    let mut res = MethodResults {
+        name: ctx.mname().to_string(),
+        d: prep.refs.iter().map(|r| r.d).collect(),
+        ..Default::default()
+    };
+    base::renders(ctx, &prep, out)?;
+    let base = base::run(ctx, &prep, &mut res)?;
+    grid::run(ctx, &prep, &base, &mut res)?;
+    random::run(ctx, &prep, &mut res)?;
+    res.seconds = t0.elapsed().as_secs_f64();
+    Ok(res)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::experiments::pipeline::{field_at, perturb};
+
+    #[test]
+    fn perturbation_moves_by_the_radius_on_a_plane() {
+        let m = crate::experiments::walk::tests::plane(20, 0.2, 5);
+        let w = Walker::new(&m);
+        let v = 10 * 21 + 10;
+        let p = m.position(v);
+        let (sp, cut) = perturb(&w, v, p + DVec3::X, 0.2, std::f64::consts::FRAC_PI_2).unwrap();
+        assert!(!cut);
+        let (_, cut) = perturb(&w, v, p + DVec3::X, 0.7, 0.0).unwrap();
+        assert!(
+            cut,
+            "a 0.7 walk from the centre towards +x leaves the unit square"
+        );
+        let q = m.point_position(&sp).unwrap();
+        assert!((q - (p + 0.2 * DVec3::Y)).length() < 1e-9);
+        let u: Vec<f64> = m.positions().iter().map(|x| x.x).collect();
+        assert!((field_at(&m, &u, &sp) - q.x).abs() < 1e-12);
+    }
+}

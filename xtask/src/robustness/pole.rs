@@ -1,0 +1,141 @@
+//! Figure 15: rotating some polar rings of the test face individually keeps every per-ring
+//! distance ~0 while the global distance becomes large.
+
+use super::base::{markers, render};
+use super::Args;
+use crate::experiments::keyed::KeyedPoints;
+use crate::experiments::pipeline::{dist, field};
+use crate::experiments::polar::{polar_descriptor, polar_key_parts, PolarOptions, Pole};
+use crate::experiments::walk::Walker;
+use anyhow::Result;
+use facemodel::{face_frame, Face, FaceFrame};
+use geodesic::{Method, Source};
+use meshcore::{DMat3, DQuat, DVec3};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use std::path::Path;
+use viz::Scene;
+
+/// The rings rotated.
+const ROTATED: [u32; 3] = [2, 4, 6];
+
+/// Figure-15 numbers.
+pub(super) struct Figure15 {
+    /// The other person's face compared with.
+    pub other: usize,
+    /// Distance of each ring to its rotated copy, each with its own best rotation.
+    pub per_ring: Vec<(u32, f64)>,
+    /// Keyed distance between the descriptor and the one with rotated rings.
+    pub global: f64,
+    /// Keyed distance between the test face and `other`.
+    pub reference: f64,
+}
+
+/// The polar descriptor of face `i` (pole at the nose tip) and its frame.
+fn describe(
+    f: &Face,
+    method: Method,
+    levels: u32,
+    sectors: u32,
+) -> Result<(KeyedPoints, FaceFrame)> {
+    let lm = f.landmarks;
+    let s = geodesic::new_solver(&f.mesh, method)?;
+    let un = field(s.as_ref(), Source::Vertex(lm.nose_tip))?;
+    let ur = field(s.as_ref(), Source::Vertex(lm.right_eye_outer))?;
+    let d = ur[lm.left_eye_outer as usize];
+    let (r, q, nose) = (
+        f.mesh.position(lm.right_eye_outer),
+        f.mesh.position(lm.left_eye_outer),
+        f.mesh.position(lm.nose_tip),
+    );
+    let w = Walker::new(&f.mesh);
+    let opts = PolarOptions {
+        step: d / f64::from(levels),
+        levels,
+        sectors,
+    };
+    Ok((
+        polar_descriptor(&w, &un, Pole::Vertex(lm.nose_tip), 0.5 * (r + q), &opts)?,
+        face_frame(&f.mesh, r, q, nose),
+    ))
+}
+
+/// `s` with rings [`ROTATED`] each rotated about its centroid by a seeded random rotation.
+fn rotate_rings(s: &KeyedPoints, seed: u64) -> KeyedPoints {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut s1 = s.clone();
+    for &lvl in &ROTATED {
+        let idx: Vec<usize> = (0..s.len())
+            .filter(|&k| polar_key_parts(s.keys[k]).0 == lvl)
+            .collect();
+        if idx.is_empty() {
+            continue;
+        }
+        let c = idx.iter().map(|&k| s.points[k]).sum::<DVec3>() / idx.len() as f64;
+        let axis = DVec3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        )
+        .normalize_or_zero();
+        let angle = rng.random_range(0.5..1.5);
+        let rot = DMat3::from_quat(DQuat::from_axis_angle(
+            if axis == DVec3::ZERO { DVec3::Z } else { axis },
+            angle,
+        ));
+        for &k in &idx {
+            s1.points[k] = c + rot * (s.points[k] - c);
+        }
+    }
+    s1
+}
+
+/// Computes figure 15 with `method` on the test face and the first face of another person,
+/// and writes its render.
+pub(super) fn figure15(
+    args: &Args,
+    faces: &[Face],
+    test: usize,
+    method: Method,
+    out: &Path,
+) -> Result<Figure15> {
+    let other = faces
+        .iter()
+        .position(|f| f.person != faces[test].person)
+        .unwrap_or(test);
+    let descs: Vec<(KeyedPoints, FaceFrame)> = [test, other]
+        .par_iter()
+        .map(|&i| describe(&faces[i], method, args.levels, args.sectors))
+        .collect::<Result<_>>()?;
+    let (s, frame) = &descs[0];
+    let s1 = rotate_rings(s, args.seed);
+    let mut per_ring = Vec::new();
+    for lvl in 1..=args.levels {
+        let idx: Vec<usize> = (0..s.len())
+            .filter(|&k| polar_key_parts(s.keys[k]).0 == lvl && !s.ambiguous[k])
+            .collect();
+        let keys: Vec<u64> = idx.iter().map(|&k| s.keys[k]).collect();
+        let a: Vec<DVec3> = idx.iter().map(|&k| s.points[k]).collect();
+        let b: Vec<DVec3> = idx.iter().map(|&k| s1.points[k]).collect();
+        let d =
+            shapedist::keyed_distance(&keys, &a, &keys, &b, &shapedist::KeyedOptions::default());
+        per_ring.push((lvl, d.map_or(f64::NAN, |d| d.distance)));
+    }
+    let global = dist(s, &s1)?;
+    let reference = dist(s, &descs[1].0)?;
+    let moved: Vec<DVec3> = (0..s.len())
+        .filter(|&k| ROTATED.contains(&polar_key_parts(s.keys[k]).0))
+        .map(|k| s1.points[k])
+        .collect();
+    let mut scene = Scene::new(&faces[test].mesh);
+    scene.points = markers(s.points.iter().copied(), [0x24, 0x71, 0xa3], 2.2);
+    scene.points.extend(markers(moved, [0xc0, 0x39, 0x2b], 2.6));
+    render(&out.join("figure15.svg"), &scene, frame.up, frame.forward)?;
+    Ok(Figure15 {
+        other,
+        per_ring,
+        global,
+        reference,
+    })
+}

@@ -1,0 +1,127 @@
+//! Figures 12, 13 and 17a: every face gets its own seeded random error (radius uniform in
+//! [0, 5 %] of D, uniform direction) on q, on both corners, and on the nose tip; the matrices
+//! between the perturbed descriptors.
+
+use super::{eye_mid, Ctx, Desc, MethodResults, Prepared};
+use crate::experiments::keyed::KeyedPoints;
+use crate::experiments::pipeline::{bar, field, field_at, perturb, Refs, Region};
+use crate::experiments::polar::{polar_descriptor, Pole};
+use crate::experiments::walk::Walker;
+use anyhow::Result;
+use facemodel::face_frame;
+use geodesic::Source;
+use meshcore::{DVec3, SurfacePoint};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+
+/// The perturbed descriptors of one face and the radius of its one-corner error (% of D).
+struct Run {
+    one: Desc,
+    both: Desc,
+    nose: KeyedPoints,
+    one_pct: f64,
+}
+
+/// A random move of vertex `v`; a draw whose walk meets the boundary (eye opening) is redrawn
+/// (up to 50 times). Returns (radius, direction, end point).
+fn draw(
+    rng: &mut ChaCha8Rng,
+    w: &Walker<'_>,
+    d: f64,
+    v: u32,
+    towards: DVec3,
+) -> Result<(f64, f64, SurfacePoint)> {
+    let mut last = None;
+    for _ in 0..50 {
+        let rad = rng.random_range(0.0..0.05) * d;
+        let th = rng.random_range(0.0..std::f64::consts::TAU);
+        let (sp, cut) = perturb(w, v, towards, rad, th)?;
+        last = Some((rad, th, sp));
+        if !cut {
+            break;
+        }
+    }
+    last.ok_or_else(|| anyhow::anyhow!("no perturbation drawn"))
+}
+
+fn one_face(ctx: &Ctx<'_>, prep: &Prepared, i: usize) -> Result<Run> {
+    let f = &ctx.faces[i];
+    let r0 = &prep.refs[i];
+    let w = &ctx.walkers[i];
+    let s = prep.solvers[i].as_ref();
+    let lm = f.landmarks;
+    let n = ctx.args.levels;
+    let mut rng =
+        ChaCha8Rng::seed_from_u64(ctx.args.seed ^ (i as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
+    // One corner (q).
+    let (rad, th, spq) = draw(&mut rng, w, r0.d, lm.left_eye_outer, r0.r)?;
+    let uq = field(s, Source::Point(spq))?;
+    let q = f.mesh.point_position(&spq)?;
+    let d1 = 0.5 * (uq[lm.right_eye_outer as usize] + field_at(&f.mesh, &r0.ur, &spq));
+    let one = Refs {
+        ur: r0.ur.clone(),
+        uq: uq.clone(),
+        d: d1,
+        r: r0.r,
+        q,
+        nose: r0.nose,
+        frame: face_frame(&f.mesh, r0.r, q, r0.nose),
+    };
+    let one = ctx.describe(&f.mesh, &one, n, Region::Static, || {
+        format!("{} (random error on q)", f.name)
+    });
+    // Both corners (q as above, r moved independently).
+    let (_, _, spr) = draw(&mut rng, w, r0.d, lm.right_eye_outer, r0.q)?;
+    let ur = field(s, Source::Point(spr))?;
+    let r = f.mesh.point_position(&spr)?;
+    let d2 = 0.5 * (field_at(&f.mesh, &ur, &spq) + field_at(&f.mesh, &uq, &spr));
+    let both = Refs {
+        ur,
+        uq,
+        d: d2,
+        r,
+        q,
+        nose: r0.nose,
+        frame: face_frame(&f.mesh, r, q, r0.nose),
+    };
+    let both = ctx.describe(&f.mesh, &both, n, Region::Static, || {
+        format!("{} (random errors on r and q)", f.name)
+    });
+    // Nose tip, with the same radius/direction draw as the single corner.
+    let (spn, _) = perturb(w, lm.nose_tip, eye_mid(r0), rad, th)?;
+    let un = field(s, Source::Point(spn))?;
+    let nose = polar_descriptor(w, &un, Pole::Point(spn), eye_mid(r0), &ctx.polar_opts(r0))?;
+    Ok(Run {
+        one,
+        both,
+        nose,
+        one_pct: 100.0 * rad / r0.d,
+    })
+}
+
+/// Fills the random-error matrices.
+pub(super) fn run(ctx: &Ctx<'_>, prep: &Prepared, res: &mut MethodResults) -> Result<()> {
+    let nf = ctx.faces.len();
+    let pb = bar(nf, &format!("{}: random errors", ctx.mname()));
+    let runs: Vec<Run> = (0..nf)
+        .into_par_iter()
+        .map(|i| {
+            let r = one_face(ctx, prep, i);
+            pb.inc(1);
+            r
+        })
+        .collect::<Result<_>>()?;
+    pb.finish();
+    let (mut one, mut both, mut nose) = (Vec::new(), Vec::new(), Vec::new());
+    for r in runs {
+        res.rand_one_pct.push(r.one_pct);
+        one.push(r.one);
+        both.push(r.both);
+        nose.push(r.nose);
+    }
+    res.m_rand_one = ctx.matrix(&one, "random error on q");
+    res.m_rand_both = ctx.matrix(&both, "random errors on r and q");
+    res.m_rand_nose = ctx.matrix_pole(&nose, "single pole, random error on the nose tip");
+    Ok(())
+}
