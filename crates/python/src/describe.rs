@@ -5,7 +5,7 @@ use crate::descriptor::PyDescriptor;
 use crate::errors;
 use crate::geodesic::PyGeodesicSolver;
 use crate::mesh::mesh_arg;
-use bipolar::{DescriptorOptions, LevelSpec, SelectionRule, Source, TangentMethod};
+use bipolar::{DescriptorOptions, LevelSpec, Source, TangentMethod};
 use geodesic::Method;
 use glam::DVec3;
 use meshcore::{FaceLocator, TriMesh};
