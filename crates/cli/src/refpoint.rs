@@ -120,7 +120,7 @@ impl<'a> Resolver<'a> {
             return self.snap(p, what, &format!("{s:?}"));
         }
         if let Some((file, lm)) = &self.given {
-            return self.landmark_in_file(s, what, file, lm);
+            return self.in_file(s, what, file, lm);
         }
         if let Some(name) = landmarks::LandmarkName::parse(s) {
             let found = match self.detected.get() {
@@ -154,7 +154,7 @@ impl<'a> Resolver<'a> {
     /// landmark in any spelling ([`landmarks::LandmarkName::parse`]) or are equal ignoring
     /// case. The file's vertex is used when it exists and sits at the given position (within
     /// 1e-5 of the bounding-box diagonal); otherwise the position is snapped.
-    fn landmark_in_file(
+    fn in_file(
         &self,
         s: &str,
         what: &str,
