@@ -118,7 +118,8 @@ fn symmetry(idx: &SurfaceIndex, face: &[(DVec3, DVec3)], t: &DAffine3, tau: f64)
         .iter()
         .filter_map(|(p, n)| {
             let h = idx.query(t.transform_point3(*p));
-            (h.d2 < tau2 && idx.nrm[h.vertex as usize].dot(t.transform_vector3(*n)) > 0.5).then_some(h.vertex)
+            (h.d2 < tau2 && idx.nrm[h.vertex as usize].dot(t.transform_vector3(*n)) > 0.5)
+                .then_some(h.vertex)
         })
         .collect();
     verts.sort_unstable();
@@ -584,7 +585,10 @@ fn refine(
     tau: f64,
 ) -> (u32, f64) {
     let tau2 = tau * tau;
-    let rotated: Vec<DVec3> = tpl.iter().map(|(q, _)| pose.transform_vector3(*q)).collect();
+    let rotated: Vec<DVec3> = tpl
+        .iter()
+        .map(|(q, _)| pose.transform_vector3(*q))
+        .collect();
     let eval = |c: DVec3, pts: &mut dyn Iterator<Item = &DVec3>| -> f64 {
         let mut s = 0.0;
         let mut n = 0usize;

@@ -181,7 +181,11 @@ impl DepthMap {
 
     /// Rasterises the triangles of `mesh` moved by `t`, keeping the largest `z` per node.
     fn rasterise(&mut self, mesh: &TriMesh, t: &DAffine3) {
-        let pos: Vec<DVec3> = mesh.positions().iter().map(|p| t.transform_point3(*p)).collect();
+        let pos: Vec<DVec3> = mesh
+            .positions()
+            .iter()
+            .map(|p| t.transform_point3(*p))
+            .collect();
         self.rasterise_moved(&pos, mesh.triangles());
     }
 

@@ -188,7 +188,6 @@ fn perturbation(seed: u64, angle: f64, shift: f64) -> DAffine3 {
     DAffine3::from_mat3_translation(r, t)
 }
 
-
 impl LandmarkRegressor {
     /// Trains the regression on faces with their true landmarks ([`LandmarkName::ALL`] order)
     /// and the model-to-mesh poses the detector fitted to them (as in
@@ -241,7 +240,11 @@ impl LandmarkRegressor {
                 continue;
             }
             used += 1;
-            let canon: Vec<DVec3> = mesh.positions().iter().map(|p| inv.transform_point3(*p)).collect();
+            let canon: Vec<DVec3> = mesh
+                .positions()
+                .iter()
+                .map(|p| inv.transform_point3(*p))
+                .collect();
             // The detected pose, then the same pose moved by small random rigid motions about
             // the nose tip (canonical origin): the regression then learns to correct pose errors
             // too, not only the offsets seen under the detector's typical pose error.
@@ -371,7 +374,11 @@ impl LandmarkRegressor {
     /// fitted model-to-mesh pose.
     pub(crate) fn predict(&self, mesh: &TriMesh, pose: &DAffine3) -> [DVec3; 5] {
         let inv = rigid_inverse(pose);
-        let canon: Vec<DVec3> = mesh.positions().iter().map(|p| inv.transform_point3(*p)).collect();
+        let canon: Vec<DVec3> = mesh
+            .positions()
+            .iter()
+            .map(|p| inv.transform_point3(*p))
+            .collect();
         let mut out = [DVec3::ZERO; 5];
         for (k, p) in self.patches.iter().enumerate().take(5) {
             let x = raw_inputs(&patch_depths(&canon, mesh.triangles(), p));

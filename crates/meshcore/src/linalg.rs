@@ -449,14 +449,14 @@ mod tests {
         use proptest::prelude::*;
 
         fn vec3() -> impl Strategy<Value = DVec3> {
-            (-10.0..10.0f64, -10.0..10.0f64, -10.0..10.0f64).prop_map(|(x, y, z)| DVec3::new(x, y, z))
+            (-10.0..10.0f64, -10.0..10.0f64, -10.0..10.0f64)
+                .prop_map(|(x, y, z)| DVec3::new(x, y, z))
         }
 
         fn motion() -> impl Strategy<Value = DAffine3> {
             (vec3(), 0.0..std::f64::consts::PI, vec3()).prop_filter_map("axis", |(ax, ang, t)| {
-                (ax.length() > 1e-3).then(|| {
-                    DAffine3::from_mat3_translation(axis_angle(ax, ang), t * 10.0)
-                })
+                (ax.length() > 1e-3)
+                    .then(|| DAffine3::from_mat3_translation(axis_angle(ax, ang), t * 10.0))
             })
         }
 

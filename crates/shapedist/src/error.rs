@@ -63,4 +63,7 @@ pub enum ShapeDistError {
     /// Two matrices of different sizes, or a matrix input with fewer than one set.
     #[error("invalid option: {0}")]
     InvalidOption(String),
+    /// A mesh target of ICP failed to answer a query (for example a non-finite moved point).
+    #[error("ICP target: {0}")]
+    Mesh(#[from] meshcore::MeshError),
 }
