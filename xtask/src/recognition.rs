@@ -25,6 +25,7 @@ use meshcore::{DVec3, FaceLocator, TriMesh};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
+use shapedist::{icp_to_target, Convergence, IcpLoopOptions, IcpVariant, TrimRounding};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -168,50 +169,43 @@ fn eer_roc(gen: &[f64], imp: &[f64]) -> (f64, Vec<(f64, f64)>) {
     (eer, roc)
 }
 
-/// ICP of the probe points onto the gallery surface (closest points on triangles), started from
-/// the landmark alignment; trims the worst 10 % of pairs; returns the RMS closest-point
-/// distance of all probe points at the final pose (cm).
+/// The recognition ICP: point-to-point with translation onto the closest surface points,
+/// the worst 10 % of pairs trimmed (kept count rounded down), at most 6 iterations, stop
+/// after a step when the trimmed RMS changed by at most `1e-6` relative.
+fn icp_options() -> IcpLoopOptions {
+    IcpLoopOptions {
+        variant: IcpVariant::PointToPoint,
+        max_iterations: 6,
+        translation: true,
+        trim: 0.1,
+        trim_rounding: TrimRounding::Down,
+        convergence: Convergence::RelativeRmseAfterStep { tolerance: 1e-6 },
+        evaluate_final: false,
+        ..IcpLoopOptions::default()
+    }
+}
+
+/// ICP of the probe points onto the gallery surface ([`shapedist::icp_to_target`] on the
+/// [`FaceLocator`], options [`icp_options`]), started from the landmark alignment; returns
+/// the RMS closest-point distance of all probe points at the final pose (cm), NaN when a
+/// step fails.
 fn icp_score(
     probe: &[DVec3],
     probe_lm: &[DVec3; 3],
     gallery: &FaceLocator<'_>,
     gallery_lm: &[DVec3; 3],
 ) -> f64 {
-    let Some(mut m) = fit_rigid(probe_lm, gallery_lm, None) else {
+    let Some(init) = fit_rigid(probe_lm, gallery_lm, None) else {
         return f64::NAN;
     };
-    let mut prev = f64::INFINITY;
-    for _ in 0..6 {
-        let moved: Vec<DVec3> = probe.iter().map(|p| m.transform_point3(*p)).collect();
-        let mut pairs: Vec<(f64, DVec3, DVec3)> = Vec::with_capacity(probe.len());
-        for (k, m) in moved.iter().enumerate() {
-            let Ok((sp, d)) = gallery.nearest(*m) else {
-                return f64::NAN;
-            };
-            let Ok(c) = gallery.mesh().point_position(&sp) else {
-                return f64::NAN;
-            };
-            pairs.push((d, probe[k], c));
-        }
-        pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let keep = (pairs.len() * 9 / 10).max(3);
-        let rms = (pairs[..keep].iter().map(|p| p.0 * p.0).sum::<f64>() / keep as f64).sqrt();
-        let src: Vec<DVec3> = pairs[..keep].iter().map(|p| p.1).collect();
-        let dst: Vec<DVec3> = pairs[..keep].iter().map(|p| p.2).collect();
-        let Some(next) = fit_rigid(&src, &dst, None) else {
-            return f64::NAN;
-        };
-        m = next;
-        if (prev - rms).abs() <= 1e-6 * rms.max(1e-12) {
-            break;
-        }
-        prev = rms;
-    }
+    let Ok(res) = icp_to_target(gallery, probe, None, init, &icp_options()) else {
+        return f64::NAN;
+    };
     let ss: f64 = probe
         .iter()
         .map(|p| {
             gallery
-                .nearest(m.transform_point3(*p))
+                .nearest(res.motion.transform_point3(*p))
                 .map_or(f64::NAN, |(_, d)| d * d)
         })
         .sum();

@@ -1,11 +1,12 @@
 //! The surface index of the detector (nearest vertex queries with a point-to-surface
 //! approximation), the fit score of a template pose, and point-to-plane ICP onto the index.
 
-#![allow(clippy::needless_range_loop)] // Dense small linear algebra reads best with indices.
-
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
-use meshcore::linalg::solve_sym_tol;
 use meshcore::{DAffine3, DMat3, DQuat, DVec3};
+use shapedist::{
+    icp_to_target, Convergence, Damping, IcpLoopOptions, IcpTarget, IcpVariant, Match,
+    ShapeDistError,
+};
 
 /// Vertex positions and normals with a k-d tree, answering approximate point-to-surface distances.
 #[derive(Debug)]
@@ -123,8 +124,71 @@ pub fn score(
     }
 }
 
-/// Point-to-plane ICP of template points onto the surface, starting from `t0`; correspondences
-/// are the nearest vertices, inliers as in [`score`]. Returns the refined motion.
+/// The detector's ICP target: partners are the nearest vertices ([`SurfaceIndex::query`]),
+/// with the approximate point-to-surface squared distance and the vertex normals.
+impl IcpTarget for SurfaceIndex {
+    type State = ();
+
+    fn start(&self, _n: usize) -> Self::State {}
+
+    fn has_normals(&self) -> bool {
+        true
+    }
+
+    fn correspond(
+        &self,
+        src: &[DVec3],
+        pose: &DAffine3,
+        _normals: bool,
+        _state: &mut (),
+        out: &mut [Match],
+    ) -> Result<usize, ShapeDistError> {
+        for (o, p) in out.iter_mut().zip(src) {
+            let h = self.query(pose.transform_point3(*p));
+            let v = h.vertex as usize;
+            *o = Match {
+                d2: h.d2,
+                point: self.pos[v],
+                normal: self.nrm[v],
+            };
+        }
+        Ok(src.len())
+    }
+}
+
+/// The options of the detector's ICP: point-to-plane with translation, pairs closer than
+/// `tau` whose normals agree (`dot > min_dot`), no trimming, damping `1e-9` times the mean
+/// diagonal entry (plus `1e-300`), at least 6 pairs, stop when a step rotates by less than
+/// `1e-7` rad and moves by less than `1e-7 (1 + |t|)`; no re-orthonormalisation per step.
+pub fn icp_options(iterations: usize, tau: f64, min_dot: f64) -> IcpLoopOptions {
+    IcpLoopOptions {
+        variant: IcpVariant::PointToPlane,
+        max_iterations: iterations,
+        translation: true,
+        max_distance: Some(tau),
+        min_normal_dot: Some(min_dot),
+        damping: Damping {
+            factor: 1e-9,
+            mean: true,
+            floor: 1e-300,
+            rel_pivot: 1e-13,
+        },
+        min_step_angle: 1e-15,
+        orthonormalise_steps: false,
+        convergence: Convergence::StepSize {
+            angle: 1e-7,
+            translation: 1e-7,
+        },
+        min_pairs: 6,
+        evaluate_final: false,
+        ..IcpLoopOptions::default()
+    }
+}
+
+/// Point-to-plane ICP of template points (with normals) onto the surface, starting from `t0`
+/// ([`shapedist::icp_to_target`] with [`icp_options`]); inliers as in [`score`]. Returns the
+/// refined motion with its rotation re-orthonormalised (through a unit quaternion); `t0` when
+/// there are no iterations or the options are invalid (a NaN `tau` or `min_dot`).
 pub fn icp(
     idx: &SurfaceIndex,
     pts: &[(DVec3, DVec3)],
@@ -133,57 +197,69 @@ pub fn icp(
     tau: f64,
     min_dot: f64,
 ) -> DAffine3 {
-    let mut t = *t0;
-    let tau2 = tau * tau;
-    for _ in 0..iterations {
-        let mut ata = [[0.0; 6]; 6];
-        let mut atb = [0.0; 6];
-        let mut count = 0;
-        for (p, n) in pts {
-            let q = t.transform_point3(*p);
-            let h = idx.query(q);
-            let vn = idx.nrm[h.vertex as usize];
-            if h.d2 >= tau2 || vn.dot(t.transform_vector3(*n)) <= min_dot {
-                continue;
-            }
-            let target = idx.pos[h.vertex as usize];
-            // Linearised: ((q + w x q + dt) - target) . vn = 0.
-            let c = q.cross(vn);
-            let row = [c.x, c.y, c.z, vn.x, vn.y, vn.z];
-            let rhs = -(q - target).dot(vn);
-            for i in 0..6 {
-                for j in 0..6 {
-                    ata[i][j] += row[i] * row[j];
-                }
-                atb[i] += row[i] * rhs;
-            }
-            count += 1;
-        }
-        if count < 6 {
-            break;
-        }
-        // Light Tikhonov damping for stability on nearly flat templates.
-        let tr: f64 = (0..6).map(|i| ata[i][i]).sum::<f64>() / 6.0;
-        for (i, row) in ata.iter_mut().enumerate() {
-            row[i] += 1e-9 * tr + 1e-300;
-        }
-        let Some(x) = solve_sym_tol(ata, atb, 1e-13) else {
-            break;
-        };
-        let w = DVec3::new(x[0], x[1], x[2]);
-        let dt = DVec3::new(x[3], x[4], x[5]);
-        let angle = w.length();
-        let dr = if angle > 1e-15 {
-            DMat3::from_axis_angle(w / angle, angle)
-        } else {
-            DMat3::IDENTITY
-        };
-        t = DAffine3::from_mat3_translation(dr, dt) * t;
-        if angle < 1e-7 && dt.length() < 1e-7 * (1.0 + t.translation.length()) {
-            break;
-        }
-    }
+    let (src, nrm): (Vec<DVec3>, Vec<DVec3>) = pts.iter().copied().unzip();
+    let t = if iterations == 0 {
+        *t0
+    } else {
+        icp_to_target(
+            idx,
+            &src,
+            Some(&nrm),
+            *t0,
+            &icp_options(iterations, tau, min_dot),
+        )
+        .map_or(*t0, |r| r.motion)
+    };
     // Re-orthonormalise the rotation (accumulated round-off).
     let q = DQuat::from_mat3(&t.matrix3).normalize();
     DAffine3::from_mat3_translation(DMat3::from_quat(q), t.translation)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use meshcore::linalg::rigid_inverse;
+    use proptest::prelude::*;
+
+    fn ellipsoid() -> meshcore::TriMesh {
+        let (pos, tri) = meshcore::shapes::icosphere(3).into_parts();
+        let pos = pos
+            .into_iter()
+            .map(|p| p * DVec3::new(3.0, 2.0, 1.2))
+            .collect();
+        meshcore::TriMesh::new(pos, tri).unwrap()
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(12))]
+
+        #[test]
+        fn a_rigid_copy_of_the_surface_is_recovered(
+            ax in (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64),
+            deg in 0.0..8.0f64,
+            t in (-0.1..0.1f64, -0.1..0.1f64, -0.1..0.1f64),
+        ) {
+            let mesh = ellipsoid();
+            let idx = crate::detect::surface_index(&mesh);
+            let axis = DVec3::new(ax.0, ax.1, ax.2 + 2.0);
+            let m = DAffine3::from_mat3_translation(
+                meshcore::linalg::axis_angle(axis, deg.to_radians()),
+                DVec3::new(t.0, t.1, t.2),
+            );
+            // Template = the vertices with their normals moved by m^-1: ICP must find m.
+            let inv = rigid_inverse(&m);
+            let pts: Vec<(DVec3, DVec3)> = idx
+                .pos
+                .iter()
+                .zip(&idx.nrm)
+                .step_by(2)
+                .map(|(p, n)| (inv.transform_point3(*p), inv.transform_vector3(*n)))
+                .collect();
+            let got = icp(&idx, &pts, &DAffine3::IDENTITY, 60, 1.0, 0.3);
+            let da = meshcore::linalg::rotation_angle_between(got.matrix3, m.matrix3);
+            let dt = (got.translation - m.translation).length();
+            prop_assert!(da < 1e-6 && dt < 1e-6, "{da} {dt}");
+            prop_assert!((got.matrix3.determinant() - 1.0).abs() < 1e-12);
+        }
+    }
 }

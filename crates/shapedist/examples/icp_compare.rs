@@ -12,7 +12,7 @@
 
 use std::time::Instant;
 
-use shapedist::glam::{DMat3, DVec3};
+use shapedist::glam::{DAffine3, DMat3, DVec3};
 use shapedist::*;
 
 fn read_npy(path: &str) -> Vec<DVec3> {
@@ -146,7 +146,7 @@ fn main() {
                 return;
             }
             let err = meshcore::linalg::rotation_angle_between(r, rtrue).to_degrees();
-            let st = closest_point_stats(&a, &b, r, DVec3::ZERO);
+            let st = closest_point_stats(&a, &b, &DAffine3::from_mat3(r));
             let nn = {
                 // source -> target RMSE only (as the peers' NN-RMSE)
                 let mut s = 0.0;
@@ -189,7 +189,7 @@ fn main() {
             "shapedist p2p, 50 iterations (no early exit)",
             ms,
             res.iterations.to_string(),
-            res.rotation,
+            res.motion.matrix3,
         );
         println!(
             "<!-- tree queries: {} of {} pair searches ({:.1} %) -->",
@@ -211,7 +211,7 @@ fn main() {
             "shapedist p2p, 40 it @500 + 10 it @all",
             ms,
             format!("{}+{}", res.coarse_iterations, res.iterations),
-            res.rotation,
+            res.motion.matrix3,
         );
         let sched2 = IcpOptions {
             max_iterations: 50,
@@ -224,7 +224,7 @@ fn main() {
             "shapedist p2p, <=50 it @500 + <=50 it @all, tol 1e-6",
             ms,
             format!("{}+{}", res.coarse_iterations, res.iterations),
-            res.rotation,
+            res.motion.matrix3,
         );
         let conv = IcpOptions {
             max_iterations: 500,
@@ -235,7 +235,7 @@ fn main() {
             "shapedist p2p, <=500 it, tol 1e-6",
             ms,
             res.iterations.to_string(),
-            res.rotation,
+            res.motion.matrix3,
         );
         let plane = IcpOptions {
             variant: IcpVariant::PointToPlane,
@@ -247,7 +247,7 @@ fn main() {
             "shapedist point-to-plane <=50 (normals not timed)",
             ms,
             res.iterations.to_string(),
-            res.rotation,
+            res.motion.matrix3,
         );
         for (name, g) in [
             (
@@ -270,7 +270,7 @@ fn main() {
                     "{}x{}+{}",
                     res.starts, g.coarse_iterations, res.icp.iterations
                 ),
-                res.icp.rotation,
+                res.icp.motion.matrix3,
             );
         }
         let keys: Vec<u64> = (0..n as u64).collect();
@@ -286,7 +286,7 @@ fn main() {
                     &format!("shapedist keyed {m:?} (pairing incl.)"),
                     ms,
                     "1".into(),
-                    res.rotation,
+                    res.motion.matrix3,
                 );
             }
         }

@@ -66,4 +66,7 @@ pub enum ShapeDistError {
     /// An option name that is none of the valid names (they are listed).
     #[error(transparent)]
     UnknownChoice(#[from] meshcore::UnknownChoice),
+    /// A mesh target of ICP failed to answer a query (for example a non-finite moved point).
+    #[error("ICP target: {0}")]
+    Mesh(#[from] meshcore::MeshError),
 }

@@ -12,7 +12,7 @@
 use std::num::NonZero;
 use std::sync::OnceLock;
 
-use glam::{DMat3, DVec3};
+use glam::{DAffine3, DMat3, DVec3};
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
@@ -23,15 +23,10 @@ use serde::Serialize;
 use crate::error::{ShapeDistError, Which};
 use crate::nn::{dist2, NeighbourGraph, PointTree, GROUP};
 use crate::points::{centred, check_spread, outer, principal_axes, radius, validate};
-use meshcore::linalg::{axis_angle, kabsch_rotation, solve_sym, sym_eigen3};
-
-/// Below this many source points the correspondence search runs on one thread (rayon's
-/// overhead dominates; the global search parallelises over starts instead).
-const PAR_MIN: usize = 2048;
-
-/// Source points per work unit. Partial sums are formed per chunk and added in chunk order,
-/// whatever the number of threads, so results do not depend on the thread count.
-const CHUNK: usize = 512;
+use crate::target::{
+    icp_to_target, Convergence, IcpLoopOptions, IcpTarget, Match, TrimRounding, CHUNK, PAR_MIN,
+};
+use meshcore::linalg::{rigid_inverse, sym_eigen3};
 
 /// "No point" index.
 const NONE: u32 = u32::MAX;
@@ -179,10 +174,6 @@ impl PreparedSet {
         &self.graph
     }
 
-    fn sub_graph(&self) -> &NeighbourGraph {
-        &self.sub_graph
-    }
-
     /// The exact nearest-neighbour tree of the centred points (its leaf order is the order in
     /// which ICP visits the points of a source set).
     pub fn point_tree(&self) -> &PointTree {
@@ -243,10 +234,9 @@ impl Default for IcpOptions {
 /// Result of an ICP run.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct IcpResult {
-    /// Rotation mapping centred B onto centred A.
-    pub rotation: DMat3,
-    /// Translation after the rotation (zero unless [`IcpOptions::translation`]).
-    pub translation: DVec3,
+    /// Rigid motion mapping centred B onto centred A (`a ~ motion * b`); the translation is
+    /// zero unless [`IcpOptions::translation`].
+    pub motion: DAffine3,
     /// Iterations run.
     pub iterations: usize,
     /// RMS distance of the kept pairs at the final pose.
@@ -263,19 +253,22 @@ pub struct IcpResult {
     pub tree_queries: usize,
 }
 
-fn check_icp_options(o: &IcpOptions) -> Result<(), ShapeDistError> {
-    if !(0.0..=0.9).contains(&o.trim) {
-        return Err(ShapeDistError::InvalidOption(format!(
-            "trim fraction must be in [0, 0.9], got {}",
-            o.trim
-        )));
+impl IcpOptions {
+    /// The options of the generic loop ([`icp_to_target`]) that run these: no gates, trim
+    /// count rounded up, damping `1e-12 tr`, relative RMS convergence before the step.
+    pub fn loop_options(&self) -> IcpLoopOptions {
+        IcpLoopOptions {
+            variant: self.variant,
+            max_iterations: self.max_iterations,
+            translation: self.translation,
+            trim: self.trim,
+            trim_rounding: TrimRounding::Up,
+            convergence: Convergence::RelativeRmse {
+                tolerance: self.tolerance,
+            },
+            ..IcpLoopOptions::default()
+        }
     }
-    if o.tolerance.is_nan() || o.tolerance < 0.0 || o.max_iterations == 0 {
-        return Err(ShapeDistError::InvalidOption(
-            "tolerance must be >= 0 and max_iterations >= 1".into(),
-        ));
-    }
-    Ok(())
 }
 
 /// Graph moves allowed per point and iteration before falling back to a tree query.
@@ -295,8 +288,7 @@ const BACKOFF: u8 = 3;
 /// other points are answered by the tree, in groups, seeded with the walk's end (or, without
 /// a previous partner, the partner of the preceding source point: the source is in a
 /// spatially coherent order). Seeds only bound the search, the result is the same exact
-/// minimum. With `accumulate`, also returns the sums of all pairs (fused pass of the
-/// untrimmed point-to-point step). The second return value counts the tree queries.
+/// minimum. Returns the number of tree queries.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 fn correspond_chunk(
@@ -309,9 +301,7 @@ fn correspond_chunk(
     out: &mut [(f64, u32)],
     skip: &mut [u8],
     warm: bool,
-    accumulate: bool,
-) -> (Sums, usize) {
-    let mut s = Sums::ZERO;
+) -> usize {
     let mut prev = NONE;
     let mut queries = 0;
     let mut ps = [DVec3::ZERO; GROUP];
@@ -357,18 +347,12 @@ fn correspond_chunk(
             queries += nq;
         }
         prev = o[g - 1].1;
-        if accumulate {
-            for k in 0..g {
-                s.push(tgt[o[k].1 as usize], b[k], o[k].0);
-            }
-        }
     }
-    (s, queries)
+    queries
 }
 
-/// Correspondences of all source points (see [`correspond_chunk`]); returns the sums of all
-/// pairs when `accumulate` (added chunk by chunk in order: deterministic) and the number of
-/// tree queries.
+/// Correspondences of all source points (see [`correspond_chunk`]), chunk by chunk (in
+/// parallel when `parallel`); returns the number of tree queries.
 #[allow(clippy::too_many_arguments)]
 fn correspond(
     tree: &PointTree,
@@ -381,302 +365,172 @@ fn correspond(
     skip: &mut [u8],
     parallel: bool,
     warm: bool,
-    accumulate: bool,
-) -> (Sums, usize) {
+) -> usize {
     type Part<'a> = ((&'a mut [(f64, u32)], &'a mut [u8]), &'a [DVec3]);
-    let run =
-        |((o, k), s): Part<'_>| correspond_chunk(tree, graph, tgt, s, r, t, o, k, warm, accumulate);
-    let add = |x: (Sums, usize), y: (Sums, usize)| (x.0.add(y.0), x.1 + y.1);
+    let run = |((o, k), s): Part<'_>| correspond_chunk(tree, graph, tgt, s, r, t, o, k, warm);
     if parallel {
-        let parts: Vec<(Sums, usize)> = out
-            .par_chunks_mut(CHUNK)
+        out.par_chunks_mut(CHUNK)
             .zip(skip.par_chunks_mut(CHUNK))
             .zip(src.par_chunks(CHUNK))
             .map(run)
-            .collect();
-        parts.into_iter().fold((Sums::ZERO, 0), add)
+            .sum()
     } else {
         out.chunks_mut(CHUNK)
             .zip(skip.chunks_mut(CHUNK))
             .zip(src.chunks(CHUNK))
             .map(run)
-            .fold((Sums::ZERO, 0), add)
+            .sum()
     }
 }
 
-/// Squared-distance threshold keeping the `(1 - trim)` closest pairs (`inf` = keep all).
-fn trim_threshold(corr: &[(f64, u32)], trim: f64, scratch: &mut Vec<f64>) -> f64 {
-    if trim <= 0.0 {
-        return f64::INFINITY;
-    }
-    let keep = ((corr.len() as f64) * (1.0 - trim)).ceil().max(3.0) as usize;
-    if keep >= corr.len() {
-        return f64::INFINITY;
-    }
-    scratch.clear();
-    scratch.extend(corr.iter().map(|c| c.0));
-    let (_, kth, _) = scratch.select_nth_unstable_by(keep - 1, f64::total_cmp);
-    *kth
-}
-
+/// One point set of a [`PreparedSet`] as an ICP target: all points (with the lazily
+/// estimated normals) or the subsample of the coarse search (no normals, one thread).
 #[derive(Clone, Copy)]
-struct Sums {
-    n: f64,
-    ss: f64,
-    sa: DVec3,
-    sb: DVec3,
-    k: DMat3,
+struct SetTarget<'a> {
+    set: &'a PreparedSet,
+    sub: bool,
 }
 
-impl Sums {
-    const ZERO: Sums = Sums {
-        n: 0.0,
-        ss: 0.0,
-        sa: DVec3::ZERO,
-        sb: DVec3::ZERO,
-        k: DMat3::ZERO,
-    };
-    #[inline(always)]
-    fn push(&mut self, a: DVec3, b: DVec3, d2: f64) {
-        self.n += 1.0;
-        self.ss += d2;
-        self.sa += a;
-        self.sb += b;
-        self.k += outer(a, b);
-    }
-    fn add(self, o: Sums) -> Sums {
-        Sums {
-            n: self.n + o.n,
-            ss: self.ss + o.ss,
-            sa: self.sa + o.sa,
-            sb: self.sb + o.sb,
-            k: self.k + o.k,
+/// Warm-start state of a run onto a [`PreparedSet`]: the previous partners `(squared
+/// distance, index)`, the graph-walk back-off counters and whether a pass has run.
+#[derive(Debug)]
+pub struct SetState {
+    corr: Vec<(f64, u32)>,
+    skip: Vec<u8>,
+    warm: bool,
+}
+
+impl SetTarget<'_> {
+    fn parts(&self) -> (&[DVec3], &PointTree, &NeighbourGraph) {
+        if self.sub {
+            (&self.set.sub_points, &self.set.sub_nn, &self.set.sub_graph)
+        } else {
+            (&self.set.points, &self.set.nn, &self.set.graph)
         }
     }
 }
 
-/// Runs ICP of `src` (centred B, or a subsample, in any order) onto a target given by its
-/// points, tree and (for point-to-plane) normals, from the initial rotation `init`.
-#[allow(clippy::too_many_arguments)]
-fn icp_core(
-    tgt_pts: &[DVec3],
-    tree: &PointTree,
-    graph: Option<&NeighbourGraph>,
-    normals: Option<&[DVec3]>,
-    src: &[DVec3],
-    init: DMat3,
-    init_t: DVec3,
-    o: &IcpOptions,
-    parallel: bool,
-) -> IcpResult {
-    let parallel = parallel && src.len() >= PAR_MIN;
-    let plane = o.variant == IcpVariant::PointToPlane && normals.is_some();
-    // Untrimmed point-to-point: the sums of the closed-form step are accumulated in the
-    // correspondence pass itself (one pass over the source per iteration).
-    let fused = !plane && o.trim <= 0.0;
-    let mut r = init;
-    let mut t = init_t;
-    let mut corr = vec![(f64::INFINITY, NONE); src.len()];
-    let mut skip = vec![0u8; src.len()];
-    let mut queries = 0;
-    let mut scratch = Vec::new();
-    let mut prev_rmse = f64::INFINITY;
-    let mut rmse = f64::INFINITY;
-    let mut iterations = 0;
-    let mut converged = false;
-    while iterations < o.max_iterations {
-        let (all, nq) = correspond(
+impl IcpTarget for SetTarget<'_> {
+    type State = SetState;
+
+    fn start(&self, n: usize) -> SetState {
+        SetState {
+            corr: vec![(f64::INFINITY, NONE); n],
+            skip: vec![0; n],
+            warm: false,
+        }
+    }
+
+    fn has_normals(&self) -> bool {
+        !self.sub
+    }
+
+    fn correspond(
+        &self,
+        src: &[DVec3],
+        pose: &DAffine3,
+        normals: bool,
+        st: &mut SetState,
+        out: &mut [Match],
+    ) -> Result<usize, ShapeDistError> {
+        let (pts, tree, graph) = self.parts();
+        let parallel = !self.sub && src.len() >= PAR_MIN;
+        let nq = correspond(
             tree,
-            graph,
-            tgt_pts,
+            Some(graph),
+            pts,
             src,
-            r,
-            t,
-            &mut corr,
-            &mut skip,
+            pose.matrix3,
+            pose.translation,
+            &mut st.corr,
+            &mut st.skip,
             parallel,
-            iterations > 0,
-            fused,
+            st.warm,
         );
-        queries += nq;
-        iterations += 1;
-        // Statistics of the kept pairs at the current pose.
-        let (thr, kept) = if fused {
-            (f64::INFINITY, all)
-        } else {
-            let thr = trim_threshold(&corr, o.trim, &mut scratch);
-            (thr, kept_sums(tgt_pts, src, &corr, thr, parallel))
-        };
-        rmse = (kept.ss / kept.n.max(1.0)).sqrt();
-        if rmse == 0.0
-            || (prev_rmse.is_finite() && (prev_rmse - rmse).abs() <= o.tolerance * prev_rmse)
-        {
-            converged = true;
-            break;
+        st.warm = true;
+        let nrm = (normals && !self.sub).then(|| self.set.normals());
+        for (o, c) in out.iter_mut().zip(&st.corr) {
+            let j = c.1 as usize;
+            *o = Match {
+                d2: c.0,
+                point: pts[j],
+                normal: nrm.map_or(DVec3::ZERO, |n| n[j]),
+            };
         }
-        prev_rmse = rmse;
-        let (nr, nt) = match (o.variant, normals) {
-            (IcpVariant::PointToPlane, Some(nrm)) => {
-                plane_step(tgt_pts, nrm, src, &corr, thr, r, t, o.translation)
-            }
-            _ => point_step(&kept, r, t, o.translation),
-        };
-        r = nr;
-        t = nt;
-    }
-    if !converged {
-        // Report the error at the returned pose.
-        let (all, nq) = correspond(
-            tree, graph, tgt_pts, src, r, t, &mut corr, &mut skip, parallel, true, fused,
-        );
-        queries += nq;
-        let kept = if fused {
-            all
-        } else {
-            let thr = trim_threshold(&corr, o.trim, &mut scratch);
-            kept_sums(tgt_pts, src, &corr, thr, parallel)
-        };
-        rmse = (kept.ss / kept.n.max(1.0)).sqrt();
-    }
-    IcpResult {
-        rotation: r,
-        translation: t,
-        iterations,
-        rmse,
-        converged,
-        coarse_iterations: 0,
-        pair_searches: src.len() * (iterations + usize::from(!converged)),
-        tree_queries: queries,
+        Ok(nq)
     }
 }
 
-/// Sums over the pairs whose squared distance is at most `thr` (chunked, added in order).
-fn kept_sums(tgt: &[DVec3], src: &[DVec3], corr: &[(f64, u32)], thr: f64, parallel: bool) -> Sums {
-    let run = |(c, b): (&[(f64, u32)], &[DVec3])| {
-        let mut s = Sums::ZERO;
-        for (c, b) in c.iter().zip(b) {
-            if c.0 <= thr {
-                s.push(tgt[c.1 as usize], *b, c.0);
-            }
+/// The centred points of the set, exact nearest points (the same answers as brute force,
+/// ties to the lowest index), PCA normals ([`PreparedSet::normals`]).
+impl IcpTarget for PreparedSet {
+    type State = SetState;
+
+    fn start(&self, n: usize) -> SetState {
+        SetTarget {
+            set: self,
+            sub: false,
         }
-        s
-    };
-    if parallel {
-        let parts: Vec<Sums> = corr
-            .par_chunks(CHUNK)
-            .zip(src.par_chunks(CHUNK))
-            .map(run)
-            .collect();
-        parts.into_iter().fold(Sums::ZERO, Sums::add)
-    } else {
-        corr.chunks(CHUNK)
-            .zip(src.chunks(CHUNK))
-            .map(run)
-            .fold(Sums::ZERO, Sums::add)
+        .start(n)
+    }
+
+    fn has_normals(&self) -> bool {
+        true
+    }
+
+    fn correspond(
+        &self,
+        src: &[DVec3],
+        pose: &DAffine3,
+        normals: bool,
+        st: &mut SetState,
+        out: &mut [Match],
+    ) -> Result<usize, ShapeDistError> {
+        SetTarget {
+            set: self,
+            sub: false,
+        }
+        .correspond(src, pose, normals, st, out)
     }
 }
 
-/// Closed-form point-to-point update from the sums of the kept pairs (`a ~ R b (+ t)`).
-fn point_step(s: &Sums, r: DMat3, t: DVec3, translation: bool) -> (DMat3, DVec3) {
-    if s.n < 3.0 {
-        return (r, t);
-    }
-    let mut k = s.k;
-    if translation {
-        let (ma, mb) = (s.sa / s.n, s.sb / s.n);
-        k -= outer(ma, mb) * s.n;
-        let (nr, _) = kabsch_rotation(k);
-        (nr, ma - nr * mb)
-    } else {
-        (kabsch_rotation(k).0, DVec3::ZERO)
-    }
-}
-
-#[allow(clippy::too_many_arguments)]
-fn plane_step(
-    tgt: &[DVec3],
-    nrm: &[DVec3],
+/// Runs [`icp_to_target`] of `src` onto one set of `a` from the rotation and translation
+/// `(r, t)`.
+fn run_set(
+    a: &PreparedSet,
+    sub: bool,
     src: &[DVec3],
-    corr: &[(f64, u32)],
-    thr: f64,
     r: DMat3,
     t: DVec3,
-    translation: bool,
-) -> (DMat3, DVec3) {
-    // Residual (p - a).n + w.(p x n) + d.n, p = R b + t; unknowns w (and d).
-    let mut ata = [[0.0; 6]; 6];
-    let mut atb = [0.0; 6];
-    for (c, b) in corr.iter().zip(src) {
-        if c.0 > thr {
-            continue;
-        }
-        let j = c.1 as usize;
-        let (a, n) = (tgt[j], nrm[j]);
-        let p = r * *b + t;
-        let cr = p.cross(n);
-        let row = [cr.x, cr.y, cr.z, n.x, n.y, n.z];
-        let res = (p - a).dot(n);
-        for u in 0..6 {
-            for v in u..6 {
-                ata[u][v] += row[u] * row[v];
-            }
-            atb[u] -= row[u] * res;
-        }
-    }
-    for u in 0..6 {
-        for v in 0..u {
-            ata[u][v] = ata[v][u];
-        }
-    }
-    let tr: f64 = (0..6).map(|i| ata[i][i]).sum();
-    let reg = tr * 1e-12 + f64::MIN_POSITIVE;
-    let (w, d) = if translation {
-        let mut m = ata;
-        (0..6).for_each(|i| m[i][i] += reg);
-        match solve_sym(m, atb) {
-            Some(x) => (DVec3::new(x[0], x[1], x[2]), DVec3::new(x[3], x[4], x[5])),
-            None => return (r, t),
-        }
-    } else {
-        let mut m = [[0.0; 3]; 3];
-        for u in 0..3 {
-            for v in 0..3 {
-                m[u][v] = ata[u][v];
-            }
-            m[u][u] += reg;
-        }
-        match solve_sym(m, [atb[0], atb[1], atb[2]]) {
-            Some(x) => (DVec3::new(x[0], x[1], x[2]), DVec3::ZERO),
-            None => return (r, t),
-        }
-    };
-    let dr = axis_angle(w, w.length());
-    let nr = meshcore::linalg::orthonormalise(dr * r);
-    let nt = if translation { dr * t + d } else { DVec3::ZERO };
-    (nr, nt)
+    o: &IcpOptions,
+) -> Result<IcpResult, ShapeDistError> {
+    icp_to_target(
+        &SetTarget { set: a, sub },
+        src,
+        None,
+        DAffine3::from_mat3_translation(r, t),
+        &o.loop_options(),
+    )
 }
 
-/// One ICP run of B onto A from the rotation `init` (about the centroids).
+/// One ICP run of B onto A from the rotation `init` (about the centroids): [`icp_to_target`]
+/// with [`IcpOptions::loop_options`], B's points in the leaf order of its tree.
 pub fn icp(
     a: &PreparedSet,
     b: &PreparedSet,
     init: DMat3,
     opts: &IcpOptions,
 ) -> Result<IcpResult, ShapeDistError> {
-    check_icp_options(opts)?;
     if !init.is_finite() {
         return Err(ShapeDistError::InvalidOption(
             "initial rotation is not finite".into(),
         ));
     }
-    let normals = (opts.variant == IcpVariant::PointToPlane).then(|| a.normals());
     let (mut r0, mut t0, mut coarse_it) = (init, DVec3::ZERO, 0);
     if opts.coarse_iterations > 0 {
-        let c = icp_core(
-            &a.sub_points,
-            &a.sub_nn,
-            Some(a.sub_graph()),
-            None,
+        let c = run_set(
+            a,
+            true,
             b.sub_nn.leaf_order_points(),
             init,
             DVec3::ZERO,
@@ -685,21 +539,10 @@ pub fn icp(
                 max_iterations: opts.coarse_iterations,
                 ..*opts
             },
-            false,
-        );
-        (r0, t0, coarse_it) = (c.rotation, c.translation, c.iterations);
+        )?;
+        (r0, t0, coarse_it) = (c.motion.matrix3, c.motion.translation, c.iterations);
     }
-    let mut res = icp_core(
-        &a.points,
-        &a.nn,
-        Some(a.graph()),
-        normals,
-        b.nn.leaf_order_points(),
-        r0,
-        t0,
-        opts,
-        true,
-    );
+    let mut res = run_set(a, false, b.nn.leaf_order_points(), r0, t0, opts)?;
     res.coarse_iterations = coarse_it;
     Ok(res)
 }
@@ -809,7 +652,7 @@ pub fn global_icp(
     b: &PreparedSet,
     opts: &GlobalOptions,
 ) -> Result<GlobalResult, ShapeDistError> {
-    check_icp_options(&opts.refine)?;
+    crate::target::check(&opts.refine.loop_options(), 0, None)?;
     let mut starts = principal_axes_starts(&a.points, &b.points);
     if opts.grid {
         starts.extend(cube_group());
@@ -826,22 +669,10 @@ pub fn global_icp(
         .par_iter()
         .enumerate()
         .map(|(i, &r0)| {
-            (
-                i,
-                icp_core(
-                    &a.sub_points,
-                    &a.sub_nn,
-                    Some(a.sub_graph()),
-                    None,
-                    b.sub_nn.leaf_order_points(),
-                    r0,
-                    DVec3::ZERO,
-                    &coarse_opts,
-                    false,
-                ),
-            )
+            let src = b.sub_nn.leaf_order_points();
+            run_set(a, true, src, r0, DVec3::ZERO, &coarse_opts).map(|c| (i, c))
         })
-        .collect();
+        .collect::<Result<_, _>>()?;
     coarse.sort_by(|x, y| x.1.rmse.total_cmp(&y.1.rmse).then(x.0.cmp(&y.0)));
     let best = coarse[0].1.rmse;
     let mut cands: Vec<IcpResult> = Vec::new();
@@ -850,46 +681,28 @@ pub fn global_icp(
             break;
         }
         if cands.iter().all(|d| {
-            meshcore::linalg::rotation_angle_between(d.rotation, c.rotation) > 10f64.to_radians()
+            meshcore::linalg::rotation_angle_between(d.motion.matrix3, c.motion.matrix3)
+                > 10f64.to_radians()
         }) {
             cands.push(*c);
         }
     }
     let mut finals = Vec::with_capacity(cands.len());
     for c in &cands {
-        let (mut r, mut t) = (c.rotation, c.translation);
+        let (mut r, mut t) = (c.motion.matrix3, c.motion.translation);
+        let src = b.nn.leaf_order_points();
         if opts.plane_warmup > 0 {
-            let w = icp_core(
-                &a.points,
-                &a.nn,
-                Some(a.graph()),
-                Some(a.normals()),
-                b.nn.leaf_order_points(),
-                r,
-                t,
-                &IcpOptions {
-                    variant: IcpVariant::PointToPlane,
-                    max_iterations: opts.plane_warmup,
-                    tolerance: 1e-6,
-                    ..opts.refine
-                },
-                true,
-            );
-            r = w.rotation;
-            t = w.translation;
+            let warm = IcpOptions {
+                variant: IcpVariant::PointToPlane,
+                max_iterations: opts.plane_warmup,
+                tolerance: 1e-6,
+                ..opts.refine
+            };
+            let w = run_set(a, false, src, r, t, &warm)?;
+            r = w.motion.matrix3;
+            t = w.motion.translation;
         }
-        let normals = (opts.refine.variant == IcpVariant::PointToPlane).then(|| a.normals());
-        finals.push(icp_core(
-            &a.points,
-            &a.nn,
-            Some(a.graph()),
-            normals,
-            b.nn.leaf_order_points(),
-            r,
-            t,
-            &opts.refine,
-            true,
-        ));
+        finals.push(run_set(a, false, src, r, t, &opts.refine)?);
     }
     let refined = finals.len();
     let icp = finals
@@ -904,7 +717,7 @@ pub fn global_icp(
     })
 }
 
-/// Closest-point statistics of two centred sets after the rotation `r` (B moved by `r`).
+/// Closest-point statistics of two centred sets after a rigid motion of B.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct ClosestPointStats {
     /// Symmetric Hausdorff distance `max(max_a min_b, max_b min_a)`.
@@ -922,12 +735,12 @@ pub struct ClosestPointStats {
     pub rms_normalised: f64,
 }
 
-/// Evaluates [`ClosestPointStats`] for the pose `a ~ r b + t` of centred sets.
+/// Evaluates [`ClosestPointStats`] for the pose `a ~ motion * b` of centred sets (`motion`
+/// rigid).
 pub fn closest_point_stats(
     a: &PreparedSet,
     b: &PreparedSet,
-    r: DMat3,
-    t: DVec3,
+    motion: &DAffine3,
 ) -> ClosestPointStats {
     let dir = |tgt: &PreparedSet, src: &[DVec3], r: DMat3, t: DVec3| -> (f64, f64, f64) {
         // Per-chunk partial sums added in chunk order: deterministic whatever the threads.
@@ -945,9 +758,14 @@ pub fn closest_point_stats(
             .into_iter()
             .fold((0.0, 0.0, 0.0), |x, y| (x.0.max(y.0), x.1 + y.1, x.2 + y.2))
     };
-    let (mb, sb, s2b) = dir(a, b.nn.leaf_order_points(), r, t);
-    let rt = r.transpose();
-    let (ma, sa, s2a) = dir(b, a.nn.leaf_order_points(), rt, -(rt * t));
+    let (mb, sb, s2b) = dir(
+        a,
+        b.nn.leaf_order_points(),
+        motion.matrix3,
+        motion.translation,
+    );
+    let inv = rigid_inverse(motion);
+    let (ma, sa, s2a) = dir(b, a.nn.leaf_order_points(), inv.matrix3, inv.translation);
     let (na, nb) = (a.points.len() as f64, b.points.len() as f64);
     let hausdorff = ma.max(mb);
     let mean = 0.5 * (sb / nb + sa / na);

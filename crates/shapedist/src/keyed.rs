@@ -2,7 +2,7 @@
 //! rotation exactly (Kabsch or Horn), optionally with robust (IRLS) weights and a residual
 //! gate.
 
-use glam::{DMat3, DVec3};
+use glam::{DAffine3, DMat3, DVec3};
 use serde::Serialize;
 
 use crate::error::{ShapeDistError, Which};
@@ -256,10 +256,9 @@ pub fn align_pairs(
 pub struct KeyedDistance {
     /// Normalised L2 distance in [0, 1] over the pairs used (weighted when robust).
     pub distance: f64,
-    /// Rotation mapping B onto A about the centroids.
-    pub rotation: DMat3,
-    /// Translation completing the rigid map: `a ~ R b + translation`.
-    pub translation: DVec3,
+    /// Rigid motion mapping B onto A: `a ~ motion * b`, with `motion.matrix3` the rotation
+    /// about the centroids and `motion.translation = c_a - R c_b`.
+    pub motion: DAffine3,
     /// Keys present exactly once in both sets.
     pub shared_keys: usize,
     /// Pairs used in the final fit (after the residual gate).
@@ -371,8 +370,10 @@ pub fn keyed_distance(
     let rmse = (res.iter().map(|r| r * r).sum::<f64>() / res.len() as f64).sqrt();
     Ok(KeyedDistance {
         distance: align.distance,
-        rotation: align.rotation,
-        translation: align.centroid_a - align.rotation * align.centroid_b,
+        motion: DAffine3::from_mat3_translation(
+            align.rotation,
+            align.centroid_a - align.rotation * align.centroid_b,
+        ),
         shared_keys: shared,
         pairs_used: pairs.len(),
         share_a: shared as f64 / a.len() as f64,

@@ -16,6 +16,11 @@
 //!   multi-start global strategy (principal axes + the 24 cube rotations on a subsample, then
 //!   refinement on all points). [`icp_distance`] returns the normalised symmetric Hausdorff,
 //!   mean and RMS closest-point distances after alignment ([`ClosestPointStats`]).
+//! * [`icp_to_target`]: the one ICP loop, generic over an [`IcpTarget`] (a [`PreparedSet`],
+//!   a mesh surface through [`meshcore::FaceLocator`], the landmark detector's surface index),
+//!   with point-to-point or point-to-plane steps, distance and normal gates, trimming,
+//!   damping and the stopping rule as options ([`IcpLoopOptions`]); [`icp`] and
+//!   [`global_icp`] run it. Rigid motions are [`glam::DAffine3`].
 //! * [`pairwise_matrix`] and [`write_matrix_csv`]: parallel symmetric distance matrices.
 //!
 //! The normalisations and their proofs of lying in [0, 1] are in `docs/shape-distance.md`.
@@ -27,8 +32,9 @@ pub mod keyed;
 mod matrix;
 pub mod nn;
 pub mod points;
+pub mod target;
 
-use glam::{DMat3, DVec3};
+use glam::{DAffine3, DVec3};
 use serde::Serialize;
 
 pub use error::{ShapeDistError, Which};
@@ -42,16 +48,17 @@ pub use keyed::{
     RobustLoss, RotationMethod,
 };
 pub use matrix::{pairwise_matrix, write_matrix_csv, PairError};
+pub use target::{
+    icp_to_target, Convergence, Damping, IcpLoopOptions, IcpTarget, Match, TrimRounding,
+};
 
 /// Result of [`icp_distance`]: the global alignment and the closest-point distances after it.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct IcpDistance {
     /// Closest-point distances (raw and normalised) at the final pose.
     pub stats: ClosestPointStats,
-    /// Rotation mapping centred B onto centred A.
-    pub rotation: DMat3,
-    /// Translation after the rotation (zero unless estimated).
-    pub translation: DVec3,
+    /// Rigid motion mapping centred B onto centred A (translation zero unless estimated).
+    pub motion: DAffine3,
     /// Iterations of the final refinement.
     pub iterations: usize,
     /// RMS of the kept pairs at the final pose (ICP's own objective).
@@ -69,11 +76,10 @@ pub fn icp_distance(
     opts: &GlobalOptions,
 ) -> Result<IcpDistance, ShapeDistError> {
     let g = global_icp(a, b, opts)?;
-    let stats = closest_point_stats(a, b, g.icp.rotation, g.icp.translation);
+    let stats = closest_point_stats(a, b, &g.icp.motion);
     Ok(IcpDistance {
         stats,
-        rotation: g.icp.rotation,
-        translation: g.icp.translation,
+        motion: g.icp.motion,
         iterations: g.icp.iterations,
         rmse: g.icp.rmse,
         converged: g.icp.converged,

@@ -5,7 +5,7 @@ mod common;
 use common::*;
 use proptest::prelude::*;
 use rand::Rng;
-use shapedist::glam::{DMat3, DVec3};
+use shapedist::glam::{DAffine3, DMat3, DVec3};
 use shapedist::*;
 
 fn prep(p: &[DVec3], w: Which) -> PreparedSet {
@@ -37,9 +37,9 @@ fn plain_icp_converges_from_a_small_rotation_both_variants() {
         )
         .unwrap();
         assert!(
-            angle_deg(res.rotation, rot) < 1e-6,
+            angle_deg(res.motion.matrix3, rot) < 1e-6,
             "{variant:?}: {}",
-            angle_deg(res.rotation, rot)
+            angle_deg(res.motion.matrix3, rot)
         );
         assert!(res.rmse < 1e-8);
         assert!(res.converged);
@@ -55,14 +55,14 @@ fn plain_icp_fails_from_180_degrees_but_the_global_strategy_does_not() {
     let (pa, pb) = (prep(&a, Which::A), prep(&b, Which::B));
     let plain = icp(&pa, &pb, DMat3::IDENTITY, &IcpOptions::default()).unwrap();
     assert!(
-        angle_deg(plain.rotation, rot) > 20.0,
+        angle_deg(plain.motion.matrix3, rot) > 20.0,
         "plain ICP found it: the test is too easy"
     );
     let d = icp_distance(&pa, &pb, &GlobalOptions::default()).unwrap();
     assert!(
-        angle_deg(d.rotation, rot) < 1e-6,
+        angle_deg(d.motion.matrix3, rot) < 1e-6,
         "{}",
-        angle_deg(d.rotation, rot)
+        angle_deg(d.motion.matrix3, rot)
     );
     assert!(d.stats.hausdorff_normalised < 1e-9);
     assert!(d.stats.mean_normalised < 1e-9);
@@ -92,7 +92,7 @@ fn global_icp_recovers_random_rotations_of_a_resampled_noisy_copy() {
         // the true rotation at this density. The global search must reach that minimum (ICP
         // started at the true rotation), not a different basin.
         let from_truth = icp(&pa, &pb, rot, &GlobalOptions::default().refine).unwrap();
-        let err = angle_deg(d.rotation, rot);
+        let err = angle_deg(d.motion.matrix3, rot);
         assert!(err < 8.0, "trial {trial}: {err} deg off");
         assert!(
             d.rmse <= from_truth.rmse * 1.02,
@@ -134,7 +134,7 @@ fn trimmed_icp_ignores_a_partial_overlap() {
         ..Default::default()
     };
     let d = icp_distance(&pa, &pb, &opts).unwrap();
-    let err = angle_deg(d.rotation, rot);
+    let err = angle_deg(d.motion.matrix3, rot);
     assert!(err < 0.5, "{err}");
 }
 
@@ -145,7 +145,7 @@ fn reflection_is_not_a_rotation_for_icp_either() {
     let m: Vec<DVec3> = a.iter().map(|p| DVec3::new(-p.x, p.y, p.z)).collect();
     let (pa, pm) = (prep(&a, Which::A), prep(&m, Which::B));
     let d = icp_distance(&pa, &pm, &GlobalOptions::default()).unwrap();
-    assert!((d.rotation.determinant() - 1.0).abs() < 1e-9);
+    assert!((d.motion.matrix3.determinant() - 1.0).abs() < 1e-9);
     assert!(
         d.stats.mean_normalised > 0.01,
         "{}",
@@ -160,8 +160,8 @@ fn closest_point_stats_match_brute_force_and_are_symmetric() {
     let b = random_cloud(&mut r, 97, 1.7);
     let (pa, pb) = (prep(&a, Which::A), prep(&b, Which::B));
     let rot = random_rotation(&mut r);
-    let s = closest_point_stats(&pa, &pb, rot, DVec3::ZERO);
-    let s_rev = closest_point_stats(&pb, &pa, rot.transpose(), DVec3::ZERO);
+    let s = closest_point_stats(&pa, &pb, &DAffine3::from_mat3(rot));
+    let s_rev = closest_point_stats(&pb, &pa, &DAffine3::from_mat3(rot.transpose()));
     let (ca, cb) = (pa.points(), pb.points());
     let nn = |p: DVec3, set: &[DVec3]| {
         set.iter()
@@ -242,7 +242,7 @@ proptest! {
         let b = rotated(&a, rot.transpose(), DVec3::new(1.0, 2.0, 3.0));
         let (pa, pb) = (prep(&a, Which::A), prep(&b, Which::B));
         let d = icp_distance(&pa, &pb, &GlobalOptions::default()).unwrap();
-        prop_assert!(angle_deg(d.rotation, rot) < 1e-5, "{} deg", angle_deg(d.rotation, rot));
+        prop_assert!(angle_deg(d.motion.matrix3, rot) < 1e-5, "{} deg", angle_deg(d.motion.matrix3, rot));
         prop_assert!(d.stats.hausdorff_normalised < 1e-8);
     }
 
@@ -253,7 +253,7 @@ proptest! {
         let b: Vec<DVec3> = random_cloud(&mut r, 45, s).iter().map(|p| *p * DVec3::new(1.0, 0.2, 3.0)).collect();
         let (pa, pb) = (prep(&a, Which::A), prep(&b, Which::B));
         let rot = random_rotation(&mut r);
-        let st = closest_point_stats(&pa, &pb, rot, DVec3::ZERO);
+        let st = closest_point_stats(&pa, &pb, &DAffine3::from_mat3(rot));
         for v in [st.hausdorff_normalised, st.mean_normalised, st.rms_normalised] {
             prop_assert!((0.0..=1.0).contains(&v));
         }

@@ -34,10 +34,10 @@ fn known_rotations_are_recovered_to_1e9_by_kabsch_and_horn() {
             };
             let d = keyed_distance(&ka, &a, &kb, &b, &o).unwrap();
             assert!(
-                angle_deg(d.rotation, rot).to_radians() < 1e-9,
+                angle_deg(d.motion.matrix3, rot).to_radians() < 1e-9,
                 "{method:?} seed {seed}"
             );
-            assert!((d.translation - t).length() < 1e-9 * 100.0);
+            assert!((d.motion.translation - t).length() < 1e-9 * 100.0);
             assert!(d.distance < 1e-12, "{}", d.distance);
             assert_eq!(d.shared_keys, a.len());
             assert_eq!((d.share_a, d.share_b), (1.0, 1.0));
@@ -73,7 +73,7 @@ fn rotations_of_180_degrees_and_near_planar_sets_are_recovered() {
             };
             let d = keyed_distance(&keys, &a, &keys, &b, &o).unwrap();
             assert!(
-                angle_deg(d.rotation, rot).to_radians() < 1e-9,
+                angle_deg(d.motion.matrix3, rot).to_radians() < 1e-9,
                 "{method:?} {deg}"
             );
             assert!(d.distance < 1e-9);
@@ -93,7 +93,7 @@ fn a_reflection_is_not_mistaken_for_a_rotation() {
             ..Default::default()
         };
         let d = keyed_distance(&keys, &a, &keys, &mirrored, &o).unwrap();
-        assert!((d.rotation.determinant() - 1.0).abs() < 1e-12);
+        assert!((d.motion.matrix3.determinant() - 1.0).abs() < 1e-12);
         assert!(d.distance > 0.2, "mirror image at distance {}", d.distance);
     }
     // A planar set IS its own mirror image up to a rotation: distance 0 there.
@@ -121,7 +121,7 @@ fn distance_matches_the_singular_value_formula_and_kabsch_equals_horn() {
         },
     )
     .unwrap();
-    assert!(angle_deg(dk.rotation, dh.rotation) < 1e-9);
+    assert!(angle_deg(dk.motion.matrix3, dh.motion.matrix3) < 1e-9);
     assert!((dk.distance - dh.distance).abs() < 1e-12);
     let (ca, cb) = (points::centroid(&a), points::centroid(&b));
     let k = a
@@ -259,7 +259,7 @@ fn residual_gate_removes_wrong_matches() {
     .unwrap();
     assert!(plain.distance > 0.1);
     assert!(gated.distance < 1e-9, "{}", gated.distance);
-    assert!(angle_deg(gated.rotation, rot) < 1e-7);
+    assert!(angle_deg(gated.motion.matrix3, rot) < 1e-7);
     assert_eq!(gated.gated, 30);
     assert_eq!(gated.pairs_used, 270);
 }
@@ -293,9 +293,9 @@ fn irls_weights_reduce_the_influence_of_outliers() {
     )
     .unwrap();
     let (ep, et, eh) = (
-        angle_deg(plain.rotation, rot),
-        angle_deg(tukey.rotation, rot),
-        angle_deg(huber.rotation, rot),
+        angle_deg(plain.motion.matrix3, rot),
+        angle_deg(tukey.motion.matrix3, rot),
+        angle_deg(huber.motion.matrix3, rot),
     );
     assert!(et < 1e-6, "tukey {et} deg");
     assert!(eh < ep * 0.5, "huber {eh} vs plain {ep}");
@@ -318,7 +318,7 @@ proptest! {
                 prop_assert!((0.0..=1.0).contains(&ab.distance));
                 prop_assert!((ab.distance - ba.distance).abs() < 1e-12);
                 // The rotations are inverse to each other.
-                prop_assert!(angle_deg(ab.rotation.transpose(), ba.rotation) < 1e-6);
+                prop_assert!(angle_deg(ab.motion.matrix3.transpose(), ba.motion.matrix3) < 1e-6);
             }
             (Err(e), _) | (_, Err(e)) => {
                 prop_assert!(matches!(e, ShapeDistError::Degenerate { .. }), "{}", e);

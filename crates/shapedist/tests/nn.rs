@@ -379,9 +379,9 @@ proptest! {
         let got = icp(&a, &b, DMat3::IDENTITY, &opts).unwrap();
         let (rr, rt, rrmse) = reference_icp(a.points(), b.points(), DMat3::IDENTITY, iters, trim, translation);
         // The sums are formed in another order (leaf order, chunks): equal to rounding.
-        let err = (got.rotation - rr).to_cols_array().iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let err = (got.motion.matrix3 - rr).to_cols_array().iter().fold(0.0f64, |m, x| m.max(x.abs()));
         prop_assert!(err < 1e-9, "rotation differs by {err:e}");
-        prop_assert!((got.translation - rt).length() < 1e-9 * (1.0 + a.radius()));
+        prop_assert!((got.motion.translation - rt).length() < 1e-9 * (1.0 + a.radius()));
         prop_assert!((got.rmse - rrmse).abs() <= 1e-9 * (1.0 + rrmse), "{} vs {}", got.rmse, rrmse);
     }
 }
@@ -409,9 +409,12 @@ fn icp_results_do_not_depend_on_the_thread_count() {
             .install(|| icp(&a, &b, DMat3::IDENTITY, &opts).unwrap())
     };
     let (one, two) = (run(1), run(2));
-    assert_eq!(one.rotation.to_cols_array(), two.rotation.to_cols_array());
+    assert_eq!(
+        one.motion.matrix3.to_cols_array(),
+        two.motion.matrix3.to_cols_array()
+    );
     assert_eq!(one.rmse.to_bits(), two.rmse.to_bits());
     assert_eq!(one.iterations, 8);
     // And the iterations did move the source (the comparison is not between two no-ops).
-    assert!(meshcore::linalg::rotation_angle_between(one.rotation, DMat3::IDENTITY) > 0.1);
+    assert!(meshcore::linalg::rotation_angle_between(one.motion.matrix3, DMat3::IDENTITY) > 0.1);
 }
