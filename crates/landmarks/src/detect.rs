@@ -9,7 +9,7 @@ use crate::geom::{icp, score, FitScore, SurfaceIndex};
 use crate::model::GenericModel;
 use crate::{Landmark, LandmarkError, LandmarkName, Landmarks};
 use meshcore::linalg::{fit_rigid, rigid_inverse};
-use meshcore::{DAffine3, DMat3, DVec3, TriMesh};
+use meshcore::{DAffine3, DMat3, DQuat, DVec3, TriMesh};
 use rayon::prelude::*;
 
 /// Options of [`detect_with`].
@@ -306,7 +306,13 @@ pub fn detect_with(
             }
             // Rotations about the nose normal: pose hypotheses that need no eye candidate (eye
             // corners are weak features under expressions).
-            if let Some(b) = fit_rigid(&src_base, &dst_base, None) {
+            // The base pose puts the model's nose on the candidate and turns its normal onto
+            // the candidate's by the shortest arc; the spins then cover the angle about the
+            // normal (a rigid fit of the two base points alone leaves that angle to the solver).
+            let (mu, nu) = (m_nn.normalize_or_zero(), nn.normalize_or_zero());
+            if mu != DVec3::ZERO && nu != DVec3::ZERO {
+                let r0 = DQuat::from_rotation_arc(mu, nu);
+                let b = DAffine3::from_rotation_translation(r0, pn - r0 * m_nose);
                 for k in 0..16 {
                     let ang = k as f64 * std::f64::consts::TAU / 16.0;
                     let r = DMat3::from_axis_angle(nn, ang);
