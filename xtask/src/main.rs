@@ -19,13 +19,13 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Task {
-    /// The paper's section 3: the descriptor on a sphere against analytic curves (issue 4).
+    /// The paper's section 3: the descriptor on a sphere against analytic curves.
     SphereValidate(sphere_validate::Args),
-    /// The paper's sections 4-6 on the face set (issue 7).
+    /// The paper's sections 4-6 on the face set.
     Robustness(robustness::Args),
-    /// Identification/verification benchmark on sampled faces (issue 7).
+    /// Identification/verification benchmark on sampled faces.
     Recognition(recognition::Args),
-    /// Landmark detection accuracy on sampled faces (issue 6).
+    /// Landmark detection accuracy on sampled faces.
     LandmarksEval(landmarks_eval::Args),
 }
 

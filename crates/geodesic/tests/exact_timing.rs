@@ -1,4 +1,4 @@
-//! Timing of the exact solver on the cases of issue 3 (paper-set face id1_neutral from vertex
+//! Timing of the exact solver on the timed cases (paper-set face id1_neutral from vertex
 //! 1507, uncut and cut at 11.8 cm; icospheres 5 and 6 from vertex 0), run by hand in release:
 //!
 //! ```text

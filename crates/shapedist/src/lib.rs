@@ -8,7 +8,7 @@
 //!   centred, rotation in closed form ([`RotationMethod::Kabsch`] with the reflection guard,
 //!   or [`RotationMethod::Horn`]); optional IRLS weights ([`RobustLoss`]) and a residual gate.
 //!   Distance `d_L2 = min_R ||A - R B||_F / sqrt(||A||_F^2 + ||B||_F^2)` in [0, 1].
-//! * [`icp`] and [`global_icp`] on [`PreparedSet`]s: point-to-point (the paper's definition)
+//! * [`icp()`] and [`global_icp`] on [`PreparedSet`]s: point-to-point (the paper's definition)
 //!   and point-to-plane ICP with an exact k-d tree ([`nn::PointTree`]: tight boxes, grouped
 //!   warm-started queries, the same answers as brute force) behind a certified walk on the
 //!   target's neighbour graph ([`nn::NeighbourGraph`]: most correspondences near convergence
@@ -19,7 +19,7 @@
 //! * [`icp_to_target`]: the one ICP loop, generic over an [`IcpTarget`] (a [`PreparedSet`],
 //!   a mesh surface through [`meshcore::FaceLocator`], the landmark detector's surface index),
 //!   with point-to-point or point-to-plane steps, distance and normal gates, trimming,
-//!   damping and the stopping rule as options ([`IcpLoopOptions`]); [`icp`] and
+//!   damping and the stopping rule as options ([`IcpLoopOptions`]); [`icp()`] and
 //!   [`global_icp`] run it. Rigid motions are [`glam::DAffine3`].
 //! * [`pairwise_matrix`] and [`write_matrix_csv`]: parallel symmetric distance matrices.
 //!

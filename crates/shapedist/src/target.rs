@@ -9,7 +9,7 @@
 //! detector's surface index (in the `landmarks` crate).
 //!
 //! Arithmetic, in a fixed order whatever the thread count: the sums of the kept pairs are
-//! formed per chunk of [`CHUNK`] source points and added in chunk order; the point-to-plane
+//! formed per chunk of `CHUNK` (512) source points and added in chunk order; the point-to-plane
 //! normal equations are accumulated over the kept pairs in source order.
 
 #![allow(clippy::needless_range_loop)] // index loops read best in the 6x6 normal equations

@@ -24,19 +24,19 @@ pub enum Region {
 /// reference and nose positions, and the landmark frame.
 #[derive(Debug, Clone)]
 pub struct Refs {
-    /// See the struct doc.
+    /// Geodesic distance from the right outer eye corner r, per vertex.
     pub ur: Vec<f64>,
-    /// See the struct doc.
+    /// Geodesic distance from the left outer eye corner q, per vertex.
     pub uq: Vec<f64>,
-    /// See the struct doc.
+    /// D: the geodesic distance between the two corners (mean of both fields' values).
     pub d: f64,
-    /// See the struct doc.
+    /// Position of r.
     pub r: DVec3,
-    /// See the struct doc.
+    /// Position of q.
     pub q: DVec3,
-    /// See the struct doc.
+    /// Position of the nose tip.
     pub nose: DVec3,
-    /// See the struct doc.
+    /// Face frame from r, q and the nose tip (for the static-area mask).
     pub frame: FaceFrame,
 }
 

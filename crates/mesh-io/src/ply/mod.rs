@@ -39,7 +39,7 @@ pub struct PlyWriteOptions<'a> {
     pub encoding: PlyEncoding,
     /// Per-vertex RGBA colours (`uchar red green blue alpha`), one per vertex.
     pub colors: Option<&'a [[u8; 4]]>,
-    /// Named per-vertex scalars (`float` or `double` by [`ScalarType`]), one value per vertex.
+    /// Named per-vertex scalars (`float` or `double` by [`ScalarType`](crate::ScalarType)), one value per vertex.
     pub scalars: &'a [ScalarField],
 }
 

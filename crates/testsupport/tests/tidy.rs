@@ -1,0 +1,98 @@
+//! Tidy checks over the workspace's Rust sources (ordinary tests, as rust-analyzer has): doc
+//! comments say something true about their item, so none of the boilerplate written to silence
+//! `missing_docs`, no issue numbers (they mean nothing to a reader of `--help` or of the API
+//! docs), and no notes waiting for a change to land that outlive it.
+
+use std::path::{Path, PathBuf};
+
+fn workspace_root() -> PathBuf {
+    let here = Path::new(env!("CARGO_MANIFEST_DIR"));
+    here.parent()
+        .and_then(Path::parent)
+        .map_or_else(|| here.to_path_buf(), Path::to_path_buf)
+}
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let mut entries: Vec<PathBuf> = entries.filter_map(Result::ok).map(|e| e.path()).collect();
+    entries.sort();
+    for p in entries {
+        if p.is_dir() {
+            if !p.ends_with("target") {
+                rust_files(&p, out);
+            }
+        } else if p.extension().is_some_and(|e| e == "rs") {
+            out.push(p);
+        }
+    }
+}
+
+/// `file:line: text` of every doc-comment line (`///`, `//!`) of the workspace's sources that
+/// satisfies `pred` (given the line in lower case); this file is left out.
+fn offenders(pred: impl Fn(&str) -> bool) -> Vec<String> {
+    let root = workspace_root();
+    let mut files = Vec::new();
+    rust_files(&root.join("crates"), &mut files);
+    rust_files(&root.join("xtask"), &mut files);
+    assert!(
+        files.len() > 50,
+        "found only {} Rust files under {}",
+        files.len(),
+        root.display()
+    );
+    let mut out = Vec::new();
+    for f in files
+        .iter()
+        .filter(|f| !f.ends_with("testsupport/tests/tidy.rs"))
+    {
+        let text = std::fs::read_to_string(f).unwrap_or_default();
+        let rel = f.strip_prefix(&root).unwrap_or(f).display().to_string();
+        for (i, line) in text.lines().enumerate() {
+            let t = line.trim_start();
+            if (t.starts_with("///") || t.starts_with("//!")) && pred(&t.to_lowercase()) {
+                out.push(format!("{rel}:{}: {t}", i + 1));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn no_boilerplate_doc_comments() {
+    let bad = offenders(|l| l.contains("see the struct doc") || l.contains("see the enum doc"));
+    assert!(
+        bad.is_empty(),
+        "boilerplate doc comments:\n{}",
+        bad.join("\n")
+    );
+}
+
+#[test]
+fn no_issue_numbers_in_docs() {
+    let bad = offenders(|l| {
+        l.match_indices("issue ").any(|(i, m)| {
+            l[i + m.len()..]
+                .chars()
+                .next()
+                .is_some_and(|c| c.is_ascii_digit() || c == '#')
+        })
+    });
+    assert!(
+        bad.is_empty(),
+        "issue numbers in doc comments (API docs, --help texts):\n{}",
+        bad.join("\n")
+    );
+}
+
+#[test]
+fn no_until_it_lands_notes() {
+    let bad =
+        offenders(|l| l.contains("until") && (l.contains(" lands") || l.contains(" is merged")));
+    assert!(
+        bad.is_empty(),
+        "stale 'until X lands' notes:\n{}",
+        bad.join("\n")
+    );
+}
