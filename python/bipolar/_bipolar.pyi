@@ -254,6 +254,6 @@ def detect_landmarks(
     mesh: Union[Mesh, PathLike],
     *,
     model: Optional[PathLike] = None,
-    scale: float = 1.0,
+    scale: Optional[float] = None,
     min_confidence: Optional[float] = None,
 ) -> Dict[str, Any]: ...

@@ -22,8 +22,19 @@ def test_detects_the_five_landmarks_on_a_paper_set_face(face, face_path):
         assert np.linalg.norm(l["position"] - truth[name]) < 0.6, name
 
 
+def test_a_face_in_millimetres_needs_no_scale(face):
+    cm = bipolar.detect_landmarks(face)
+    mm = bipolar.detect_landmarks(bipolar.Mesh(face.vertices * 10.0, face.triangles))
+    for name in bipolar.LANDMARK_NAMES:
+        d = np.linalg.norm(mm["landmarks"][name]["position"] / 10.0 - cm["landmarks"][name]["position"])
+        assert d < 0.35, name
+
+
 def test_a_sphere_is_not_a_face():
     with pytest.raises(errors.LandmarksNotFoundError, match="landmarks not found"):
+        bipolar.detect_landmarks(bipolar.icosphere(4), scale=1.0)
+    # Without a scale the units come from the size: a unit sphere is no face in any unit.
+    with pytest.raises(errors.LandmarksNotFoundError, match="cannot detect units"):
         bipolar.detect_landmarks(bipolar.icosphere(4))
     with pytest.raises(errors.InputError, match="mesh_units_per_model_unit"):
         bipolar.detect_landmarks(bipolar.icosphere(2), scale=-1.0)

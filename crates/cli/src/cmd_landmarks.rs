@@ -19,9 +19,10 @@ pub struct Args {
     /// Also write the landmarks as a Bosphorus `.lm3` file.
     #[arg(long)]
     pub lm3: Option<PathBuf>,
-    /// Mesh units per model unit (10 for a scan in mm with the default model in cm).
-    #[arg(long, default_value_t = 1.0)]
-    pub scale: f64,
+    /// Mesh units per model unit (10 for a scan in mm with the default model in cm); by
+    /// default recognised from the size of the face (mm, cm or m) and printed.
+    #[arg(long)]
+    pub scale: Option<f64>,
     /// Overall confidence below which detection fails (default: the library's,
     /// `landmarks::DetectOptions::default().min_confidence`, calibrated on training faces).
     #[arg(long)]
@@ -36,8 +37,23 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Some(p) => GenericModel::load(p)?,
         None => GenericModel::default_model()?,
     };
+    let scale = match args.scale {
+        Some(s) => s,
+        None => {
+            let u = meshcore::units::detect_units(&loaded.mesh)
+                .with_context(|| format!("units of {}", args.mesh.display()))?;
+            println!(
+                "{}: units {} (recognised from the face size, {:.1} {}; override with --scale)",
+                args.mesh.display(),
+                u.units,
+                u.size,
+                u.units
+            );
+            landmarks::mesh_units_per_model_unit(&loaded.mesh, &model)?
+        }
+    };
     let opts = DetectOptions {
-        mesh_units_per_model_unit: args.scale,
+        mesh_units_per_model_unit: scale,
         min_confidence: args
             .min_confidence
             .unwrap_or(DetectOptions::default().min_confidence),

@@ -86,3 +86,45 @@ fn not_a_face_fails_with_a_clear_message() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("not found") && err.contains("score"), "{err}");
 }
+
+#[test]
+fn a_face_in_millimetres_needs_no_scale_flag() {
+    let Some(mesh) = paper_face("id2_neutral.obj") else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let mm = dir.path().join("face_mm.obj");
+    let text: String = std::fs::read_to_string(&mesh)
+        .unwrap()
+        .lines()
+        .map(|l| match l.strip_prefix("v ") {
+            Some(rest) => {
+                let v: Vec<String> = rest
+                    .split_whitespace()
+                    .map(|x| format!("{}", 10.0 * x.parse::<f64>().unwrap()))
+                    .collect();
+                format!("v {}\n", v.join(" "))
+            }
+            None => format!("{l}\n"),
+        })
+        .collect();
+    std::fs::write(&mm, text).unwrap();
+    let json = dir.path().join("lm.json");
+    let out = bipolar(&[mm.to_str().unwrap(), "--out", json.to_str().unwrap()]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("units mm"), "{stdout}");
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let x = v["landmarks"]["outer_eye_right"]["position"][0]
+        .as_f64()
+        .unwrap();
+    assert!((x + 44.0).abs() < 6.0, "outer_eye_right x = {x} mm");
+    // An explicit --scale still wins: 1 (the model's cm) on a face in mm finds no face.
+    let out = bipolar(&[mm.to_str().unwrap(), "--scale", "1"]);
+    assert!(!out.status.success());
+}

@@ -172,9 +172,30 @@ struct Verified {
     refined: Option<([Landmark; 5], f64)>,
 }
 
-/// Detects the five landmarks with the default options (mesh in the model's units).
+/// Detects the five landmarks with the default options, the mesh in any of mm, cm or m: its
+/// units are recognised from the size of the face ([`mesh_units_per_model_unit`]). Positions
+/// are returned in the mesh's own units.
 pub fn detect(mesh: &TriMesh, model: &GenericModel) -> Result<Landmarks, LandmarkError> {
-    detect_with(mesh, model, &DetectOptions::default())
+    let options = DetectOptions {
+        mesh_units_per_model_unit: mesh_units_per_model_unit(mesh, model)?,
+        ..DetectOptions::default()
+    };
+    detect_with(mesh, model, &options)
+}
+
+/// Mesh units per model unit for a face-sized `mesh`: the mesh's units recognised from its size
+/// ([`meshcore::units::detect_units`]), the model's from its `units` label (`mm`, `cm` or `m`).
+/// A model whose label names no unit (one trained by [`GenericModel::train`] without a label)
+/// is taken to be in the mesh's units (1). Errors when the mesh's size fits no unit.
+pub fn mesh_units_per_model_unit(
+    mesh: &TriMesh,
+    model: &GenericModel,
+) -> Result<f64, LandmarkError> {
+    let mesh_units = meshcore::units::detect_units(mesh)?.units;
+    Ok(match model.units.trim().parse::<meshcore::units::Units>() {
+        Ok(model_units) => model_units.factor_to(mesh_units),
+        Err(_) => 1.0,
+    })
 }
 
 /// Detects the five landmarks.

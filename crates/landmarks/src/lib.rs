@@ -24,7 +24,7 @@ mod model;
 mod regress;
 
 pub use curvature::{curvedness, shape_index, Curvature, CurvatureOptions};
-pub use detect::{detect, detect_with, DetectOptions};
+pub use detect::{detect, detect_with, mesh_units_per_model_unit, DetectOptions};
 pub use model::{DetectParams, GenericModel, Template, TrainOptions};
 pub use regress::{LandmarkRegressor, RegressorOptions, RegressorPatch};
 
@@ -210,4 +210,7 @@ pub enum LandmarkError {
     /// An option name that is none of the valid names (they are listed).
     #[error(transparent)]
     UnknownChoice(#[from] meshcore::UnknownChoice),
+    /// The units of the mesh (or of the model) could not be told from its size or label.
+    #[error("landmarks: {0}")]
+    Units(#[from] meshcore::units::UnitsError),
 }

@@ -2,7 +2,8 @@
 //! the data is absent), and clear failures on non-faces and faces seen from behind.
 
 use landmarks::{
-    detect, detect_with, io, DetectOptions, GenericModel, LandmarkError, LandmarkName,
+    detect, detect_with, io, mesh_units_per_model_unit, DetectOptions, GenericModel, LandmarkError,
+    LandmarkName,
 };
 use meshcore::{DAffine3, DQuat, DVec3, TriMesh};
 use std::path::PathBuf;
@@ -205,13 +206,40 @@ fn non_faces_are_not_found() {
         ("sphere r=1", sphere(1.0, 30, 60)),
         ("bumpy plane", bumpy(80)),
     ] {
-        match detect(&mesh, &model) {
+        // In the model's units: what is tested is the face check, not the units check.
+        match detect_with(&mesh, &model, &DetectOptions::default()) {
             Err(e @ LandmarkError::NotFound { .. }) => {
                 let msg = e.to_string();
                 assert!(msg.contains("not found") && msg.contains("score"), "{msg}");
             }
             other => panic!("{what}: expected NotFound, got {other:?}"),
         }
+    }
+}
+
+#[test]
+fn units_are_recognised_from_the_face_size() {
+    let Some(dir) = paper_set() else { return };
+    let model = GenericModel::default_model().unwrap();
+    let mesh = read_obj(&dir.join("id2_neutral.obj"));
+    let cm = detect(&mesh, &model).unwrap();
+    for (units, f) in [("mm", 10.0), ("m", 0.01)] {
+        let scaled = mesh.transformed(&DAffine3::from_scale(DVec3::splat(f)));
+        assert_eq!(
+            mesh_units_per_model_unit(&scaled, &model).unwrap(),
+            f,
+            "{units}"
+        );
+        let lm = detect(&scaled, &model).unwrap();
+        for n in LandmarkName::ALL {
+            let d = (lm.get(n).position / f - cm.get(n).position).length();
+            assert!(d < 0.35, "{units} {n}: {d} cm from the detection in cm");
+        }
+    }
+    // Something too small to be a face in any unit is a units error, not a silent guess.
+    match detect(&sphere(1.0, 30, 60), &model) {
+        Err(LandmarkError::Units(e)) => assert!(e.to_string().contains("3.4"), "{e}"),
+        other => panic!("expected a units error, got {other:?}"),
     }
 }
 

@@ -172,7 +172,8 @@ pub fn shapedist(e: shapedist::ShapeDistError) -> PyErr {
 pub fn landmarks(e: landmarks::LandmarkError) -> PyErr {
     use landmarks::LandmarkError as E;
     let kind = match &e {
-        E::NotFound { .. } => Kind::NotFound,
+        // A surface whose size fits no face is a face not found (the message says why).
+        E::NotFound { .. } | E::Units(_) => Kind::NotFound,
         E::Mesh(m) => return mesh(m.clone()),
         E::Io { .. } => Kind::File,
         E::File(f) => return io_kind_err(f, chain(&e)),

@@ -16,18 +16,18 @@ pub fn names() -> Vec<&'static str> {
 ///
 /// ``model``: a generic face model JSON path (default: the model shipped with the library,
 /// trained on ICT FaceKit faces in cm); ``scale``: mesh units per model unit (10 for a scan in
-/// mm with the default model); ``min_confidence``: overall confidence below which detection
+/// mm with the default model; default: recognised from the size of the face, mm, cm or m); ``min_confidence``: overall confidence below which detection
 /// fails (default: the library's). Returns a dict: one entry per landmark name
 /// (``{"vertex", "position", "confidence"}``) under ``"landmarks"``, and ``confidence``,
 /// ``fit_rms``, ``inlier_fraction``, ``symmetry``, ``model_to_mesh`` (4 x 4 rigid motion).
 /// Raises ``LandmarksNotFoundError`` when the mesh does not fit a face.
 #[pyfunction]
-#[pyo3(signature = (mesh, *, model=None, scale=1.0, min_confidence=None))]
+#[pyo3(signature = (mesh, *, model=None, scale=None, min_confidence=None))]
 pub fn detect_landmarks<'py>(
     py: Python<'py>,
     mesh: &Bound<'py, PyAny>,
     model: Option<&Bound<'py, PyAny>>,
-    scale: f64,
+    scale: Option<f64>,
     min_confidence: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = mesh_arg(mesh)?;
@@ -37,6 +37,10 @@ pub fn detect_landmarks<'py>(
         None => GenericModel::default_model(),
     }
     .map_err(errors::landmarks)?;
+    let scale = match scale {
+        Some(s) => s,
+        None => landmarks::mesh_units_per_model_unit(mesh, &model).map_err(errors::landmarks)?,
+    };
     let opts = DetectOptions {
         mesh_units_per_model_unit: scale,
         min_confidence: min_confidence.unwrap_or(DetectOptions::default().min_confidence),
