@@ -257,3 +257,25 @@ def detect_landmarks(
     scale: Optional[float] = None,
     min_confidence: Optional[float] = None,
 ) -> Dict[str, Any]: ...
+
+def scan(
+    mesh: Union[Mesh, PathLike],
+    *,
+    units: Optional[Literal["mm", "cm", "m"]] = None,
+    pitch: float = 0.5,
+    yaw: float = 0.0,
+    pitch_angle: float = 0.0,
+    pinhole: Optional[float] = None,
+    artifacts: Literal["none", "structured-light"] = "none",
+    seed: int = 0,
+) -> Tuple[Mesh, Dict[str, Any]]: ...
+def clean(
+    mesh: Union[Mesh, PathLike],
+    *,
+    units: Optional[Literal["mm", "cm", "m"]] = None,
+    crop_center: Optional[ArrayLike] = None,
+    crop_radius: float = 100.0,
+    max_hole: float = 10.0,
+    smooth: int = 0,
+    target_edge: Optional[float] = None,
+) -> Tuple[Mesh, Dict[str, Any]]: ...

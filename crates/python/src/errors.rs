@@ -184,3 +184,23 @@ pub fn landmarks(e: landmarks::LandmarkError) -> PyErr {
     };
     err(kind, chain(&e))
 }
+
+/// `rangescan::ScanError`.
+pub fn scan(e: rangescan::ScanError) -> PyErr {
+    use rangescan::ScanError as E;
+    let kind = match &e {
+        E::InvalidOption(_) | E::GridTooLarge(_) | E::BadLandmark { .. } => Kind::Input,
+        E::NothingInView => Kind::Computation,
+    };
+    err(kind, chain(&e))
+}
+
+/// `scanprep::ScanPrepError`.
+pub fn scanprep(e: scanprep::ScanPrepError) -> PyErr {
+    use scanprep::ScanPrepError as E;
+    match e {
+        E::Mesh(m) => mesh(m),
+        E::Triangulation(i) => io(i),
+        other => err(Kind::Input, chain(&other)),
+    }
+}

@@ -16,6 +16,7 @@ mod geodesic;
 mod landmark;
 mod mesh;
 mod polar;
+mod scan;
 
 use pyo3::prelude::*;
 
@@ -56,5 +57,7 @@ fn _bipolar(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(distance::cross_distances, m)?)?;
     m.add_function(wrap_pyfunction!(distance::_distance_options_from_dict, m)?)?;
     m.add_function(wrap_pyfunction!(landmark::detect_landmarks, m)?)?;
+    m.add_function(wrap_pyfunction!(scan::scan, m)?)?;
+    m.add_function(wrap_pyfunction!(scan::clean, m)?)?;
     Ok(())
 }
