@@ -125,6 +125,8 @@ def test_describe_bad_input(bump_mesh):
         bipolar.describe(bump_mesh, "left ear", 1599)
     with pytest.raises(errors.InputError, match="not finite"):
         bipolar.describe(bump_mesh, [np.nan, 0, 0], 1599)
+    with pytest.raises(errors.InputError, match="farther than the tolerance"):
+        bipolar.describe(bump_mesh, [1e9, 0, 0], 1599)
     with pytest.raises(errors.InputError, match="not among the given landmarks"):
         bipolar.describe(bump_mesh, "nose-tip", 1599, landmarks={"x": [0, 0, 0]})
     with pytest.raises(errors.LandmarksNotFoundError):

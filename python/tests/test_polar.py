@@ -68,3 +68,12 @@ def test_bad_input_is_a_clear_error(plane):
         bipolar.describe_polar(plane, 840, (1.0, 0.0, 0.0), step=0.1, method="nope")
     with pytest.raises(errors.InputError):
         bipolar.unpack_polar_key(16)
+
+
+def test_towards_may_be_a_point_off_the_surface(plane):
+    centre = int(np.argmin(np.linalg.norm(plane.vertices, axis=1)))
+    p0 = plane.vertices[centre]
+    above = bipolar.describe_polar(plane, centre, (p0[0] + 1.0, p0[1], p0[2] + 5.0), step=0.1, levels=2, sectors=4)
+    on = bipolar.describe_polar(plane, centre, (p0[0] + 1.0, p0[1], p0[2]), step=0.1, levels=2, sectors=4)
+    # The direction is projected on the tangent plane: the same rays.
+    np.testing.assert_allclose(above.points, on.points, atol=1e-12)

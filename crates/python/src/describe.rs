@@ -73,7 +73,16 @@ fn snap(mesh: &TriMesh, p: DVec3, what: &str) -> PyResult<Source> {
             p.to_array()
         )));
     }
-    let (sp, _) = FaceLocator::new(mesh).nearest(p).map_err(errors::mesh)?;
+    let (sp, d) = FaceLocator::new(mesh).nearest(p).map_err(errors::mesh)?;
+    // As the CLI's default `--snap-tolerance`: 1 % of the bounding-box diagonal.
+    let tol = 0.01 * mesh.bbox().diagonal();
+    if d > tol {
+        return Err(errors::input(format!(
+            "{what}: {:?} is {d:.6} from the surface, farther than the tolerance {tol:.6} (1 % of \
+             the bounding-box diagonal); give a point on the surface",
+            p.to_array()
+        )));
+    }
     Ok(Source::Point(sp))
 }
 

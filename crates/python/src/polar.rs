@@ -1,7 +1,7 @@
 //! `describe_polar`: the single-pole (geodesic polar) descriptor of `bipolar::polar`, and its
 //! keyed distance.
 
-use crate::convert::{points_out, vec_out};
+use crate::convert::{self, points_out, vec_out};
 use crate::describe::{given_landmarks, references};
 use crate::errors;
 use crate::geodesic::PyGeodesicSolver;
@@ -10,6 +10,7 @@ use bipolar::{PolarDescriptor, PolarKey, PolarOptions, Source};
 use geodesic::{GeodesicSolver, Method, SolveOptions, Walker};
 use glam::DVec3;
 use pyo3::prelude::*;
+use pyo3::types::PyString;
 use std::time::Duration;
 
 /// A single-pole descriptor: points at geodesic radius ``level * step`` from the pole on
@@ -100,8 +101,9 @@ impl PyPolarDescriptor {
 ///
 /// ``pole``: a vertex index, an ``(x, y, z)`` point (snapped to the surface) or a landmark name
 /// (``"nose-tip"``, from ``landmarks`` or detected), as the references of ``describe``.
-/// ``towards``: a second reference of the same kinds fixing the angular origin (for faces the
-/// midpoint of the outer eye corners, given as a point). ``step`` (positive) between radius
+/// ``towards`` fixes the angular origin: a vertex index or landmark name (its position), or an
+/// ``(x, y, z)`` point used as given, not snapped (for faces the midpoint of the outer eye
+/// corners). ``step`` (positive) between radius
 /// levels, ``levels`` of them, on ``sectors`` rays. Geodesic ``method`` or a prepared ``solver``
 /// for this mesh. The GIL is released while it runs. No ray reaching level 1 is an error.
 #[pyfunction]
@@ -123,16 +125,30 @@ pub fn describe_polar(
     let m = mesh_arg(mesh)?;
     let mesh = m.mesh();
     let given = landmarks.map(given_landmarks).transpose()?;
-    let specs = vec![
-        ("pole".to_string(), pole.clone()),
-        ("towards".to_string(), towards.clone()),
-    ];
     let mut in_library = Duration::ZERO;
-    let refs = references(py, mesh, &specs, given.as_deref(), &mut in_library)?;
-    let (pole, towards) = (refs[0], refs[1]);
-    let towards = match towards {
-        Source::Vertex(v) => mesh.try_position(v).map_err(errors::mesh)?,
-        Source::Point(sp) => mesh.point_position(&sp).map_err(errors::mesh)?,
+    let pole = references(
+        py,
+        mesh,
+        &[("pole".to_string(), pole.clone())],
+        given.as_deref(),
+        &mut in_library,
+    )?[0];
+    // The angular origin is only a direction: a point is used as given (the eye-corner midpoint
+    // of a face lies off the surface); a vertex or a landmark name gives its position.
+    let towards = if towards.is_instance_of::<PyString>() || towards.extract::<i64>().is_ok() {
+        let r = references(
+            py,
+            mesh,
+            &[("towards".to_string(), towards.clone())],
+            given.as_deref(),
+            &mut in_library,
+        )?[0];
+        match r {
+            Source::Vertex(v) => mesh.try_position(v).map_err(errors::mesh)?,
+            Source::Point(sp) => mesh.point_position(&sp).map_err(errors::mesh)?,
+        }
+    } else {
+        convert::point(towards, "towards")?
     };
     let opts = PolarOptions {
         step,
