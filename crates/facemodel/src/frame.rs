@@ -67,27 +67,12 @@ mod tests {
     use super::*;
     use crate::random_rigid_motion;
     use meshcore::shapes::{grid, Diagonals};
-    use rand::{Rng, SeedableRng};
+    use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 
-    /// Jittered planar grid on [0, 1]^2 (z = 0), `n` cells a side (the grid the tests of
-    /// xtask's straightest geodesics use).
+    /// The shared jittered unit plane ([`testsupport::jittered_unit_plane`]).
     fn plane(n: usize, jitter: f64, seed: u64) -> TriMesh {
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let h = 1.0 / n as f64;
-        grid(n, n, Diagonals::Uniform, |i, j| {
-            let inner = i > 0 && j > 0 && i < n && j < n;
-            let (dx, dy) = if inner && jitter > 0.0 {
-                (
-                    rng.random_range(-jitter..jitter) * h,
-                    rng.random_range(-jitter..jitter) * h,
-                )
-            } else {
-                (0.0, 0.0)
-            };
-            DVec3::new(i as f64 * h + dx, j as f64 * h + dy, 0.0)
-        })
-        .unwrap()
+        testsupport::jittered_unit_plane(n, jitter, seed)
     }
 
     fn assert_orthonormal(f: &FaceFrame) {

@@ -7,7 +7,8 @@
 //!   the test panics with the lookup's message.
 //! * **Paths**: [`PAPER_SET`], [`MODEL`], [`paper_face`].
 //! * **Meshes**: [`read_mesh`] (through `mesh-io`, the project's one reader) and the generators
-//!   of [`meshcore::shapes`], re-exported as [`shapes`].
+//!   of [`meshcore::shapes`], re-exported as [`shapes`], plus [`jittered_unit_plane`] (the
+//!   plane of the straightest-geodesic, single-pole and face-frame tests).
 //! * **Analytic distance fields**: [`fields`].
 //! * **The independent descriptor and distance** the crates are checked against: [`oracle`].
 
@@ -20,6 +21,27 @@ pub use meshcore::shapes;
 use facemodel::FaceModelError;
 use meshcore::TriMesh;
 use std::path::{Path, PathBuf};
+
+/// Planar grid on [0, 1]^2 (z = 0) of `n` cells a side, uniform diagonals, interior vertices
+/// jittered by up to `jitter` cells per axis (ChaCha8 seeded by `seed`; boundary kept straight).
+pub fn jittered_unit_plane(n: usize, jitter: f64, seed: u64) -> TriMesh {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let h = 1.0 / n as f64;
+    shapes::grid(n, n, shapes::Diagonals::Uniform, |i, j| {
+        let inner = i > 0 && j > 0 && i < n && j < n;
+        let (dx, dy) = if inner && jitter > 0.0 {
+            (
+                rng.random_range(-jitter..jitter) * h,
+                rng.random_range(-jitter..jitter) * h,
+            )
+        } else {
+            (0.0, 0.0)
+        };
+        meshcore::DVec3::new(i as f64 * h + dx, j as f64 * h + dy, 0.0)
+    })
+    .expect("a unit grid is a valid mesh")
+}
 
 /// `rel` inside the shared data folder, or `None` after printing why the caller skips:
 /// `skipped: ../shared not found ...` when there is no shared folder, `skipped: <path> not

@@ -13,29 +13,11 @@ pub mod walk {
 
     #[cfg(test)]
     pub(crate) mod tests {
-        use meshcore::shapes::{grid, Diagonals};
-        use meshcore::{DVec3, TriMesh};
-        use rand::{Rng, SeedableRng};
-        use rand_chacha::ChaCha8Rng;
+        use meshcore::TriMesh;
 
-        /// Jittered planar grid on [0, 1]^2 (z = 0), `n` cells a side (the test mesh of the
-        /// walker's tests in `geodesic::straightest`).
+        /// The shared jittered unit plane ([`testsupport::jittered_unit_plane`]).
         pub(crate) fn plane(n: usize, jitter: f64, seed: u64) -> TriMesh {
-            let mut rng = ChaCha8Rng::seed_from_u64(seed);
-            let h = 1.0 / n as f64;
-            grid(n, n, Diagonals::Uniform, |i, j| {
-                let inner = i > 0 && j > 0 && i < n && j < n;
-                let (dx, dy) = if inner && jitter > 0.0 {
-                    (
-                        rng.random_range(-jitter..jitter) * h,
-                        rng.random_range(-jitter..jitter) * h,
-                    )
-                } else {
-                    (0.0, 0.0)
-                };
-                DVec3::new(i as f64 * h + dx, j as f64 * h + dy, 0.0)
-            })
-            .unwrap()
+            testsupport::jittered_unit_plane(n, jitter, seed)
         }
     }
 }
