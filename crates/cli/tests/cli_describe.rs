@@ -189,14 +189,9 @@ fn landmark_names_are_detected_or_fail_clearly() {
     assert!(err.contains("outer_eye_right"), "{err}");
 
     // On a paper-set face the detected corners are within 5 mm of the ground-truth vertices.
-    let shared = std::env::var_os("BIPOLAR_SHARED")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"));
-    let face = shared.join("faces/ict-facekit/paper-set/id2_neutral.obj");
-    if !face.is_file() {
-        println!("skipped: {} is absent", face.display());
+    let Some(face) = testsupport::paper_face("id2_neutral.obj") else {
         return;
-    }
+    };
     let csv = dir.path().join("f.csv");
     let out = bin()
         .args(["describe", face.to_str().unwrap()])

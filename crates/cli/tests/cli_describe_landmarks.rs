@@ -165,15 +165,12 @@ fn missing_names_and_unreadable_files_fail_clearly() {
 
 #[test]
 fn ict_landmarks_json_gives_the_ground_truth_vertices() {
-    let shared = std::env::var_os("BIPOLAR_SHARED")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"));
-    let set = shared.join("faces/ict-facekit/paper-set");
-    let (face, json) = (set.join("id1_happiness.obj"), set.join("landmarks.json"));
-    if !face.is_file() || !json.is_file() {
-        println!("skipped: {} is absent", set.display());
+    let (Some(face), Some(json)) = (
+        testsupport::paper_face("id1_happiness.obj"),
+        testsupport::paper_face("landmarks.json"),
+    ) else {
         return;
-    }
+    };
     let dir = tempfile::tempdir().unwrap();
     let (a, b) = (dir.path().join("a.csv"), dir.path().join("b.csv"));
     let common = ["--levels", "5", "--method", "dijkstra"];

@@ -1,6 +1,5 @@
 //! End-to-end tests of `bipolar landmarks`.
 
-use std::path::PathBuf;
 use std::process::Command;
 
 fn bipolar(args: &[&str]) -> std::process::Output {
@@ -11,18 +10,7 @@ fn bipolar(args: &[&str]) -> std::process::Output {
         .unwrap()
 }
 
-fn paper_face(name: &str) -> Option<PathBuf> {
-    let shared = std::env::var_os("BIPOLAR_SHARED")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"));
-    let p = shared.join("faces/ict-facekit/paper-set").join(name);
-    if p.is_file() {
-        Some(p)
-    } else {
-        eprintln!("skipped: {} not found", p.display());
-        None
-    }
-}
+use testsupport::paper_face;
 
 #[test]
 fn detects_on_a_paper_face_and_writes_json_and_lm3() {

@@ -16,18 +16,7 @@ fn bipolar(args: &[&str]) -> (bool, String, String) {
     )
 }
 
-fn paper_face(name: &str) -> Option<PathBuf> {
-    let shared = std::env::var_os("BIPOLAR_SHARED")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"));
-    let p = shared.join("faces/ict-facekit/paper-set").join(name);
-    if p.is_file() {
-        Some(p)
-    } else {
-        println!("skipped: {} not found", p.display());
-        None
-    }
-}
+use testsupport::paper_face;
 
 #[test]
 fn scan_an_ict_face_clean_it_and_read_it_back() {
