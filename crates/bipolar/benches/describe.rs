@@ -1,6 +1,6 @@
 //! Descriptor construction time (geodesics excluded) on a paper-set face (6,706 vertices,
-//! 30 levels) and on an icosphere. The face is read from `$BIPOLAR_SHARED` (default
-//! `../shared` relative to the workspace root); without it only the sphere is measured.
+//! 30 levels) and on an icosphere. The face comes from the shared data folder (found by
+//! `testsupport`); without it only the sphere is measured.
 
 // criterion_group! generates an undocumented function.
 #![allow(missing_docs)]
@@ -8,20 +8,15 @@
 use bipolar::{DescriptorOptions, LevelSpec, SelectionRule, Source, TangentMethod};
 use criterion::{criterion_group, criterion_main, Criterion};
 use meshcore::{Surface, TriMesh};
-use std::path::PathBuf;
 
-fn shared_dir() -> PathBuf {
-    std::env::var_os("BIPOLAR_SHARED")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"))
-}
-
+/// A paper-set face (through the shared-data rule of `testsupport`) and its outer eye
+/// corners in the ICT FaceKit topology.
 fn face() -> Option<(TriMesh, [Source; 2])> {
-    let dir = shared_dir().join("faces/ict-facekit/paper-set");
-    let path = dir.join("id1_neutral.obj");
-    let mesh = mesh_io::read_mesh(&path).ok()?.mesh;
-    // Outer eye corners of the ICT FaceKit topology.
-    Some((mesh, [Source::Vertex(1507), Source::Vertex(3721)]))
+    let path = testsupport::paper_face("id1_neutral.obj")?;
+    Some((
+        testsupport::read_mesh(path),
+        [Source::Vertex(1507), Source::Vertex(3721)],
+    ))
 }
 
 fn fields(mesh: &TriMesh, refs: &[Source]) -> (Vec<Vec<f64>>, &'static str) {
@@ -47,12 +42,9 @@ fn bench(c: &mut Criterion) {
     let mut cases: Vec<(String, TriMesh, [Source; 2], u32)> = Vec::new();
     match face() {
         Some((m, r)) => cases.push(("face".into(), m, r, 30)),
-        None => eprintln!(
-            "paper-set face not found under {}; benchmarking the sphere only",
-            shared_dir().display()
-        ),
+        None => eprintln!("paper-set face not found; benchmarking the sphere only"),
     }
-    let ico = bipolar::synthetic::icosphere(5);
+    let ico = testsupport::shapes::icosphere(5);
     cases.push((
         "ico5".into(),
         ico,
@@ -109,33 +101,20 @@ fn bench(c: &mut Criterion) {
                 tangent,
                 ..DescriptorOptions::default()
             };
-            let d = bipolar::describe(
-                &surface,
-                bipolar::Fields::Precomputed {
+            let run = || {
+                let fields = bipolar::Fields::Precomputed {
                     fields: &f,
                     references: Some(refs),
-                },
-                &opts,
-            )
-            .unwrap();
+                };
+                bipolar::describe(&surface, fields, &opts).unwrap()
+            };
+            let d = run();
             eprintln!(
                 "  {label}: {} points from {} intersections",
                 d.len(),
                 d.stats.intersections
             );
-            g.bench_function(label, |b| {
-                b.iter(|| {
-                    bipolar::describe(
-                        &surface,
-                        bipolar::Fields::Precomputed {
-                            fields: &f,
-                            references: Some(refs),
-                        },
-                        &opts,
-                    )
-                    .unwrap()
-                })
-            });
+            g.bench_function(label, |b| b.iter(run));
         }
         g.finish();
     }
@@ -158,43 +137,22 @@ fn bench_whole(c: &mut Criterion) {
             max_level,
             ..DescriptorOptions::default()
         };
-        let solver = geodesic::new_solver(&mesh, geodesic::Method::Exact).unwrap();
-        let d = bipolar::describe(
-            &surface,
-            bipolar::Fields::Solve {
-                solver: solver.as_ref(),
+        let describe = |solver: &dyn geodesic::GeodesicSolver| {
+            let fields = bipolar::Fields::Solve {
+                solver,
                 references: &refs,
-            },
-            &opts,
-        )
-        .unwrap();
+            };
+            bipolar::describe(&surface, fields, &opts).unwrap()
+        };
+        let exact = || geodesic::new_solver(&mesh, geodesic::Method::Exact).unwrap();
+        let solver = exact();
+        let d = describe(solver.as_ref());
         eprintln!("  {label}: {} points", d.len());
         g.bench_function(format!("{label}_solver_prepared"), |b| {
-            b.iter(|| {
-                bipolar::describe(
-                    &surface,
-                    bipolar::Fields::Solve {
-                        solver: solver.as_ref(),
-                        references: &refs,
-                    },
-                    &opts,
-                )
-                .unwrap()
-            })
+            b.iter(|| describe(solver.as_ref()))
         });
         g.bench_function(format!("{label}_with_solver_setup"), |b| {
-            b.iter(|| {
-                let solver = geodesic::new_solver(&mesh, geodesic::Method::Exact).unwrap();
-                bipolar::describe(
-                    &surface,
-                    bipolar::Fields::Solve {
-                        solver: solver.as_ref(),
-                        references: &refs,
-                    },
-                    &opts,
-                )
-                .unwrap()
-            })
+            b.iter(|| describe(exact().as_ref()))
         });
     }
     g.finish();

@@ -17,7 +17,7 @@
 //! * More than two reference points: every pair `a < b` contributes, keys carry the pair.
 //! * [`polar`]: the single-pole descriptor (geodesic polar coordinates around one point,
 //!   [`describe_polar`]), keyed by `(level, sector)`.
-//! * [`io`]: CSV / JSON / PLY files. [`synthetic`]: test meshes with analytic fields.
+//! * [`io`]: CSV / JSON / PLY files. [`synthetic`]: test meshes.
 //!
 //! Determinism: points are sorted by key, then position. Errors: [`BipolarError`]; an empty
 //! result is an error ([`BipolarError::NoIntersections`]) carrying the reason.

@@ -1,23 +1,7 @@
-//! Synthetic meshes with analytic geodesic fields, for tests, benchmarks and validation.
+//! Synthetic meshes for tests, benchmarks and validation (the generators of
+//! `meshcore::shapes`; their analytic distance fields are `testsupport::fields`).
 
-use glam::DVec3;
 pub use meshcore::shapes::{grid_plane, icosphere, uv_sphere};
-use meshcore::TriMesh;
-
-/// Euclidean distance from `c` to every vertex.
-pub fn euclidean_field(mesh: &TriMesh, c: DVec3) -> Vec<f64> {
-    mesh.positions().iter().map(|p| (*p - c).length()).collect()
-}
-
-/// Great-circle distance on the sphere of radius `radius` centred at the origin from the
-/// direction `c` to every vertex (vertices are projected on the sphere).
-pub fn great_circle_field(mesh: &TriMesh, c: DVec3, radius: f64) -> Vec<f64> {
-    let c = c.normalize();
-    mesh.positions()
-        .iter()
-        .map(|p| radius * p.normalize().dot(c).clamp(-1.0, 1.0).acos())
-        .collect()
-}
 
 #[cfg(test)]
 mod tests {

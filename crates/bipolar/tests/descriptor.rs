@@ -1,7 +1,6 @@
 //! The descriptor against analytic oracles (plane: law of cosines; sphere: spherical law of
 //! cosines), invariances, holes, errors and file round trips.
 
-use bipolar::synthetic::{euclidean_field, great_circle_field, grid_plane, icosphere};
 use bipolar::{
     describe, BipolarError, Descriptor, DescriptorOptions, Fields, LevelSpec, SelectionRule,
     Source, TangentMethod,
@@ -9,6 +8,44 @@ use bipolar::{
 use glam::{DAffine3, DQuat, DVec3};
 use meshcore::{Surface, TriMesh};
 use proptest::prelude::*;
+use testsupport::fields::{euclidean, sphere_geodesic};
+use testsupport::shapes::{grid_plane, icosphere};
+
+/// The descriptor of precomputed `fields` (of the `references`, if given).
+fn describe_fields(
+    surface: &Surface,
+    fields: &[Vec<f64>],
+    references: Option<&[Source]>,
+    o: &DescriptorOptions,
+) -> Result<Descriptor, BipolarError> {
+    describe(surface, Fields::Precomputed { fields, references }, o)
+}
+
+/// The descriptor of the fields `solver` computes from the `references`.
+fn describe_solved(
+    surface: &Surface,
+    solver: &dyn geodesic::GeodesicSolver,
+    references: &[Source],
+    o: &DescriptorOptions,
+) -> Result<Descriptor, BipolarError> {
+    describe(surface, Fields::Solve { solver, references }, o)
+}
+
+/// The vertex nearest to `p` (the first on ties).
+fn nearest(mesh: &TriMesh, p: DVec3) -> u32 {
+    (0..mesh.n_vertices() as u32)
+        .min_by(|&a, &b| {
+            (mesh.position(a) - p)
+                .length()
+                .total_cmp(&(mesh.position(b) - p).length())
+        })
+        .unwrap()
+}
+
+/// Options with every intersection kept and gradient tangents.
+fn all_gradient(levels: LevelSpec) -> DescriptorOptions {
+    opts(SelectionRule::All, TangentMethod::Gradient, levels)
+}
 
 fn opts(rule: SelectionRule, tangent: TangentMethod, levels: LevelSpec) -> DescriptorOptions {
     DescriptorOptions {
@@ -19,37 +56,49 @@ fn opts(rule: SelectionRule, tangent: TangentMethod, levels: LevelSpec) -> Descr
     }
 }
 
+/// A surface, exact distance fields from its reference vertices and the references' positions.
+struct Setup {
+    mesh: TriMesh,
+    surface: Surface,
+    fields: Vec<Vec<f64>>,
+    refs: Vec<Source>,
+    poles: Vec<DVec3>,
+}
+
+impl Setup {
+    /// `field(mesh, position)` from each of the vertices `refs`.
+    fn new(mesh: TriMesh, refs: &[u32], field: impl Fn(&TriMesh, DVec3) -> Vec<f64>) -> Self {
+        let poles: Vec<DVec3> = refs.iter().map(|&v| mesh.position(v)).collect();
+        Setup {
+            surface: Surface::new(mesh.clone()),
+            fields: poles.iter().map(|&p| field(&mesh, p)).collect(),
+            refs: refs.iter().map(|&v| Source::Vertex(v)).collect(),
+            poles,
+            mesh,
+        }
+    }
+
+    /// The descriptor of the fields, with their references.
+    fn describe(&self, o: &DescriptorOptions) -> Result<Descriptor, BipolarError> {
+        describe_fields(&self.surface, &self.fields, Some(&self.refs), o)
+    }
+}
+
 /// Plane grid on [-1.5, 1.5]^2 with `n` cells a side, references at the vertices nearest to
 /// (-0.5, 0) and (0.5, 0) (no jitter there), exact Euclidean fields.
-fn plane_setup(
-    n: usize,
-    jitter: f64,
-) -> (TriMesh, Surface, Vec<Vec<f64>>, Vec<Source>, [DVec3; 2]) {
+fn plane_setup(n: usize, jitter: f64) -> Setup {
     let h = 3.0 / n as f64;
     let mesh = grid_plane(n, h, -1.5, jitter, 5, |_| false);
-    let surface = Surface::new(mesh.clone());
-    let near = |p: DVec3| {
-        (0..mesh.n_vertices() as u32)
-            .min_by(|&a, &b| {
-                (mesh.position(a) - p)
-                    .length()
-                    .total_cmp(&(mesh.position(b) - p).length())
-            })
-            .unwrap()
-    };
-    let (vr, vq) = (
-        near(DVec3::new(-0.5, 0.0, 0.0)),
-        near(DVec3::new(0.5, 0.0, 0.0)),
-    );
-    let (r, q) = (mesh.position(vr), mesh.position(vq));
-    let fields = vec![euclidean_field(&mesh, r), euclidean_field(&mesh, q)];
-    (
-        mesh,
-        surface,
-        fields,
-        vec![Source::Vertex(vr), Source::Vertex(vq)],
-        [r, q],
-    )
+    let refs = [
+        nearest(&mesh, DVec3::new(-0.5, 0.0, 0.0)),
+        nearest(&mesh, DVec3::new(0.5, 0.0, 0.0)),
+    ];
+    Setup::new(mesh, &refs, euclidean)
+}
+
+/// Great-circle fields on the unit sphere `mesh` from the vertices `refs`.
+fn sphere_setup(mesh: TriMesh, refs: &[u32]) -> Setup {
+    Setup::new(mesh, refs, |m, c| sphere_geodesic(m, c, 1.0))
 }
 
 fn law_of_cosines(p: DVec3, r: DVec3, q: DVec3) -> f64 {
@@ -66,20 +115,8 @@ fn linear_fields_give_exact_angles_and_positions() {
     let e2 = DVec3::new(0.6, 0.8, 0.0);
     let fa: Vec<f64> = mesh.positions().iter().map(|p| p.dot(e1) + 2.0).collect();
     let fb: Vec<f64> = mesh.positions().iter().map(|p| p.dot(e2) + 2.5).collect();
-    let o = opts(
-        SelectionRule::All,
-        TangentMethod::Gradient,
-        LevelSpec::Step(0.25),
-    );
-    let d = describe(
-        &surface,
-        Fields::Precomputed {
-            fields: &[fa, fb],
-            references: None,
-        },
-        &o,
-    )
-    .unwrap();
+    let o = all_gradient(LevelSpec::Step(0.25));
+    let d = describe_fields(&surface, &[fa, fb], None, &o).unwrap();
     assert!(d.len() > 100);
     for p in &d.points {
         assert!((p.cos - e1.dot(e2)).abs() < 1e-12, "cos {}", p.cos);
@@ -102,22 +139,13 @@ fn linear_fields_give_exact_angles_and_positions() {
 fn plane_euclidean_fields_follow_the_law_of_cosines() {
     let mut mean_err = Vec::new();
     for n in [30, 60, 120] {
-        let (_, surface, fields, refs, [r, q]) = plane_setup(n, 0.3);
+        let plane = plane_setup(n, 0.3);
+        let [r, q] = plane.poles[..] else {
+            unreachable!()
+        };
         let h = 3.0 / n as f64;
-        let o = opts(
-            SelectionRule::All,
-            TangentMethod::Gradient,
-            LevelSpec::Count(5),
-        );
-        let d = describe(
-            &surface,
-            Fields::Precomputed {
-                fields: &fields,
-                references: Some(&refs),
-            },
-            &o,
-        )
-        .unwrap();
+        let o = all_gradient(LevelSpec::Count(5));
+        let d = plane.describe(&o).unwrap();
         let dist = (r - q).length();
         assert!((d.step - dist / 5.0).abs() < 1e-12);
         assert!((d.reference_distance - dist).abs() < 1e-12);
@@ -146,35 +174,15 @@ fn plane_euclidean_fields_follow_the_law_of_cosines() {
 
 #[test]
 fn filter_rule_keeps_only_points_near_angle_levels() {
-    let (_, surface, fields, refs, _) = plane_setup(60, 0.3);
-    let all = describe(
-        &surface,
-        Fields::Precomputed {
-            fields: &fields,
-            references: Some(&refs),
-        },
-        &opts(
-            SelectionRule::All,
-            TangentMethod::Gradient,
-            LevelSpec::Count(5),
-        ),
-    )
-    .unwrap();
+    let plane = plane_setup(60, 0.3);
+    let all = plane.describe(&all_gradient(LevelSpec::Count(5))).unwrap();
     let tol = 0.95 / 32.0;
     let o = opts(
         SelectionRule::Filter { tolerance: tol },
         TangentMethod::Gradient,
         LevelSpec::Count(5),
     );
-    let d = describe(
-        &surface,
-        Fields::Precomputed {
-            fields: &fields,
-            references: Some(&refs),
-        },
-        &o,
-    )
-    .unwrap();
+    let d = plane.describe(&o).unwrap();
     assert!(!d.is_empty() && d.len() < all.len());
     for p in &d.points {
         let c = p.cos.abs();
@@ -201,7 +209,10 @@ fn filter_rule_keeps_only_points_near_angle_levels() {
 
 #[test]
 fn isoangle_points_sit_on_angle_levels() {
-    let (_, surface, fields, refs, [r, q]) = plane_setup(90, 0.3);
+    let plane = plane_setup(90, 0.3);
+    let [r, q] = plane.poles[..] else {
+        unreachable!()
+    };
     let h = 3.0 / 90.0;
     for tangent in [
         TangentMethod::Gradient,
@@ -212,15 +223,7 @@ fn isoangle_points_sit_on_angle_levels() {
             max_level: Some(5),
             ..opts(SelectionRule::IsoAngle, tangent, LevelSpec::Count(5))
         };
-        let d = describe(
-            &surface,
-            Fields::Precomputed {
-                fields: &fields,
-                references: Some(&refs),
-            },
-            &o,
-        )
-        .unwrap();
+        let d = plane.describe(&o).unwrap();
         assert!(d.len() > 40, "{tangent:?}: {}", d.len());
         let mut errs = Vec::new();
         for p in &d.points {
@@ -240,7 +243,6 @@ fn isoangle_points_sit_on_angle_levels() {
 #[test]
 fn sphere_matches_the_spherical_law_of_cosines() {
     let mesh = icosphere(4);
-    let surface = Surface::new(mesh.clone());
     // Two orthogonal poles, at vertices of the icosphere: (0, 1, t) and (0, -1, t) are not
     // orthogonal, so use the directions of two vertices and exact great-circle fields.
     let vr = 0u32;
@@ -253,12 +255,8 @@ fn sphere_matches_the_spherical_law_of_cosines() {
                 .total_cmp(&mesh.position(b).dot(r).abs())
         })
         .unwrap();
-    let q = mesh.position(vq);
-    let fields = vec![
-        great_circle_field(&mesh, r, 1.0),
-        great_circle_field(&mesh, q, 1.0),
-    ];
-    let refs = [Source::Vertex(vr), Source::Vertex(vq)];
+    let sphere = sphere_setup(mesh, &[vr, vq]);
+    let q = sphere.poles[1];
     let dd = r.dot(q).clamp(-1.0, 1.0).acos();
     let oracle = |p: DVec3| {
         let p = p.normalize();
@@ -275,15 +273,7 @@ fn sphere_matches_the_spherical_law_of_cosines() {
             max_level: Some(8),
             ..opts(SelectionRule::All, tangent, LevelSpec::Count(6))
         };
-        let d = describe(
-            &surface,
-            Fields::Precomputed {
-                fields: &fields,
-                references: Some(&refs),
-            },
-            &o,
-        )
-        .unwrap();
+        let d = sphere.describe(&o).unwrap();
         assert!(d.len() > 50);
         let mut errs: Vec<f64> = d
             .points
@@ -365,13 +355,13 @@ proptest! {
         let surface = Surface::new(mesh.clone());
         let r = mesh.position(3);
         let q = mesh.position(40);
-        let fields = vec![great_circle_field(&mesh, r, 1.0), great_circle_field(&mesh, q, 1.0)];
+        let fields = vec![sphere_geodesic(&mesh, r, 1.0), sphere_geodesic(&mesh, q, 1.0)];
         let rule = if iso { SelectionRule::IsoAngle } else { SelectionRule::Filter { tolerance: 0.95 / 32.0 } };
         let o = opts(rule, TangentMethod::Gradient, LevelSpec::Count(6));
         let t = random_motion(seed);
         let moved = mesh.transformed(&t);
-        let d1 = describe(&surface, Fields::Precomputed { fields: &fields, references: None }, &o).unwrap();
-        let d2 = describe(&Surface::new(moved.clone()), Fields::Precomputed { fields: &fields, references: None }, &o).unwrap();
+        let d1 = describe_fields(&surface, &fields, None, &o).unwrap();
+        let d2 = describe_fields(&Surface::new(moved.clone()), &fields, None, &o).unwrap();
         let m1 = sorted_by_key_then_mapped(&d1, &t);
         assert_same_up_to(&m1, &d2, &DAffine3::IDENTITY, 1e-9, 1e-9);
     }
@@ -382,32 +372,16 @@ fn rigid_motion_invariance_of_strip_and_spline() {
     let mesh = icosphere(3);
     let surface = Surface::new(mesh.clone());
     let fields = vec![
-        great_circle_field(&mesh, mesh.position(3), 1.0),
-        great_circle_field(&mesh, mesh.position(40), 1.0),
+        sphere_geodesic(&mesh, mesh.position(3), 1.0),
+        sphere_geodesic(&mesh, mesh.position(40), 1.0),
     ];
     let t = random_motion(77);
     let moved = mesh.transformed(&t);
     let moved_surface = Surface::new(moved.clone());
     for tangent in [TangentMethod::Strip, TangentMethod::Spline] {
         let o = opts(SelectionRule::All, tangent, LevelSpec::Count(6));
-        let d1 = describe(
-            &surface,
-            Fields::Precomputed {
-                fields: &fields,
-                references: None,
-            },
-            &o,
-        )
-        .unwrap();
-        let d2 = describe(
-            &moved_surface,
-            Fields::Precomputed {
-                fields: &fields,
-                references: None,
-            },
-            &o,
-        )
-        .unwrap();
+        let d1 = describe_fields(&surface, &fields, None, &o).unwrap();
+        let d2 = describe_fields(&moved_surface, &fields, None, &o).unwrap();
         let m1 = sorted_by_key_then_mapped(&d1, &t);
         assert_same_up_to(&m1, &d2, &DAffine3::IDENTITY, 1e-9, 1e-7);
     }
@@ -415,8 +389,8 @@ fn rigid_motion_invariance_of_strip_and_spline() {
 
 #[test]
 fn vertex_renumbering_does_not_change_the_descriptor() {
-    let (mesh, surface, fields, refs, _) = plane_setup(40, 0.3);
-    let n = mesh.n_vertices();
+    let plane = plane_setup(40, 0.3);
+    let n = plane.mesh.n_vertices();
     // A deterministic permutation and a rotation of each face's corner order, faces reversed.
     let perm: Vec<u32> = (0..n as u32).map(|v| (v * 7919 + 13) % n as u32).collect();
     let mut seen = vec![false; n];
@@ -424,9 +398,10 @@ fn vertex_renumbering_does_not_change_the_descriptor() {
     assert!(seen.iter().all(|&s| s), "not a permutation");
     let mut pos = vec![DVec3::ZERO; n];
     for v in 0..n {
-        pos[perm[v] as usize] = mesh.positions()[v];
+        pos[perm[v] as usize] = plane.mesh.positions()[v];
     }
-    let tris: Vec<[u32; 3]> = mesh
+    let tris: Vec<[u32; 3]> = plane
+        .mesh
         .triangles()
         .iter()
         .rev()
@@ -445,10 +420,11 @@ fn vertex_renumbering_does_not_change_the_descriptor() {
     let mut f2 = vec![vec![0.0; n]; 2];
     for k in 0..2 {
         for v in 0..n {
-            f2[k][perm[v] as usize] = fields[k][v];
+            f2[k][perm[v] as usize] = plane.fields[k][v];
         }
     }
-    let refs2: Vec<Source> = refs
+    let refs2: Vec<Source> = plane
+        .refs
         .iter()
         .map(|r| match r {
             Source::Vertex(v) => Source::Vertex(perm[*v as usize]),
@@ -457,24 +433,8 @@ fn vertex_renumbering_does_not_change_the_descriptor() {
         .collect();
     for rule in [SelectionRule::IsoAngle, SelectionRule::All] {
         let o = opts(rule, TangentMethod::Gradient, LevelSpec::Count(5));
-        let d1 = describe(
-            &surface,
-            Fields::Precomputed {
-                fields: &fields,
-                references: Some(&refs),
-            },
-            &o,
-        )
-        .unwrap();
-        let d2 = describe(
-            &t2,
-            Fields::Precomputed {
-                fields: &f2,
-                references: Some(&refs2),
-            },
-            &o,
-        )
-        .unwrap();
+        let d1 = plane.describe(&o).unwrap();
+        let d2 = describe_fields(&t2, &f2, Some(&refs2), &o).unwrap();
         assert_same_up_to(&d1, &d2, &DAffine3::IDENTITY, 1e-12, 1e-9);
     }
 }
@@ -488,7 +448,7 @@ fn holes_split_curves_and_hold_no_points() {
     let r = DVec3::new(-0.5, 0.0, 0.0);
     let q = DVec3::new(0.5, 0.0, 0.0);
     // Euclidean fields (a stand-in: on a holed plane true geodesics bend around the hole).
-    let fields = vec![euclidean_field(&mesh, r), euclidean_field(&mesh, q)];
+    let fields = vec![euclidean(&mesh, r), euclidean(&mesh, q)];
     for rule in [SelectionRule::IsoAngle, SelectionRule::All] {
         for tangent in [
             TangentMethod::Gradient,
@@ -496,15 +456,7 @@ fn holes_split_curves_and_hold_no_points() {
             TangentMethod::Strip,
         ] {
             let o = opts(rule, tangent, LevelSpec::Step(0.2));
-            let d = describe(
-                &surface,
-                Fields::Precomputed {
-                    fields: &fields,
-                    references: None,
-                },
-                &o,
-            )
-            .unwrap();
+            let d = describe_fields(&surface, &fields, None, &o).unwrap();
             assert!(!d.is_empty());
             for p in &d.points {
                 assert!(
@@ -519,66 +471,30 @@ fn holes_split_curves_and_hold_no_points() {
 
 #[test]
 fn vertex_mask_limits_the_region() {
-    let (mesh, surface, fields, refs, _) = plane_setup(40, 0.2);
-    let mask: Vec<bool> = mesh.positions().iter().map(|p| p.y >= -0.05).collect();
+    let plane = plane_setup(40, 0.2);
+    let mask: Vec<bool> = plane
+        .mesh
+        .positions()
+        .iter()
+        .map(|p| p.y >= -0.05)
+        .collect();
     let o = DescriptorOptions {
         vertex_mask: Some(mask),
-        ..opts(
-            SelectionRule::All,
-            TangentMethod::Gradient,
-            LevelSpec::Count(5),
-        )
+        ..all_gradient(LevelSpec::Count(5))
     };
-    let d = describe(
-        &surface,
-        Fields::Precomputed {
-            fields: &fields,
-            references: Some(&refs),
-        },
-        &o,
-    )
-    .unwrap();
+    let d = plane.describe(&o).unwrap();
     assert!(d
         .points
         .iter()
         .all(|p| p.position.y >= -0.05 && p.key.side == 1 || p.position.y.abs() < 0.1));
-    let full = describe(
-        &surface,
-        Fields::Precomputed {
-            fields: &fields,
-            references: Some(&refs),
-        },
-        &opts(
-            SelectionRule::All,
-            TangentMethod::Gradient,
-            LevelSpec::Count(5),
-        ),
-    )
-    .unwrap();
+    let full = plane.describe(&all_gradient(LevelSpec::Count(5))).unwrap();
     assert!(d.len() < full.len() * 6 / 10);
 }
 
 #[test]
 fn more_than_two_references_give_every_pair() {
-    let mesh = icosphere(3);
-    let surface = Surface::new(mesh.clone());
-    let refs = [Source::Vertex(0), Source::Vertex(5), Source::Vertex(100)];
-    let fields: Vec<Vec<f64>> = refs
-        .iter()
-        .map(|r| match r {
-            Source::Vertex(v) => great_circle_field(&mesh, mesh.position(*v), 1.0),
-            _ => unreachable!(),
-        })
-        .collect();
-    let d = describe(
-        &surface,
-        Fields::Precomputed {
-            fields: &fields,
-            references: Some(&refs),
-        },
-        &DescriptorOptions::default(),
-    )
-    .unwrap();
+    let sphere = sphere_setup(icosphere(3), &[0, 5, 100]);
+    let d = sphere.describe(&DescriptorOptions::default()).unwrap();
     let mut pairs: Vec<(u8, u8)> = d.points.iter().map(|p| (p.key.a, p.key.b)).collect();
     pairs.dedup();
     assert_eq!(pairs, vec![(0, 1), (0, 2), (1, 2)]);
@@ -590,20 +506,8 @@ fn describe_with_a_solver() {
     let mesh = grid_plane(30, 0.1, -1.5, 0.0, 0, |_| false);
     let solver = geodesic::new_solver(&mesh, geodesic::Method::Dijkstra).unwrap();
     let refs = [Source::Vertex(15 * 31 + 10), Source::Vertex(15 * 31 + 20)];
-    let o = opts(
-        SelectionRule::All,
-        TangentMethod::Gradient,
-        LevelSpec::Count(5),
-    );
-    let d = describe(
-        &Surface::new(mesh.clone()),
-        Fields::Solve {
-            solver: solver.as_ref(),
-            references: &refs,
-        },
-        &o,
-    )
-    .unwrap();
+    let o = all_gradient(LevelSpec::Count(5));
+    let d = describe_solved(&Surface::new(mesh.clone()), solver.as_ref(), &refs, &o).unwrap();
     assert!((d.reference_distance - 1.0).abs() < 1e-9);
     assert!(d.len() > 20);
     // Surface-point references work too.
@@ -612,29 +516,19 @@ fn describe_with_a_solver() {
         .unwrap()
         .0;
     let refs = [Source::Point(sp), Source::Vertex(15 * 31 + 20)];
-    let d = describe(
-        &Surface::new(mesh.clone()),
-        Fields::Solve {
-            solver: solver.as_ref(),
-            references: &refs,
-        },
-        &o,
-    )
-    .unwrap();
+    let d = describe_solved(&Surface::new(mesh.clone()), solver.as_ref(), &refs, &o).unwrap();
     assert!((d.references[0] - DVec3::new(-0.47, 0.03, 0.0)).length() < 1e-12);
 }
 
 #[test]
 fn bad_input_gives_clear_errors() {
-    let (_, surface, fields, refs, _) = plane_setup(20, 0.0);
+    let plane = plane_setup(20, 0.0);
     let o = DescriptorOptions::default();
     // Coincident references.
-    let r = describe(
-        &surface,
-        Fields::Precomputed {
-            fields: &[fields[0].clone(), fields[0].clone()],
-            references: Some(&[refs[0], refs[0]]),
-        },
+    let r = describe_fields(
+        &plane.surface,
+        &[plane.fields[0].clone(), plane.fields[0].clone()],
+        Some(&[plane.refs[0], plane.refs[0]]),
         &o,
     );
     assert!(
@@ -645,16 +539,9 @@ fn bad_input_gives_clear_errors() {
         "{r:?}"
     );
     // NaN field.
-    let mut bad = fields.clone();
+    let mut bad = plane.fields.clone();
     bad[1][7] = f64::NAN;
-    let r = describe(
-        &surface,
-        Fields::Precomputed {
-            fields: &bad,
-            references: None,
-        },
-        &o,
-    );
+    let r = describe_fields(&plane.surface, &bad, None, &o);
     assert!(matches!(
         r,
         Err(BipolarError::NonFiniteField {
@@ -664,42 +551,22 @@ fn bad_input_gives_clear_errors() {
         })
     ));
     // Wrong length.
-    let r = describe(
-        &surface,
-        Fields::Precomputed {
-            fields: &[fields[0].clone(), vec![0.0; 3]],
-            references: None,
-        },
+    let r = describe_fields(
+        &plane.surface,
+        &[plane.fields[0].clone(), vec![0.0; 3]],
+        None,
         &o,
     );
     assert!(matches!(r, Err(BipolarError::FieldLength { field: 1, .. })));
     // One field.
     assert!(matches!(
-        describe(
-            &surface,
-            Fields::Precomputed {
-                fields: &fields[..1],
-                references: None
-            },
-            &o
-        ),
+        describe_fields(&plane.surface, &plane.fields[..1], None, &o),
         Err(BipolarError::ReferenceCount(1))
     ));
     // Step too large: no level fits.
-    let big = opts(
-        SelectionRule::All,
-        TangentMethod::Gradient,
-        LevelSpec::Step(100.0),
-    );
+    let big = all_gradient(LevelSpec::Step(100.0));
     assert!(matches!(
-        describe(
-            &surface,
-            Fields::Precomputed {
-                fields: &fields,
-                references: None
-            },
-            &big
-        ),
+        describe_fields(&plane.surface, &plane.fields, None, &big),
         Err(BipolarError::NoIntersections(_))
     ));
     // Invalid alpha.
@@ -708,14 +575,7 @@ fn bad_input_gives_clear_errors() {
         ..DescriptorOptions::default()
     };
     assert!(matches!(
-        describe(
-            &surface,
-            Fields::Precomputed {
-                fields: &fields,
-                references: None
-            },
-            &a
-        ),
+        describe_fields(&plane.surface, &plane.fields, None, &a),
         Err(BipolarError::InvalidOption(_))
     ));
     // Different components: two disjoint grids.
@@ -730,12 +590,10 @@ fn bad_input_gives_clear_errors() {
     t.extend(m1.triangles().iter().map(|tr| tr.map(|v| v + off)));
     let two = TriMesh::new(p, t).unwrap();
     let solver = geodesic::new_solver(&two, geodesic::Method::Dijkstra).unwrap();
-    let r = describe(
+    let r = describe_solved(
         &Surface::new(two.clone()),
-        Fields::Solve {
-            solver: solver.as_ref(),
-            references: &[Source::Vertex(0), Source::Vertex(off + 3)],
-        },
+        solver.as_ref(),
+        &[Source::Vertex(0), Source::Vertex(off + 3)],
         &o,
     );
     assert!(
@@ -743,12 +601,10 @@ fn bad_input_gives_clear_errors() {
         "{r:?}"
     );
     // Reference out of range.
-    let r = describe(
+    let r = describe_solved(
         &Surface::new(two.clone()),
-        Fields::Solve {
-            solver: solver.as_ref(),
-            references: &[Source::Vertex(0), Source::Vertex(10_000)],
-        },
+        solver.as_ref(),
+        &[Source::Vertex(0), Source::Vertex(10_000)],
         &o,
     );
     assert!(r.is_err());
@@ -756,16 +612,8 @@ fn bad_input_gives_clear_errors() {
 
 #[test]
 fn files_round_trip() {
-    let (_, surface, fields, refs, _) = plane_setup(30, 0.3);
-    let d = describe(
-        &surface,
-        Fields::Precomputed {
-            fields: &fields,
-            references: Some(&refs),
-        },
-        &DescriptorOptions::default(),
-    )
-    .unwrap();
+    let plane = plane_setup(30, 0.3);
+    let d = plane.describe(&DescriptorOptions::default()).unwrap();
     let dir = std::env::temp_dir().join(format!("bipolar-io-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let json = dir.join("d.json");
@@ -825,15 +673,6 @@ impl geodesic::GeodesicSolver for Recording<'_> {
 fn a_region_limit_cuts_the_fields_off_without_changing_the_descriptor() {
     let sphere = icosphere(4);
     let plane = grid_plane(40, 0.075, -1.5, 0.3, 11, |_| false);
-    let near = |mesh: &TriMesh, p: DVec3| {
-        (0..mesh.n_vertices() as u32)
-            .min_by(|&a, &b| {
-                (mesh.position(a) - p)
-                    .length()
-                    .total_cmp(&(mesh.position(b) - p).length())
-            })
-            .unwrap()
-    };
     for (mesh, a, b, c, far, step) in [
         // Nearly antipodal references: the straight-line guess of d(r, q) is far too short and
         // the first field has to be solved again.
@@ -857,8 +696,8 @@ fn a_region_limit_cuts_the_fields_off_without_changing_the_descriptor() {
         let surface = Surface::new(mesh.clone());
         let sp = meshcore::FaceLocator::new(mesh).nearest(c).unwrap().0;
         let refs = [
-            Source::Vertex(near(mesh, a)),
-            Source::Vertex(near(mesh, b)),
+            Source::Vertex(nearest(mesh, a)),
+            Source::Vertex(nearest(mesh, b)),
             Source::Point(sp),
         ];
         for method in [geodesic::Method::Exact, geodesic::Method::Dijkstra] {
@@ -872,30 +711,14 @@ fn a_region_limit_cuts_the_fields_off_without_changing_the_descriptor() {
                 })
                 .collect();
             for (levels, max_level) in [(LevelSpec::Count(6), 4), (LevelSpec::Step(step), 5)] {
-                let mut o = opts(SelectionRule::All, TangentMethod::Gradient, levels);
+                let mut o = all_gradient(levels);
                 o.max_level = Some(max_level);
                 let rec = Recording {
                     inner: inner.as_ref(),
                     cuts: std::sync::Mutex::new(Vec::new()),
                 };
-                let got = describe(
-                    &surface,
-                    Fields::Solve {
-                        solver: &rec,
-                        references: &refs,
-                    },
-                    &o,
-                )
-                .unwrap();
-                let want = describe(
-                    &surface,
-                    Fields::Precomputed {
-                        fields: &full,
-                        references: Some(&refs),
-                    },
-                    &o,
-                )
-                .unwrap();
+                let got = describe_solved(&surface, &rec, &refs, &o).unwrap();
+                let want = describe_fields(&surface, &full, Some(&refs), &o).unwrap();
                 let cuts = rec.cuts.into_inner().unwrap();
                 assert!(cuts.iter().all(|c| c.is_some()), "{cuts:?}");
                 assert!(cuts.len() >= 3);

@@ -30,6 +30,16 @@ fn circle(n: usize, r: f64) -> Vec<DVec3> {
         .collect()
 }
 
+/// [`circle`] with Gaussian noise of deviation `sigma` on every coordinate (ChaCha8 seeded by
+/// `seed`).
+fn noisy_circle(n: usize, r: f64, sigma: f64, seed: u64) -> Vec<DVec3> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    circle(n, r)
+        .into_iter()
+        .map(|p| p + sigma * DVec3::new(gauss(&mut rng), gauss(&mut rng), gauss(&mut rng)))
+        .collect()
+}
+
 fn gauss(rng: &mut ChaCha8Rng) -> f64 {
     // Box-Muller.
     let u1: f64 = rng.random::<f64>().max(1e-300);
@@ -130,11 +140,7 @@ fn closed_fit_reproduces_periodic_spline_samples() {
 
 #[test]
 fn closed_curve_is_periodic_and_c2() {
-    let mut rng = ChaCha8Rng::seed_from_u64(3);
-    let pts: Vec<DVec3> = circle(60, 2.0)
-        .into_iter()
-        .map(|p| p + 0.05 * DVec3::new(gauss(&mut rng), gauss(&mut rng), gauss(&mut rng)))
-        .collect();
+    let pts = noisy_circle(60, 2.0, 0.05, 3);
     let s = BSpline3::fit(&pts, &closed_opts(None, 1e-3)).unwrap();
     let e = 1e-12;
     assert!((s.eval(0.0) - s.eval(1.0 - e)).length() < 1e-9);
@@ -188,14 +194,10 @@ fn circle_tangent_error_shrinks_with_sampling() {
 
 #[test]
 fn circle_tangent_better_than_finite_differences_under_noise() {
-    let mut rng = ChaCha8Rng::seed_from_u64(11);
     let r = 30.0;
     let n = 200; // spacing ~0.94
     let sigma = 0.1;
-    let pts: Vec<DVec3> = circle(n, r)
-        .into_iter()
-        .map(|p| p + sigma * DVec3::new(gauss(&mut rng), gauss(&mut rng), gauss(&mut rng)))
-        .collect();
+    let pts = noisy_circle(n, r, sigma, 11);
     let s = BSpline3::fit(&pts, &closed_opts(None, 1e-3)).unwrap();
     let (mut err_fit, mut err_fd) = (0.0, 0.0);
     for i in 0..n {
@@ -213,14 +215,10 @@ fn circle_tangent_better_than_finite_differences_under_noise() {
 
 #[test]
 fn fit_reduces_noise() {
-    let mut rng = ChaCha8Rng::seed_from_u64(5);
     let r = 20.0;
     let n = 150;
     let sigma = 0.2;
-    let pts: Vec<DVec3> = circle(n, r)
-        .into_iter()
-        .map(|p| p + sigma * DVec3::new(gauss(&mut rng), gauss(&mut rng), gauss(&mut rng)))
-        .collect();
+    let pts = noisy_circle(n, r, sigma, 5);
     let dist_circle = |p: DVec3| ((p.x.hypot(p.y) - r).powi(2) + p.z * p.z).sqrt();
     let noisy: f64 = pts.iter().map(|&p| dist_circle(p)).sum::<f64>() / n as f64;
     for closed in [true, false] {
@@ -245,11 +243,7 @@ fn fit_reduces_noise() {
 
 #[test]
 fn smoothing_increases_smoothness() {
-    let mut rng = ChaCha8Rng::seed_from_u64(9);
-    let pts: Vec<DVec3> = circle(80, 5.0)
-        .into_iter()
-        .map(|p| p + 0.1 * DVec3::new(gauss(&mut rng), gauss(&mut rng), gauss(&mut rng)))
-        .collect();
+    let pts = noisy_circle(80, 5.0, 0.1, 9);
     let roughness = |s: &BSpline3| -> f64 {
         (0..400)
             .map(|i| s.second_derivative(i as f64 / 400.0).length_squared())
@@ -356,33 +350,30 @@ fn errors_are_reported() {
     assert_eq!(idx, (0..10).collect::<Vec<_>>());
     assert!(BSpline3::fit(&dd, &closed_opts(None, 1e-3)).is_ok());
     let pts = circle(10, 1.0);
-    for bad in [3, 11] {
-        let opts = FitOptions {
+    let mut invalid: Vec<FitOptions> = [3, 11]
+        .map(|bad| FitOptions {
             n_control: Some(bad),
             ..o.clone()
-        };
-        assert!(matches!(
-            BSpline3::fit(&pts, &opts),
-            Err(BSplineError::InvalidOption(_))
-        ));
-    }
+        })
+        .to_vec();
     for bad in [-1.0, f64::NAN] {
-        let opts = FitOptions {
+        invalid.push(FitOptions {
             smoothing: bad,
             ..o.clone()
-        };
-        assert!(matches!(
-            BSpline3::fit(&pts, &opts),
-            Err(BSplineError::InvalidOption(_))
-        ));
-        let opts = FitOptions {
+        });
+        invalid.push(FitOptions {
             control_spacing: Some(bad),
             ..o.clone()
-        };
-        assert!(matches!(
-            BSpline3::fit(&pts, &opts),
-            Err(BSplineError::InvalidOption(_))
-        ));
+        });
+    }
+    for opts in &invalid {
+        assert!(
+            matches!(
+                BSpline3::fit(&pts, opts),
+                Err(BSplineError::InvalidOption(_))
+            ),
+            "{opts:?}"
+        );
     }
     let us = vec![0.0, 0.5, 0.4, 0.6, 0.7, 0.8, 0.9, 0.95, 0.97, 1.0];
     assert!(matches!(
@@ -480,9 +471,7 @@ proptest! {
 
 #[test]
 fn parametrization_names_round_trip() {
-    meshcore::choice::check_choice::<bspline::Parametrization>("uniform").unwrap();
-    assert!(matches!(
-        "uniform".parse::<bspline::Parametrization>(),
-        Err(bspline::BSplineError::UnknownChoice(_))
-    ));
+    testsupport::check_choice_error::<bspline::Parametrization>("uniform", |e| {
+        matches!(e, bspline::BSplineError::UnknownChoice(_))
+    });
 }

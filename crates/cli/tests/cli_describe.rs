@@ -1,59 +1,24 @@
 //! End-to-end tests of `bipolar describe`.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_bipolar"))
-}
-
-/// Writes a unit icosphere (3 subdivisions, 642 vertices) as OBJ.
-fn sphere_obj(dir: &Path) -> PathBuf {
-    let mesh = bipolar::synthetic::icosphere(3);
-    let mut s = String::new();
-    for p in mesh.positions() {
-        s.push_str(&format!("v {} {} {}\n", p.x, p.y, p.z));
-    }
-    for t in mesh.triangles() {
-        s.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
-    }
-    let path = dir.join("sphere.obj");
-    std::fs::write(&path, s).unwrap();
-    path
-}
+mod common;
+use common::{arg, bipolar, sphere_obj};
 
 #[test]
 fn describe_writes_csv_json_and_ply() {
     let dir = tempfile::tempdir().unwrap();
     let obj = sphere_obj(dir.path());
     let csv = dir.path().join("d.csv");
-    let out = bin()
-        .args([
-            "describe",
-            obj.to_str().unwrap(),
-            "--ref-a",
-            "0",
-            "--ref-b",
-            "100",
-        ])
-        .args([
-            "--levels",
-            "6",
-            "--method",
-            "dijkstra",
-            "--rule",
-            "filter",
-            "--tangent",
-            "strip",
-        ])
-        .args(["--out", csv.to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let ab = ["describe", arg(&obj), "--ref-a", "0", "--ref-b", "100"];
+    let strip = ["--levels", "6", "--rule", "filter", "--tangent", "strip"];
+    bipolar(
+        &[
+            &ab[..],
+            &strip,
+            &["--method", "dijkstra", "--out", arg(&csv)],
+        ]
+        .concat(),
+    )
+    .success();
     let d = bipolar::io::read_csv(&csv).unwrap();
     assert!(!d.is_empty());
     assert!(std::fs::read_to_string(&csv)
@@ -67,34 +32,31 @@ fn describe_writes_csv_json_and_ply() {
 
     // Coordinates as references, a third reference, JSON output, spline tangents.
     let json = dir.path().join("d.json");
-    let out = bin()
-        .args(["describe", obj.to_str().unwrap()])
-        .args(["--ref-a", "0,0,1", "--ref-b", "1,0,0", "--ref", "0,1,0"])
-        .args([
-            "--step",
-            "0.2",
-            "--max-level",
-            "8",
-            "--angles",
-            "6",
-            "--alpha",
-            "0.9",
-        ])
-        .args([
-            "--tangent",
-            "spline",
-            "--method",
-            "dijkstra",
-            "--out",
-            json.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    bipolar(&[
+        "describe",
+        arg(&obj),
+        "--ref-a",
+        "0,0,1",
+        "--ref-b",
+        "1,0,0",
+        "--ref",
+        "0,1,0",
+        "--step",
+        "0.2",
+        "--max-level",
+        "8",
+        "--angles",
+        "6",
+        "--alpha",
+        "0.9",
+        "--tangent",
+        "spline",
+        "--method",
+        "dijkstra",
+        "--out",
+        arg(&json),
+    ])
+    .success();
     let d = bipolar::io::read_json(&json).unwrap();
     assert_eq!(d.references.len(), 3);
     assert!((d.references[0] - glam::DVec3::Z).length() < 0.05);
@@ -105,23 +67,7 @@ fn describe_writes_csv_json_and_ply() {
     assert!(d.points.iter().all(|p| p.key.j <= 6 && p.key.i <= 8));
 
     let ply = dir.path().join("d.ply");
-    let out = bin()
-        .args([
-            "describe",
-            obj.to_str().unwrap(),
-            "--ref-a",
-            "0",
-            "--ref-b",
-            "100",
-        ])
-        .args(["--method", "dijkstra", "--out", ply.to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    bipolar(&[&ab[..], &["--method", "dijkstra", "--out", arg(&ply)]].concat()).success();
     assert!(std::fs::read_to_string(&ply).unwrap().starts_with("ply\n"));
 }
 
@@ -129,48 +75,38 @@ fn describe_writes_csv_json_and_ply() {
 fn describe_reports_bad_input() {
     let dir = tempfile::tempdir().unwrap();
     let obj = sphere_obj(dir.path());
-    let run = |args: &[&str]| {
-        let out = bin()
-            .args(["describe", obj.to_str().unwrap()])
-            .args(args)
-            .output()
-            .unwrap();
-        assert!(!out.status.success());
-        String::from_utf8_lossy(&out.stderr).to_string()
-    };
     let out = dir.path().join("x.csv");
-    let o = out.to_str().unwrap();
-    let e = run(&[
-        "--ref-a", "0", "--ref-b", "99999", "--method", "dijkstra", "--out", o,
-    ]);
-    assert!(e.contains("99999"), "{e}");
-    let e = run(&[
-        "--ref-a", "0", "--ref-b", "a,b", "--method", "dijkstra", "--out", o,
-    ]);
-    assert!(e.contains("a,b"), "{e}");
-    let e = run(&[
-        "--ref-a", "0", "--ref-b", "0", "--method", "dijkstra", "--out", o,
-    ]);
-    assert!(e.contains("coincide"), "{e}");
-    let e = run(&[
-        "--ref-a", "0", "--ref-b", "5", "--method", "dijkstra", "--out", "x.txt",
-    ]);
-    assert!(e.contains(".csv"), "{e}");
-    let e = run(&[
-        "--ref-a",
-        "0",
-        "--ref-b",
-        "5",
-        "--tangent",
-        "magic",
-        "--out",
-        o,
-    ]);
-    assert!(e.contains("magic"), "{e}");
-    let e = run(&[
-        "--ref-a", "0", "--ref-b", "5", "--method", "dijkstra", "--step", "50", "--out", o,
-    ]);
-    assert!(e.contains("no descriptor points"), "{e}");
+    let o = arg(&out);
+    // (arguments after the mesh, what the error names)
+    let cases: [(&[&str], &str); 6] = [
+        (
+            &["--ref-b", "99999", "--method", "dijkstra", "--out", o],
+            "99999",
+        ),
+        (
+            &["--ref-b", "a,b", "--method", "dijkstra", "--out", o],
+            "a,b",
+        ),
+        (
+            &["--ref-b", "0", "--method", "dijkstra", "--out", o],
+            "coincide",
+        ),
+        (
+            &["--ref-b", "5", "--method", "dijkstra", "--out", "x.txt"],
+            ".csv",
+        ),
+        (&["--ref-b", "5", "--tangent", "magic", "--out", o], "magic"),
+        (
+            &[
+                "--ref-b", "5", "--method", "dijkstra", "--step", "50", "--out", o,
+            ],
+            "no descriptor points",
+        ),
+    ];
+    for (args, needle) in cases {
+        let e = bipolar(&[&["describe", arg(&obj), "--ref-a", "0"][..], args].concat()).failure();
+        assert!(e.contains(needle), "{args:?}: {e}");
+    }
 }
 
 #[test]
@@ -178,14 +114,10 @@ fn landmark_names_are_detected_or_fail_clearly() {
     let dir = tempfile::tempdir().unwrap();
     // A sphere is not a face: the detector must say so, not pick a point.
     let obj = sphere_obj(dir.path());
-    let out = bin()
-        .args(["describe", obj.to_str().unwrap()])
-        .args(["--ref-a", "outer-eye-right", "--ref-b", "outer-eye-left"])
-        .args(["--out", dir.path().join("s.csv").to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
+    let s_csv = dir.path().join("s.csv");
+    let eyes = ["--ref-a", "outer-eye-right", "--ref-b", "outer-eye-left"];
+    let err =
+        bipolar(&[&["describe", arg(&obj)][..], &eyes, &["--out", arg(&s_csv)]].concat()).failure();
     assert!(err.contains("outer_eye_right"), "{err}");
 
     // On a paper-set face the detected corners are within 5 mm of the ground-truth vertices.
@@ -193,14 +125,10 @@ fn landmark_names_are_detected_or_fail_clearly() {
         return;
     };
     let csv = dir.path().join("f.csv");
-    let out = bin()
-        .args(["describe", face.to_str().unwrap()])
-        .args(["--ref-a", "outer-eye-right", "--ref-b", "outer-eye-left"])
-        .args(["--levels", "5", "--out", csv.to_str().unwrap()])
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "{err}");
+    let levels = ["--levels", "5", "--out", arg(&csv)];
+    let err = bipolar(&[&["describe", arg(&face)][..], &eyes, &levels].concat())
+        .success()
+        .stderr;
     assert!(std::fs::read_to_string(&csv).unwrap().lines().count() > 10);
     let mesh = mesh_io::read_mesh(&face).unwrap().mesh;
     for (name, truth) in [("outer_eye_right", 1507u32), ("outer_eye_left", 3721)] {

@@ -1,7 +1,6 @@
 //! `bipolar distance` and `bipolar matrix` end to end on small descriptor CSV files.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 const HEADER: &str = "x,y,z,a,b,i,j,side,sign,cos,ambiguous";
 
@@ -55,16 +54,12 @@ fn write(dir: &Path, name: &str, pts: &[([f64; 3], [i64; 6])], ambiguous: &[usiz
     path
 }
 
+mod common;
+
+/// (success, stdout, stderr) of one run of `bipolar`.
 fn bipolar(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_bipolar"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    let r = common::bipolar(args);
+    (r.ok, r.stdout, r.stderr)
 }
 
 fn p(path: &Path) -> &str {

@@ -1,42 +1,17 @@
 //! End-to-end tests of `bipolar geodesic`.
 
 use std::path::Path;
-use std::process::Command;
 
-/// A flat 8 x 8 grid of unit cells in the plane z = 0, as OBJ text.
-fn grid_obj(n: usize) -> String {
-    let mut s = String::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            s.push_str(&format!("v {i} {j} 0\n"));
-        }
-    }
-    let idx = |i: usize, j: usize| j * (n + 1) + i + 1;
-    for j in 0..n {
-        for i in 0..n {
-            s.push_str(&format!(
-                "f {} {} {}\n",
-                idx(i, j),
-                idx(i + 1, j),
-                idx(i + 1, j + 1)
-            ));
-            s.push_str(&format!(
-                "f {} {} {}\n",
-                idx(i, j),
-                idx(i + 1, j + 1),
-                idx(i, j + 1)
-            ));
-        }
-    }
-    s
+mod common;
+use common::{arg, grid_obj, Run};
+
+/// A flat `n x n` grid of unit cells in the plane z = 0 as `dir/grid.obj`.
+fn unit_grid(dir: &Path, n: usize) -> std::path::PathBuf {
+    grid_obj(dir, "grid.obj", n, 1.0)
 }
 
-fn bipolar(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_bipolar"))
-        .arg("geodesic")
-        .args(args)
-        .output()
-        .unwrap()
+fn geodesic(args: &[&str]) -> Run {
+    common::bipolar_cmd("geodesic", args)
 }
 
 fn read_txt(p: &Path) -> Vec<f64> {
@@ -50,23 +25,22 @@ fn read_txt(p: &Path) -> Vec<f64> {
 #[test]
 fn writes_every_format() {
     let dir = tempfile::tempdir().unwrap();
-    let mesh = dir.path().join("grid.obj");
-    std::fs::write(&mesh, grid_obj(8)).unwrap();
-    let m = mesh.to_str().unwrap();
+    let mesh = unit_grid(dir.path(), 8);
+    let m = arg(&mesh);
     let out = |name: &str| dir.path().join(name);
 
     // Dijkstra from vertex 0: along the bottom row the distance is the x coordinate.
     let txt = out("d.txt");
-    let o = bipolar(&[
+    geodesic(&[
         m,
         "--source",
         "0",
         "--method",
         "dijkstra",
         "--out",
-        txt.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        arg(&txt),
+    ])
+    .success();
     let d = read_txt(&txt);
     assert_eq!(d.len(), 81);
     for (i, di) in d.iter().enumerate().take(9) {
@@ -75,16 +49,7 @@ fn writes_every_format() {
 
     // Fast marching, CSV.
     let csv = out("d.csv");
-    let o = bipolar(&[
-        m,
-        "--source",
-        "40",
-        "--method",
-        "fmm",
-        "--out",
-        csv.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    geodesic(&[m, "--source", "40", "--method", "fmm", "--out", arg(&csv)]).success();
     let text = std::fs::read_to_string(&csv).unwrap();
     let mut lines = text.lines();
     assert_eq!(lines.next(), Some("vertex,distance"));
@@ -101,7 +66,7 @@ fn writes_every_format() {
 
     // Heat method from a snapped surface point, NPY.
     let npy = out("d.npy");
-    let o = bipolar(&[
+    geodesic(&[
         m,
         "--source-point",
         "2.5,3.25,0.7",
@@ -111,9 +76,9 @@ fn writes_every_format() {
         "--method",
         "heat",
         "--out",
-        npy.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        arg(&npy),
+    ])
+    .success();
     let bytes = std::fs::read(&npy).unwrap();
     assert_eq!(&bytes[..6], b"\x93NUMPY");
     let hl = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
@@ -136,7 +101,7 @@ fn writes_every_format() {
 
     // PLY with the field as a vertex property, with a cut-off.
     let ply = out("d.ply");
-    let o = bipolar(&[
+    geodesic(&[
         m,
         "--source",
         "0",
@@ -145,9 +110,9 @@ fn writes_every_format() {
         "--max-distance",
         "3",
         "--out",
-        ply.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        arg(&ply),
+    ])
+    .success();
     let back = mesh_io::read_mesh(&ply).unwrap();
     assert_eq!(back.mesh.n_vertices(), 81);
     let f = back
@@ -163,33 +128,38 @@ fn writes_every_format() {
 #[test]
 fn reports_bad_input() {
     let dir = tempfile::tempdir().unwrap();
-    let mesh = dir.path().join("grid.obj");
-    std::fs::write(&mesh, grid_obj(2)).unwrap();
-    let m = mesh.to_str().unwrap();
+    let mesh = unit_grid(dir.path(), 2);
+    let m = arg(&mesh);
     let out = dir.path().join("d.txt");
-    let o = out.to_str().unwrap();
-    let e = bipolar(&[m, "--source", "99", "--method", "fmm", "--out", o]);
-    assert!(!e.status.success());
-    assert!(String::from_utf8_lossy(&e.stderr).contains("99"));
-    let e = bipolar(&[m, "--source", "0", "--method", "fmm", "--out", "x.bin"]);
-    assert!(!e.status.success());
-    assert!(String::from_utf8_lossy(&e.stderr).contains("extension"));
-    let e = bipolar(&[m, "--method", "fmm", "--out", o]);
-    assert!(!e.status.success(), "a source is required");
-    let e = bipolar(&[m, "--source", "0", "--method", "nope", "--out", o]);
-    assert!(!e.status.success());
-    let e = bipolar(&[
-        m,
-        "--source",
-        "0",
-        "--method",
-        "fmm",
-        "--max-distance",
-        "-1",
-        "--out",
-        o,
-    ]);
-    assert!(!e.status.success());
-    let e = bipolar(&["/nonexistent/mesh.obj", "--source", "0", "--out", o]);
-    assert!(!e.status.success());
+    let o = arg(&out);
+    // (arguments, what the error names if anything)
+    let cases: [(&[&str], &str); 6] = [
+        (&[m, "--source", "99", "--method", "fmm", "--out", o], "99"),
+        (
+            &[m, "--source", "0", "--method", "fmm", "--out", "x.bin"],
+            "extension",
+        ),
+        // A source is required.
+        (&[m, "--method", "fmm", "--out", o], ""),
+        (&[m, "--source", "0", "--method", "nope", "--out", o], ""),
+        (
+            &[
+                m,
+                "--source",
+                "0",
+                "--method",
+                "fmm",
+                "--max-distance",
+                "-1",
+                "--out",
+                o,
+            ],
+            "",
+        ),
+        (&["/nonexistent/mesh.obj", "--source", "0", "--out", o], ""),
+    ];
+    for (args, needle) in cases {
+        let e = geodesic(args).failure();
+        assert!(e.contains(needle), "{args:?}: {e}");
+    }
 }

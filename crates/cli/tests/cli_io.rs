@@ -1,11 +1,9 @@
 //! `bipolar info` and `bipolar convert` end to end.
 
-use std::path::PathBuf;
-use std::process::Command;
+use std::path::{Path, PathBuf};
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_bipolar"))
-}
+mod common;
+use common::{arg, bipolar};
 
 fn fixture(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -13,14 +11,15 @@ fn fixture(name: &str) -> PathBuf {
         .join(name)
 }
 
-fn info_json(path: &std::path::Path) -> serde_json::Value {
-    let out = bin().arg("info").arg(path).arg("--json").output().unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
+fn info_json(path: &Path) -> serde_json::Value {
+    let out = bipolar(&["info", arg(path), "--json"]).success();
+    serde_json::from_str(&out.stdout).unwrap()
+}
+
+/// Two triangles as a soup (2 duplicate vertices), one degenerate face, an open strip: `name`
+/// in `dir`.
+fn soup(dir: &Path, name: &str) -> PathBuf {
+    testsupport::cli::write_mesh(dir, name, &testsupport::triangle_soup())
 }
 
 #[test]
@@ -42,21 +41,14 @@ fn info_on_the_cube() {
         (mean - (12.0 + 6.0 * 2f64.sqrt()) / 18.0).abs() < 1e-12,
         "{mean}"
     );
-    let text = bin().arg("info").arg(fixture("cube.obj")).output().unwrap();
-    let s = String::from_utf8_lossy(&text.stdout);
+    let s = bipolar(&["info", arg(&fixture("cube.obj"))]).stdout;
     assert!(s.contains("vertices:              8"), "{s}");
 }
 
 #[test]
 fn info_reports_defects_without_repairing() {
     let dir = tempfile::tempdir().unwrap();
-    let p = dir.path().join("bad.obj");
-    // Two triangles as a soup (2 duplicate vertices), one degenerate face, an open strip.
-    std::fs::write(
-        &p,
-        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 4 5 6\nf 1 1 2\n",
-    )
-    .unwrap();
+    let p = soup(dir.path(), "bad.obj");
     let j = info_json(&p);
     assert_eq!(j["vertices"], 6);
     assert_eq!(j["duplicate_vertices"], 2);
@@ -70,25 +62,17 @@ fn info_reports_defects_without_repairing() {
 #[test]
 fn convert_between_formats_with_repairs() {
     let dir = tempfile::tempdir().unwrap();
-    let src = dir.path().join("soup.obj");
-    std::fs::write(
-        &src,
-        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 4 5 6\nf 1 1 2\n",
-    )
-    .unwrap();
+    let src = soup(dir.path(), "soup.obj");
     let out = dir.path().join("clean.ply");
-    let st = bin()
-        .arg("convert")
-        .arg(&src)
-        .arg(&out)
-        .args(["--weld", "0", "--drop-degenerate"])
-        .output()
-        .unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
-    );
+    bipolar(&[
+        "convert",
+        arg(&src),
+        arg(&out),
+        "--weld",
+        "0",
+        "--drop-degenerate",
+    ])
+    .success();
     let j = info_json(&out);
     assert_eq!(j["vertices"], 4);
     assert_eq!(j["faces"], 2);
@@ -99,12 +83,8 @@ fn convert_between_formats_with_repairs() {
     let mut prev = fixture("cube_ascii.ply");
     for ext in ["obj", "off", "stl", "glb", "ply"] {
         let next = dir.path().join(format!("cube.{ext}"));
-        let st = bin().arg("convert").arg(&prev).arg(&next).output().unwrap();
-        assert!(
-            st.status.success(),
-            "{ext}: {}",
-            String::from_utf8_lossy(&st.stderr)
-        );
+        let r = bipolar(&["convert", arg(&prev), arg(&next)]);
+        assert!(r.ok, "{ext}: {}", r.stderr);
         let j = info_json(&next);
         assert_eq!(j["faces"], 12, "{ext}");
         assert_eq!(j["vertices"], 8, "{ext}");
@@ -114,21 +94,8 @@ fn convert_between_formats_with_repairs() {
     // Colours survive PLY -> GLB -> PLY.
     let a = dir.path().join("c.glb");
     let b = dir.path().join("c.ply");
-    assert!(bin()
-        .arg("convert")
-        .arg(fixture("cube_ascii.ply"))
-        .arg(&a)
-        .status()
-        .unwrap()
-        .success());
-    assert!(bin()
-        .arg("convert")
-        .arg(&a)
-        .arg(&b)
-        .args(["--ascii"])
-        .status()
-        .unwrap()
-        .success());
+    bipolar(&["convert", arg(&fixture("cube_ascii.ply")), arg(&a)]).success();
+    bipolar(&["convert", arg(&a), arg(&b), "--ascii"]).success();
     assert_eq!(info_json(&b)["has_colors"], true);
     let text = std::fs::read_to_string(&b).unwrap();
     assert!(text.starts_with("ply\nformat ascii"), "{text}");
@@ -155,12 +122,7 @@ fn convert_bnt_to_obj() {
     let src = dir.path().join("scan.bnt");
     std::fs::write(&src, g.to_bytes()).unwrap();
     let out = dir.path().join("scan.obj");
-    let st = bin().arg("convert").arg(&src).arg(&out).output().unwrap();
-    assert!(
-        st.status.success(),
-        "{}",
-        String::from_utf8_lossy(&st.stderr)
-    );
+    bipolar(&["convert", arg(&src), arg(&out)]).success();
     let j = info_json(&out);
     assert_eq!(j["vertices"], 42);
     assert_eq!(j["faces"], 60);
@@ -172,26 +134,13 @@ fn errors_name_the_file_and_line() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("broken.off");
     std::fs::write(&p, "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n").unwrap();
-    let out = bin().arg("info").arg(&p).output().unwrap();
-    assert!(!out.status.success());
-    let e = String::from_utf8_lossy(&out.stderr);
+    let e = bipolar(&["info", arg(&p)]).failure();
     assert!(
         e.contains("broken.off: line 6: vertex index 9 out of range"),
         "{e}"
     );
-    let out = bin()
-        .arg("convert")
-        .arg(fixture("cube.obj"))
-        .arg(dir.path().join("x.bnt"))
-        .output()
-        .unwrap();
-    assert!(!out.status.success());
-    let out = bin()
-        .arg("convert")
-        .arg(fixture("cube.obj"))
-        .arg(dir.path().join("x.ply"))
-        .args(["--weld", "-1"])
-        .output()
-        .unwrap();
-    assert!(!out.status.success());
+    let cube = fixture("cube.obj");
+    let (bnt, ply) = (dir.path().join("x.bnt"), dir.path().join("x.ply"));
+    bipolar(&["convert", arg(&cube), arg(&bnt)]).failure();
+    bipolar(&["convert", arg(&cube), arg(&ply), "--weld", "-1"]).failure();
 }

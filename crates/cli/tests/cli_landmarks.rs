@@ -1,38 +1,22 @@
 //! End-to-end tests of `bipolar landmarks`.
 
-use std::process::Command;
+mod common;
+use common::{arg, Run};
 
-fn bipolar(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_bipolar"))
-        .arg("landmarks")
-        .args(args)
-        .output()
-        .unwrap()
+fn bipolar(args: &[&str]) -> Run {
+    common::bipolar_cmd("landmarks", args)
 }
-
-use testsupport::paper_face;
 
 #[test]
 fn detects_on_a_paper_face_and_writes_json_and_lm3() {
-    let Some(mesh) = paper_face("id2_neutral.obj") else {
+    let Some((mesh, dir)) = common::paper_face_and_tempdir("id2_neutral.obj") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let json = dir.path().join("lm.json");
     let lm3 = dir.path().join("lm.lm3");
-    let out = bipolar(&[
-        mesh.to_str().unwrap(),
-        "--out",
-        json.to_str().unwrap(),
-        "--lm3",
-        lm3.to_str().unwrap(),
-    ]);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let stdout = bipolar(&[arg(&mesh), "--out", arg(&json), "--lm3", arg(&lm3)])
+        .success()
+        .stdout;
     assert!(stdout.contains("confidence") && stdout.contains("outer_eye_right"));
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
@@ -47,40 +31,17 @@ fn detects_on_a_paper_face_and_writes_json_and_lm3() {
 #[test]
 fn not_a_face_fails_with_a_clear_message() {
     let dir = tempfile::tempdir().unwrap();
-    let obj = dir.path().join("plane.obj");
-    let mut s = String::new();
-    for j in 0..=20 {
-        for i in 0..=20 {
-            s.push_str(&format!("v {} {} 0\n", i as f64 * 0.5, j as f64 * 0.5));
-        }
-    }
-    for j in 0..20 {
-        for i in 0..20 {
-            let a = j * 21 + i + 1;
-            s.push_str(&format!(
-                "f {} {} {}\nf {} {} {}\n",
-                a,
-                a + 1,
-                a + 22,
-                a,
-                a + 22,
-                a + 21
-            ));
-        }
-    }
-    std::fs::write(&obj, s).unwrap();
-    let out = bipolar(&[obj.to_str().unwrap()]);
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr);
+    // A flat 20 x 20 grid of cells 0.5 wide in the plane z = 0.
+    let obj = common::grid_obj(dir.path(), "plane.obj", 20, 0.5);
+    let err = bipolar(&[arg(&obj)]).failure();
     assert!(err.contains("not found") && err.contains("score"), "{err}");
 }
 
 #[test]
 fn a_face_in_millimetres_needs_no_scale_flag() {
-    let Some(mesh) = paper_face("id2_neutral.obj") else {
+    let Some((mesh, dir)) = common::paper_face_and_tempdir("id2_neutral.obj") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let mm = dir.path().join("face_mm.obj");
     let text: String = std::fs::read_to_string(&mesh)
         .unwrap()
@@ -98,13 +59,7 @@ fn a_face_in_millimetres_needs_no_scale_flag() {
         .collect();
     std::fs::write(&mm, text).unwrap();
     let json = dir.path().join("lm.json");
-    let out = bipolar(&[mm.to_str().unwrap(), "--out", json.to_str().unwrap()]);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let stdout = bipolar(&[arg(&mm), "--out", arg(&json)]).success().stdout;
     assert!(stdout.contains("units mm"), "{stdout}");
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
@@ -113,6 +68,5 @@ fn a_face_in_millimetres_needs_no_scale_flag() {
         .unwrap();
     assert!((x + 44.0).abs() < 6.0, "outer_eye_right x = {x} mm");
     // An explicit --scale still wins: 1 (the model's cm) on a face in mm finds no face.
-    let out = bipolar(&[mm.to_str().unwrap(), "--scale", "1"]);
-    assert!(!out.status.success());
+    bipolar(&[arg(&mm), "--scale", "1"]).failure();
 }

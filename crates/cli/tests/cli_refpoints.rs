@@ -3,38 +3,10 @@
 //! (farther is an error naming the distance and the tolerance) and landmark names from
 //! `--landmarks FILE`.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
 
-fn bipolar(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bipolar"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-/// A unit icosphere (3 subdivisions, 642 vertices; bounding-box diagonal about 3.46) as OBJ.
-fn sphere_obj(dir: &Path) -> PathBuf {
-    let mesh = bipolar::synthetic::icosphere(3);
-    let mut s = String::new();
-    for p in mesh.positions() {
-        s.push_str(&format!("v {} {} {}\n", p.x, p.y, p.z));
-    }
-    for t in mesh.triangles() {
-        s.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
-    }
-    let path = dir.join("sphere.obj");
-    std::fs::write(&path, s).unwrap();
-    path
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
+mod common;
+use common::{arg as s, bipolar, sphere_obj};
 
 #[test]
 fn a_far_point_is_rejected_with_its_distance_in_every_command() {
@@ -79,8 +51,8 @@ fn a_far_point_is_rejected_with_its_distance_in_every_command() {
         ]),
     ];
     for o in &runs {
-        let e = stderr(o);
-        assert!(!o.status.success(), "{e}");
+        let e = &o.stderr;
+        assert!(!o.ok, "{e}");
         // The distance (1e9 - 1) and the tolerance (1 % of the diagonal, 0.0346...).
         assert!(
             e.contains("999999999.") && e.contains("farther than the tolerance 0.034"),
@@ -96,38 +68,27 @@ fn a_near_point_is_accepted_and_the_tolerance_can_be_tightened() {
     let obj = sphere_obj(dir.path());
     let csv = dir.path().join("d.csv");
     let run = |extra: &[&str]| {
-        bipolar(
-            &[
-                &[
-                    "describe",
-                    s(&obj),
-                    "--ref-a",
-                    "0,0,1.01",
-                    "--ref-b",
-                    "1.01,0,0",
-                ][..],
-                &["--method", "dijkstra", "--levels", "5", "--out", s(&csv)],
-                extra,
-            ]
-            .concat(),
-        )
+        let fixed = [
+            "describe",
+            s(&obj),
+            "--ref-a",
+            "0,0,1.01",
+            "--ref-b",
+            "1.01,0,0",
+            "--method",
+            "dijkstra",
+            "--levels",
+            "5",
+            "--out",
+            s(&csv),
+        ];
+        bipolar(&[&fixed[..], extra].concat())
     };
-    let o = run(&[]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    assert!(
-        stderr(&o).contains("--ref-a: \"0,0,1.01\" snapped to face"),
-        "{}",
-        stderr(&o)
-    );
-    let o = run(&["--snap-tolerance", "0.001"]);
-    assert!(!o.status.success());
-    assert!(
-        stderr(&o).contains("farther than the tolerance"),
-        "{}",
-        stderr(&o)
-    );
-    let o = run(&["--snap-tolerance", "-1"]);
-    assert!(!o.status.success());
+    let e = run(&[]).success().stderr;
+    assert!(e.contains("--ref-a: \"0,0,1.01\" snapped to face"), "{e}");
+    let e = run(&["--snap-tolerance", "0.001"]).failure();
+    assert!(e.contains("farther than the tolerance"), "{e}");
+    run(&["--snap-tolerance", "-1"]).failure();
 }
 
 #[test]
@@ -141,43 +102,49 @@ fn landmark_names_from_a_file_work_in_describe_render_and_geodesic() {
     )
     .unwrap();
     let d = |name: &str| dir.path().join(name);
-    // describe: the file's names give the same descriptor as the coordinates.
-    let common = ["--method", "dijkstra", "--levels", "5"];
-    let o = bipolar(
-        &[
-            &["describe", s(&obj), "--landmarks", s(&lm3)][..],
-            &["--ref-a", "outer-eye-right", "--ref-b", "outer-eye-left"],
-            &common,
-            &["--out", s(&d("a.csv"))],
-        ]
-        .concat(),
-    );
-    assert!(o.status.success(), "{}", stderr(&o));
-    let o = bipolar(
-        &[
+    let (lm3, a_csv, b_csv, r_svg) = (s(&lm3), d("a.csv"), d("b.csv"), d("r.svg"));
+    let (g1, g2, g3) = (d("g1.txt"), d("g2.txt"), d("g3.txt"));
+    // describe: the file's names give the same descriptor as the coordinates; geodesic: a
+    // landmark source equals the same point given as coordinates. (names, coordinates, the
+    // common arguments, the two outputs).
+    let pairs: [(&[&str], &[&str], &[&str], [&Path; 2]); 2] = [
+        (
             &[
-                "describe",
-                s(&obj),
+                "--landmarks",
+                lm3,
                 "--ref-a",
-                "0,0,1.01",
+                "outer-eye-right",
                 "--ref-b",
-                "1.01,0,0",
-            ][..],
-            &common,
-            &["--out", s(&d("b.csv"))],
-        ]
-        .concat(),
-    );
-    assert!(o.status.success(), "{}", stderr(&o));
-    let a = std::fs::read_to_string(d("a.csv")).unwrap();
-    assert!(a.lines().count() > 5, "{a}");
-    assert_eq!(a, std::fs::read_to_string(d("b.csv")).unwrap());
+                "outer-eye-left",
+            ],
+            &["--ref-a", "0,0,1.01", "--ref-b", "1.01,0,0"],
+            &["describe", s(&obj), "--method", "dijkstra", "--levels", "5"],
+            [&a_csv, &b_csv],
+        ),
+        (
+            &["--landmarks", lm3, "--source", "outer-eye-right"],
+            &["--source-point", "0,0,1.01"],
+            &["geodesic", s(&obj), "--method", "dijkstra"],
+            [&g1, &g2],
+        ),
+    ];
+    let mut texts = Vec::new();
+    for (names, coords, common, outs) in pairs {
+        let [by_name, by_coords] = [(names, outs[0]), (coords, outs[1])].map(|(refs, out)| {
+            bipolar(&[common, refs, &["--out", s(out)]].concat()).success();
+            std::fs::read_to_string(out).unwrap()
+        });
+        assert_eq!(by_name, by_coords, "{common:?}");
+        texts.push(by_name);
+    }
+    assert!(texts[0].lines().count() > 5, "{}", texts[0]);
+    assert_eq!(texts[1].lines().count(), 642);
     // render: the names place both markers and curves.
-    let o = bipolar(&[
+    bipolar(&[
         "render",
         s(&obj),
         "--landmarks",
-        s(&lm3),
+        lm3,
         "--ref-a",
         "outer-eye-right",
         "--ref-b",
@@ -187,97 +154,65 @@ fn landmark_names_from_a_file_work_in_describe_render_and_geodesic() {
         "--method",
         "dijkstra",
         "--out",
-        s(&d("r.svg")),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let svg = std::fs::read_to_string(d("r.svg")).unwrap();
+        s(&r_svg),
+    ])
+    .success();
+    let svg = std::fs::read_to_string(&r_svg).unwrap();
     assert!(
         svg.contains("#d72828") && svg.contains("#1e5adc"),
         "both curve colours"
     );
-    // geodesic: a landmark source equals the same point given as coordinates.
-    let o = bipolar(&[
-        "geodesic",
-        s(&obj),
-        "--landmarks",
-        s(&lm3),
-        "--source",
-        "outer-eye-right",
-        "--method",
-        "dijkstra",
-        "--out",
-        s(&d("g1.txt")),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let o = bipolar(&[
-        "geodesic",
-        s(&obj),
-        "--source-point",
-        "0,0,1.01",
-        "--method",
-        "dijkstra",
-        "--out",
-        s(&d("g2.txt")),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let g1 = std::fs::read_to_string(d("g1.txt")).unwrap();
-    assert_eq!(g1.lines().count(), 642);
-    assert_eq!(g1, std::fs::read_to_string(d("g2.txt")).unwrap());
     // A name the file lacks is an error listing the file's labels.
-    let o = bipolar(&[
+    let e = bipolar(&[
         "geodesic",
         s(&obj),
         "--landmarks",
-        s(&lm3),
+        lm3,
         "--source",
         "nose-tip",
         "--out",
-        s(&d("g3.txt")),
-    ]);
-    assert!(!o.status.success());
-    assert!(
-        stderr(&o).contains("Outer left eye corner"),
-        "{}",
-        stderr(&o)
-    );
+        s(&g3),
+    ])
+    .failure();
+    assert!(e.contains("Outer left eye corner"), "{e}");
 }
 
 #[test]
 fn bad_option_names_list_the_valid_ones() {
     let dir = tempfile::tempdir().unwrap();
     let obj = sphere_obj(dir.path());
-    let o = bipolar(&[
-        "geodesic",
-        s(&obj),
-        "--source",
-        "0",
-        "--method",
-        "mmp",
-        "--out",
-        "x.txt",
-    ]);
-    assert!(!o.status.success());
-    let e = stderr(&o);
-    assert!(
-        e.contains("unknown geodesic method \"mmp\"; expected one of: exact, fmm, heat, dijkstra"),
-        "{e}"
-    );
-    let o = bipolar(&[
-        "describe",
-        s(&obj),
-        "--ref-a",
-        "0",
-        "--ref-b",
-        "5",
-        "--rule",
-        "band",
-        "--out",
-        "x.csv",
-    ]);
-    assert!(!o.status.success());
-    assert!(
-        stderr(&o).contains("filter, isoangle, all"),
-        "{}",
-        stderr(&o)
-    );
+    let cases: [(&[&str], &str); 2] = [
+        (
+            &[
+                "geodesic",
+                s(&obj),
+                "--source",
+                "0",
+                "--method",
+                "mmp",
+                "--out",
+                "x.txt",
+            ],
+            "unknown geodesic method \"mmp\"; expected one of: exact, fmm, heat, dijkstra",
+        ),
+        (
+            &[
+                "describe",
+                s(&obj),
+                "--ref-a",
+                "0",
+                "--ref-b",
+                "5",
+                "--rule",
+                "band",
+                "--out",
+                "x.csv",
+            ],
+            "filter, isoangle, all",
+        ),
+    ];
+    for (args, needle) in cases {
+        let e = bipolar(args).failure();
+        assert!(e.contains(needle), "{args:?}: {e}");
+    }
 }

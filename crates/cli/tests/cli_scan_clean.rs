@@ -2,28 +2,20 @@
 //! read the result back.
 
 use std::path::PathBuf;
-use std::process::Command;
 
+mod common;
+
+/// (success, stdout, stderr) of one run of `bipolar`.
 fn bipolar(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_bipolar"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    let r = common::bipolar(args);
+    (r.ok, r.stdout, r.stderr)
 }
-
-use testsupport::paper_face;
 
 #[test]
 fn scan_an_ict_face_clean_it_and_read_it_back() {
-    let Some(face) = paper_face("id1_neutral.obj") else {
+    let Some((face, dir)) = common::paper_face_and_tempdir("id1_neutral.obj") else {
         return;
     };
-    let dir = tempfile::tempdir().unwrap();
     let bnt = dir.path().join("scan.bnt");
     let lm3 = dir.path().join("scan.lm3");
     let s = |p: &PathBuf| p.to_str().unwrap().to_string();

@@ -2,14 +2,17 @@
 //! oracles and invariants. Meshes are generated here; everything runs in a few seconds in the
 //! dev profile.
 
+mod common;
+
 use geodesic::{
     distances_many, new_solver, Dijkstra, FastMarching, FmmUpdate, GeodesicError, GeodesicSolver,
     HeatMethod, Method, SolveOptions, Source, SurfacePoint, TriMesh,
 };
 use glam::{DAffine3, DQuat, DVec3};
-use meshcore::shapes::{cylinder, icosphere, uv_sphere};
 use proptest::prelude::*;
 use std::f64::consts::PI;
+use testsupport::fields::{euclidean, max_abs_diff, max_rel_err, mean_abs_diff, sphere_geodesic};
+use testsupport::shapes::{self, cylinder, icosphere, uv_sphere, Diagonals};
 
 const APPROX: [Method; 3] = [Method::Fmm, Method::Heat, Method::Dijkstra];
 
@@ -22,45 +25,20 @@ fn solve(mesh: &TriMesh, m: Method, s: &[Source]) -> Vec<f64> {
 
 /// Planar grid `nx` x `ny` cells of size `sx` x `sy`, diagonals alternating (or all one way).
 fn grid(nx: usize, ny: usize, sx: f64, sy: f64, alternate: bool) -> TriMesh {
-    let mut p = Vec::new();
-    for j in 0..=ny {
-        for i in 0..=nx {
-            p.push(DVec3::new(i as f64 * sx, j as f64 * sy, 0.0));
-        }
-    }
-    let idx = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
-    let mut t = Vec::new();
-    for j in 0..ny {
-        for i in 0..nx {
-            if !alternate || (i + j) % 2 == 0 {
-                t.push([idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)]);
-                t.push([idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)]);
-            } else {
-                t.push([idx(i, j), idx(i + 1, j), idx(i, j + 1)]);
-                t.push([idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1)]);
-            }
-        }
-    }
-    TriMesh::new(p, t).unwrap()
+    let diagonals = if alternate {
+        Diagonals::Alternating
+    } else {
+        Diagonals::Uniform
+    };
+    shapes::grid(nx, ny, diagonals, |i, j| {
+        DVec3::new(i as f64 * sx, j as f64 * sy, 0.0)
+    })
+    .unwrap()
 }
 
+/// Great-circle distance on the unit sphere from vertex `src`.
 fn great_circle(mesh: &TriMesh, src: u32) -> Vec<f64> {
-    let p = mesh.position(src).normalize();
-    mesh.positions()
-        .iter()
-        .map(|v| v.normalize().dot(p).clamp(-1.0, 1.0).acos())
-        .collect()
-}
-
-fn max_err(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max)
-}
-
-fn mean_err(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| (x - y).abs()).sum::<f64>() / a.len() as f64
+    sphere_geodesic(mesh, mesh.position(src), 1.0)
 }
 
 #[test]
@@ -69,20 +47,20 @@ fn plane_matches_euclidean_distance() {
     let m = grid(n, n, h, h, true);
     let src = (n / 2 * (n + 1) + n / 2) as u32;
     let c = m.position(src);
-    let exact: Vec<f64> = m.positions().iter().map(|p| (*p - c).length()).collect();
+    let exact = euclidean(&m, c);
     let fmm = solve(&m, Method::Fmm, &[Source::Vertex(src)]);
     let heat = solve(&m, Method::Heat, &[Source::Vertex(src)]);
     let dij = solve(&m, Method::Dijkstra, &[Source::Vertex(src)]);
     let (ef, eh, ed) = (
-        max_err(&fmm, &exact),
-        max_err(&heat, &exact),
-        max_err(&dij, &exact),
+        max_abs_diff(&fmm, &exact),
+        max_abs_diff(&heat, &exact),
+        max_abs_diff(&dij, &exact),
     );
     // FMM: first order from a point source; a fraction of an edge. Heat: boundary effects.
     assert!(ef < 0.35 * h, "fmm max error {ef} (h = {h})");
-    assert!(mean_err(&fmm, &exact) < 0.1 * h);
+    assert!(mean_abs_diff(&fmm, &exact) < 0.1 * h);
     assert!(eh < 2.0 * h, "heat max error {eh}");
-    assert!(mean_err(&heat, &exact) < 0.5 * h);
+    assert!(mean_abs_diff(&heat, &exact) < 0.5 * h);
     // Dijkstra on edges is far worse and never below the truth.
     assert!(ed > 2.0 * ef, "dijkstra {ed} vs fmm {ef}");
     assert!(dij.iter().zip(&exact).all(|(d, e)| *d >= e - 1e-12));
@@ -127,7 +105,7 @@ fn point_source_update_is_exact_on_flat_meshes() {
         .unwrap()
         .distances(&[Source::Vertex(src)], &SolveOptions::default())
         .unwrap();
-    assert!(max_err(&p, &d) > 1e-3);
+    assert!(max_abs_diff(&p, &d) > 1e-3);
 }
 
 #[test]
@@ -150,16 +128,11 @@ fn obtuse_triangles_are_split_by_unfolding() {
     assert!(split as f64 > 0.8 * obtuse as f64, "{split} of {obtuse}");
     let src = 10 * 21 + 10;
     let c = m.position(src);
-    let exact: Vec<f64> = m.positions().iter().map(|p| (*p - c).length()).collect();
+    let exact = euclidean(&m, c);
     let d = fm
         .distances(&[Source::Vertex(src)], &SolveOptions::default())
         .unwrap();
-    let rel = d
-        .iter()
-        .zip(&exact)
-        .filter(|(_, e)| **e > 0.2)
-        .map(|(a, e)| (a - e).abs() / e)
-        .fold(0.0, f64::max);
+    let rel = max_rel_err(&d, &exact, 0.2);
     let worst = d
         .iter()
         .zip(&exact)
@@ -177,12 +150,7 @@ fn obtuse_triangles_are_split_by_unfolding() {
         m.position(worst.0 as u32)
     );
     let dij = solve(&m, Method::Dijkstra, &[Source::Vertex(src)]);
-    let rel_dij = dij
-        .iter()
-        .zip(&exact)
-        .filter(|(_, e)| **e > 0.2)
-        .map(|(a, e)| (a - e).abs() / e)
-        .fold(0.0, f64::max);
+    let rel_dij = max_rel_err(&dij, &exact, 0.2);
     assert!(rel_dij > 3.0 * rel, "dijkstra {rel_dij} vs fmm {rel}");
 }
 
@@ -194,8 +162,8 @@ fn sphere_great_circle_and_fmm_convergence() {
         let g = great_circle(&m, 0);
         let h = m.mean_edge_length();
         let d = solve(&m, Method::Fmm, &[Source::Vertex(0)]);
-        let e = mean_err(&d, &g);
-        let emax = max_err(&d, &g);
+        let e = mean_abs_diff(&d, &g);
+        let emax = max_abs_diff(&d, &g);
         assert!(emax < 0.75 * h, "level {level}: fmm max {emax}, h {h}");
         assert!(
             e < 0.7 * prev,
@@ -207,7 +175,11 @@ fn sphere_great_circle_and_fmm_convergence() {
     let g = great_circle(&m, 0);
     let h = m.mean_edge_length();
     let d = solve(&m, Method::Heat, &[Source::Vertex(0)]);
-    assert!(max_err(&d, &g) < 0.5 * h, "heat {}", max_err(&d, &g));
+    assert!(
+        max_abs_diff(&d, &g) < 0.5 * h,
+        "heat {}",
+        max_abs_diff(&d, &g)
+    );
     let d = solve(&m, Method::Dijkstra, &[Source::Vertex(0)]);
     assert!(d
         .iter()
@@ -234,7 +206,7 @@ fn uv_sphere_from_the_equator_stays_accurate() {
             .unwrap();
         // Whole sphere (the antipodal region, where geodesics converge, is the hardest) and
         // the hemisphere around the source.
-        let e = max_err(&d, &g);
+        let e = max_abs_diff(&d, &g);
         assert!(e < 0.1, "{rule:?}: max error {e}");
         let near = d
             .iter()
@@ -280,11 +252,11 @@ fn surface_point_sources() {
     let face = 2 * (8 * 16 + 8) as u32;
     let sp = SurfacePoint::new(face, DVec3::new(0.2, 0.5, 0.3));
     let c = m.point_position(&sp).unwrap();
-    let exact: Vec<f64> = m.positions().iter().map(|p| (*p - c).length()).collect();
+    let exact = euclidean(&m, c);
     let tri = m.triangles()[face as usize];
     for meth in APPROX {
         let d = solve(&m, meth, &[Source::Point(sp)]);
-        let e = max_err(&d, &exact);
+        let e = max_abs_diff(&d, &exact);
         let tol = match meth {
             Method::Fmm => 0.02,
             Method::Heat => 0.1,
@@ -302,7 +274,7 @@ fn surface_point_sources() {
     for meth in APPROX {
         let a = solve(&m, meth, &[Source::Point(corner)]);
         let b = solve(&m, meth, &[Source::Vertex(tri[1])]);
-        assert!(max_err(&a, &b) < 1e-9, "{meth:?}");
+        assert!(max_abs_diff(&a, &b) < 1e-9, "{meth:?}");
     }
 }
 
@@ -371,9 +343,9 @@ fn rigid_motion_and_renumbering_invariance() {
         let a = solve(&m, meth, &[Source::Vertex(5)]);
         let b = solve(&moved, meth, &[Source::Vertex(5)]);
         assert!(
-            max_err(&a, &b) < 1e-9,
+            max_abs_diff(&a, &b) < 1e-9,
             "{meth:?} rigid: {}",
-            max_err(&a, &b)
+            max_abs_diff(&a, &b)
         );
         let c = solve(&renum, meth, &[Source::Vertex(perm(5))]);
         let e = (0..n)
@@ -496,17 +468,7 @@ fn bad_input_errors() {
                 "{meth:?} {p:?}"
             );
         }
-        for c in [0.0, -1.0, f64::NAN] {
-            assert!(matches!(
-                s.distances(
-                    &[Source::Vertex(0)],
-                    &SolveOptions {
-                        max_distance: Some(c)
-                    }
-                ),
-                Err(GeodesicError::InvalidCutoff(_))
-            ));
-        }
+        common::assert_rejects_bad_cutoffs(s.as_ref());
     }
     // Empty meshes and non-finite coordinates never reach a solver: TriMesh rejects them.
     assert!(TriMesh::new(vec![], vec![]).is_err());

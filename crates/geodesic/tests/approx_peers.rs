@@ -13,29 +13,22 @@ use geodesic::{
 use glam::DVec3;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use testsupport::fields::{max_abs_diff, max_rel_err, mean_abs_diff, sphere_geodesic};
 
-fn load_obj(path: &Path) -> TriMesh {
-    let text = std::fs::read_to_string(path).unwrap();
-    let (mut p, mut t) = (Vec::new(), Vec::new());
-    for line in text.lines() {
-        let mut it = line.split_whitespace();
-        match it.next() {
-            Some("v") => {
-                let c: Vec<f64> = it.take(3).map(|s| s.parse().unwrap()).collect();
-                p.push(DVec3::new(c[0], c[1], c[2]));
-            }
-            Some("f") => {
-                let c: Vec<u32> = it
-                    .map(|s| s.split('/').next().unwrap().parse::<u32>().unwrap() - 1)
-                    .collect();
-                for k in 1..c.len() - 1 {
-                    t.push([c[0], c[k], c[k + 1]]);
-                }
-            }
-            _ => {}
-        }
+/// The solver named `name`: `fmm` (the default rule), `fmm_point`, `fmm_plane`, `fmm_blend`,
+/// `fmm_curved`, `heat` or `dijkstra`.
+fn solver(mesh: &TriMesh, name: &str) -> Box<dyn GeodesicSolver> {
+    let fmm = |rule| FastMarching::with_update(mesh, rule).unwrap();
+    match name {
+        "fmm" => Box::new(FastMarching::new(mesh).unwrap()),
+        "fmm_point" => Box::new(fmm(FmmUpdate::PointSource)),
+        "fmm_plane" => Box::new(fmm(FmmUpdate::PlaneWave)),
+        "fmm_blend" => Box::new(fmm(FmmUpdate::Blend)),
+        "fmm_curved" => Box::new(fmm(FmmUpdate::CurvedFront)),
+        "heat" => Box::new(HeatMethod::new(mesh).unwrap()),
+        "dijkstra" => Box::new(Dijkstra::new(mesh).unwrap()),
+        other => panic!("unknown method {other}"),
     }
-    TriMesh::new(p, t).unwrap()
 }
 
 fn load_txt(path: &Path) -> Option<Vec<f64>> {
@@ -71,6 +64,12 @@ fn errors(d: &[f64], g: &[f64]) -> Err3 {
         rel: r / nr as f64,
         at,
     }
+}
+
+/// Latitude and longitude (degrees, about the z axis) of the direction of `p`.
+fn lat_lon_deg(p: DVec3) -> (f64, f64) {
+    let q = p.normalize();
+    (q.z.asin().to_degrees(), q.y.atan2(q.x).to_degrees())
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -117,26 +116,11 @@ fn peer_comparison() {
             println!("| {case} | missing mesh |");
             continue;
         }
-        let mesh = load_obj(&path);
-        let p = mesh.position(src).normalize();
-        let g: Vec<f64> = mesh
-            .positions()
-            .iter()
-            .map(|v| v.normalize().dot(p).clamp(-1.0, 1.0).acos())
-            .collect();
+        let mesh = testsupport::read_mesh(&path);
+        let g = sphere_geodesic(&mesh, mesh.position(src), 1.0);
         let out = dir.join(std::env::var("GEODESIC_PEERS_OUT").unwrap_or_else(|_| "out".into()));
         let exact = load_txt(&out.join(format!("{name}_s{src}_exact_gdist.txt")));
-        let vs_exact = |d: &[f64]| {
-            exact
-                .as_ref()
-                .map(|x| {
-                    d.iter()
-                        .zip(x)
-                        .map(|(a, b)| (a - b).abs())
-                        .fold(0.0, f64::max)
-                })
-                .unwrap_or(f64::NAN)
-        };
+        let vs_exact = |d: &[f64]| exact.as_ref().map_or(f64::NAN, |x| max_abs_diff(d, x));
         for peer in ["fmm_pp3d", "heat_igl"] {
             if let Some(d) = load_txt(&out.join(format!("{name}_s{src}_{peer}.txt"))) {
                 let e = errors(&d, &g);
@@ -155,24 +139,7 @@ fn peer_comparison() {
             let mut d = Vec::new();
             for _ in 0..repeat {
                 let t0 = Instant::now();
-                let solver: Box<dyn GeodesicSolver> = match m {
-                    "fmm" => Box::new(FastMarching::new(&mesh).unwrap()),
-                    "fmm_point" => {
-                        Box::new(FastMarching::with_update(&mesh, FmmUpdate::PointSource).unwrap())
-                    }
-                    "fmm_plane" => {
-                        Box::new(FastMarching::with_update(&mesh, FmmUpdate::PlaneWave).unwrap())
-                    }
-                    "fmm_blend" => {
-                        Box::new(FastMarching::with_update(&mesh, FmmUpdate::Blend).unwrap())
-                    }
-                    "fmm_curved" => {
-                        Box::new(FastMarching::with_update(&mesh, FmmUpdate::CurvedFront).unwrap())
-                    }
-                    "heat" => Box::new(HeatMethod::new(&mesh).unwrap()),
-                    "dijkstra" => Box::new(Dijkstra::new(&mesh).unwrap()),
-                    other => panic!("unknown method {other}"),
-                };
+                let solver = solver(&mesh, m);
                 let t1 = Instant::now();
                 d = solver
                     .distances(&[Source::Vertex(src)], &SolveOptions::default())
@@ -210,11 +177,9 @@ fn peer_comparison() {
                 let mut idx: Vec<usize> = (0..d.len()).collect();
                 idx.sort_by(|&i, &j| (d[j] - g[j]).abs().total_cmp(&(d[i] - g[i]).abs()));
                 for &i in idx.iter().take(8) {
-                    let q = mesh.position(i as u32).normalize();
+                    let (lat, lon) = lat_lon_deg(mesh.position(i as u32));
                     println!(
-                        "  v{i}: lat {:+.1} lon {:+.1} dist {:.4} err {:+.2e} vs exact {:+.2e}",
-                        q.z.asin().to_degrees(),
-                        q.y.atan2(q.x).to_degrees(),
+                        "  v{i}: lat {lat:+.1} lon {lon:+.1} dist {:.4} err {:+.2e} vs exact {:+.2e}",
                         g[i],
                         d[i] - g[i],
                         exact.as_ref().map(|x| d[i] - x[i]).unwrap_or(f64::NAN)
@@ -240,20 +205,13 @@ fn peer_comparison() {
 #[ignore = "slow: needs the paper-set faces and a release build"]
 fn face_comparison_against_exact() {
     faer::set_global_parallelism(faer::Par::Seq);
-    let shared = std::env::var("BIPOLAR_SHARED")
-        .map(PathBuf::from)
-        .unwrap_or_else(|_| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"));
-    let dir = shared.join("faces/ict-facekit/paper-set");
-    if !dir.is_dir() {
-        println!("skipping: no paper-set faces in {}", dir.display());
-        return;
-    }
+    let dir = testsupport::require_shared!(testsupport::PAPER_SET);
     println!(
         "| face | method | setup | solve | MAE vs exact | max vs exact | max rel (d > 1 cm) |"
     );
     println!("|---|---|---:|---:|---:|---:|---:|");
     for face in ["id1_neutral", "id2_neutral"] {
-        let mesh = load_obj(&dir.join(format!("{face}.obj")));
+        let mesh = testsupport::read_mesh(dir.join(format!("{face}.obj")));
         let src = [Source::Vertex(3721)];
         let exact = geodesic::ExactGeodesic::new(&mesh)
             .unwrap()
@@ -261,17 +219,7 @@ fn face_comparison_against_exact() {
             .unwrap();
         for m in ["fmm", "fmm_point", "fmm_blend", "heat", "dijkstra"] {
             let t0 = Instant::now();
-            let solver: Box<dyn GeodesicSolver> = match m {
-                "fmm" => Box::new(FastMarching::new(&mesh).unwrap()),
-                "fmm_point" => {
-                    Box::new(FastMarching::with_update(&mesh, FmmUpdate::PointSource).unwrap())
-                }
-                "fmm_blend" => {
-                    Box::new(FastMarching::with_update(&mesh, FmmUpdate::Blend).unwrap())
-                }
-                "heat" => Box::new(HeatMethod::new(&mesh).unwrap()),
-                _ => Box::new(Dijkstra::new(&mesh).unwrap()),
-            };
+            let solver = solver(&mesh, m);
             let t1 = Instant::now();
             let d = solver.distances(&src, &SolveOptions::default()).unwrap();
             let t2 = Instant::now();
@@ -280,22 +228,14 @@ fn face_comparison_against_exact() {
             if n_inf + n_inf_exact > 0 {
                 println!("{m}: {n_inf} non-finite values (exact: {n_inf_exact})");
             }
-            let (mut s, mut mx, mut rel) = (0.0, 0.0f64, 0.0f64);
-            for (a, b) in d.iter().zip(&exact) {
-                let e = (a - b).abs();
-                s += e;
-                mx = mx.max(e);
-                if *b > 1.0 {
-                    rel = rel.max(e / b);
-                }
-            }
+
             println!(
                 "| {face} | {m} | {} | {} | {:.2e} | {:.2e} | {:.2e} |",
                 fmt_t((t1 - t0).as_secs_f64()),
                 fmt_t((t2 - t1).as_secs_f64()),
-                s / d.len() as f64,
-                mx,
-                rel
+                mean_abs_diff(&d, &exact),
+                max_abs_diff(&d, &exact),
+                max_rel_err(&d, &exact, 1.0)
             );
         }
     }

@@ -2,17 +2,24 @@
 //! cylinder, sphere bracket), metric properties, invariances, sources inside faces and on
 //! edges, several components, cut-off, degenerate input and path tracing.
 
-mod exact_util;
+mod common;
 
-use exact_util::{grid, icosphere};
 use geodesic::{
     ExactGeodesic, GeodesicError, GeodesicSolver, SolveOptions, Source, SurfacePoint, TriMesh,
 };
 use glam::{DAffine3, DQuat, DVec3};
 use proptest::prelude::*;
+use testsupport::fields::assert_close;
+use testsupport::shapes::{icosphere, Diagonals};
 
 fn solve(s: &ExactGeodesic, src: &[Source]) -> Vec<f64> {
     s.distances(src, &SolveOptions::default()).unwrap()
+}
+
+/// Positions and triangles of an `nx x ny` grid of cells of side `h` from the origin,
+/// alternating diagonals, interior vertices jittered by up to `jitter` cells (seeded).
+fn grid(nx: usize, ny: usize, h: f64, jitter: f64, seed: u64) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+    testsupport::jittered_grid(nx, ny, h, Diagonals::Alternating, jitter, seed).into_parts()
 }
 
 fn plane(nx: usize, jitter: f64, seed: u64) -> TriMesh {
@@ -391,12 +398,7 @@ fn orientation_flips_do_not_matter() {
     let s2 = ExactGeodesic::new(&m2).unwrap();
     assert!(s2.report().inconsistent_edges > 0);
     let d2 = solve(&s2, &[Source::Vertex(5)]);
-    for v in 0..d0.len() {
-        assert!(
-            (d0[v] - d2[v]).abs() <= 1e-12 * d0[v].max(1.0),
-            "vertex {v}"
-        );
-    }
+    assert_close(&d2, &d0, 1e-12, "some faces flipped");
 }
 
 #[test]
@@ -428,10 +430,10 @@ fn face_point_source_distances_and_multi_source_minimum() {
     let srcs = [Source::Point(sp), Source::Vertex(100), Source::Vertex(3)];
     let all = solve(&s, &srcs);
     let singles: Vec<Vec<f64>> = srcs.iter().map(|x| solve(&s, &[*x])).collect();
-    for u in 0..d.len() {
-        let mn = singles.iter().map(|f| f[u]).fold(f64::INFINITY, f64::min);
-        assert!((all[u] - mn).abs() <= 1e-12 * mn.max(1.0), "vertex {u}");
-    }
+    let min: Vec<f64> = (0..d.len())
+        .map(|u| singles.iter().map(|f| f[u]).fold(f64::INFINITY, f64::min))
+        .collect();
+    assert_close(&all, &min, 1e-12, "multi-source minimum");
     assert_eq!(all, solve(&s, &srcs));
     // Parallel batch = sequential calls, bit for bit.
     let sets: Vec<Vec<Source>> = srcs.iter().map(|x| vec![*x]).collect();
@@ -466,12 +468,7 @@ fn face_point_source_distances_and_multi_source_minimum() {
         solve(&s, &[Source::Point(sp1)]),
         solve(&s, &[Source::Point(sp2)]),
     );
-    for u in 0..da.len() {
-        assert!(
-            (da[u] - db[u]).abs() <= 1e-12 * da[u].max(1.0),
-            "vertex {u}"
-        );
-    }
+    assert_close(&db, &da, 1e-12, "edge point from the other face");
 }
 
 #[test]
@@ -558,17 +555,7 @@ fn bad_sources_and_options_are_errors() {
             Err(GeodesicError::Mesh(_))
         ));
     }
-    for c in [0.0, -1.0, f64::NAN] {
-        assert!(matches!(
-            s.distances(
-                &[Source::Vertex(0)],
-                &SolveOptions {
-                    max_distance: Some(c)
-                }
-            ),
-            Err(GeodesicError::InvalidCutoff(_))
-        ));
-    }
+    common::assert_rejects_bad_cutoffs(&s);
 }
 
 #[test]

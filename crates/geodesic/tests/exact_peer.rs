@@ -10,8 +10,6 @@
 //! that face (compare with libigl's `exact_geodesic` face sources); `0,17,40` are several
 //! sources at once.
 
-mod exact_util;
-
 use geodesic::{ExactGeodesic, GeodesicSolver, SolveOptions, Source};
 use std::time::Instant;
 
@@ -32,7 +30,7 @@ fn compare_with_peer() {
         .unwrap_or(1e-9);
     let mut worst = 0.0f64;
     for ((mesh, rf), src) in meshes.split(';').zip(refs.split(';')).zip(srcs.split(';')) {
-        let m = exact_util::read_obj(std::path::Path::new(mesh)).unwrap();
+        let m = testsupport::read_mesh(mesh);
         // "F<face>" means the centroid of that face (libigl's `FS` face source); several
         // sources are separated by commas.
         let src_str = src.trim().to_string();
@@ -83,7 +81,7 @@ fn compare_with_peer() {
         let (sw, sc) = med(&mut setup);
         let (vw, vc) = med(&mut solve);
         let floor = 1e-12 * m.bbox().diagonal();
-        let rel = exact_util::max_rel_diff(&d, &reference, floor);
+        let rel = testsupport::fields::max_rel_diff(&d, &reference, floor);
         let (mut imax, mut vmax) = (0, 0.0);
         for i in 0..d.len() {
             let r = (d[i] - reference[i]).abs() / reference[i].abs().max(floor);

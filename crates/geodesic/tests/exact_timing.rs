@@ -10,8 +10,6 @@
 //! so two builds can be compared bit for bit (`cmp`); `EXACT_TIMING_ONLY=prefix` runs only the
 //! cases whose name starts with `prefix` (for `perf record`).
 
-mod exact_util;
-
 use geodesic::{ExactGeodesic, GeodesicSolver, SolveOptions, Source, TriMesh};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -55,22 +53,17 @@ fn exact_timing() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(7);
-    let shared = std::env::var("BIPOLAR_SHARED")
-        .map(PathBuf::from)
-        .unwrap_or_else(|_| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"));
-    let face = shared.join("faces/ict-facekit/paper-set/id1_neutral.obj");
-    match exact_util::read_obj(&face) {
-        Ok(m) => {
-            time_case("face1507", &m, 1507, None, repeat);
-            time_case("face1507_cut11.8", &m, 1507, Some(11.8), repeat);
-            time_case("face3721_cut11.8", &m, 3721, Some(11.8), repeat);
-        }
-        Err(_) => println!("skipping the face: {} not found", face.display()),
+    // Without the shared data, paper_face prints why the face is skipped.
+    if let Some(face) = testsupport::paper_face("id1_neutral.obj") {
+        let m = testsupport::read_mesh(face);
+        time_case("face1507", &m, 1507, None, repeat);
+        time_case("face1507_cut11.8", &m, 1507, Some(11.8), repeat);
+        time_case("face3721_cut11.8", &m, 3721, Some(11.8), repeat);
     }
-    time_case("ico5", &meshcore::shapes::icosphere(5), 0, None, repeat);
+    time_case("ico5", &testsupport::shapes::icosphere(5), 0, None, repeat);
     time_case(
         "ico6",
-        &meshcore::shapes::icosphere(6),
+        &testsupport::shapes::icosphere(6),
         0,
         None,
         repeat.min(5),

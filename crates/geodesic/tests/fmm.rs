@@ -5,8 +5,9 @@
 
 use geodesic::{FastMarching, FmmUpdate, GeodesicSolver, SolveOptions, Source, TriMesh};
 use glam::DVec3;
-use meshcore::shapes::{icosphere, uv_sphere};
 use std::f64::consts::PI;
+use testsupport::fields::{max_abs_diff, mean_abs_diff, prism_geodesic, sphere_geodesic};
+use testsupport::shapes::{self, icosphere, uv_sphere, Diagonals};
 
 fn solve(mesh: &TriMesh, rule: FmmUpdate, src: &[Source]) -> Vec<f64> {
     FastMarching::with_update(mesh, rule)
@@ -15,21 +16,14 @@ fn solve(mesh: &TriMesh, rule: FmmUpdate, src: &[Source]) -> Vec<f64> {
         .unwrap()
 }
 
+/// Great-circle distance on the unit sphere from vertex `src`.
 fn great_circle(mesh: &TriMesh, src: u32) -> Vec<f64> {
-    let p = mesh.position(src).normalize();
-    mesh.positions()
-        .iter()
-        .map(|v| v.normalize().dot(p).clamp(-1.0, 1.0).acos())
-        .collect()
+    sphere_geodesic(mesh, mesh.position(src), 1.0)
 }
 
 /// (MAE, max error).
 fn errors(d: &[f64], g: &[f64]) -> (f64, f64) {
-    let e: Vec<f64> = d.iter().zip(g).map(|(a, b)| (a - b).abs()).collect();
-    (
-        e.iter().sum::<f64>() / e.len() as f64,
-        e.iter().copied().fold(0.0, f64::max),
-    )
+    (mean_abs_diff(d, g), max_abs_diff(d, g))
 }
 
 #[test]
@@ -81,27 +75,12 @@ fn icosphere_errors_far_below_the_plane_wave() {
 fn curved_front_is_exact_on_flat_meshes() {
     // On a plane (no Gaussian curvature) the carried curvature stays 1 / T and the rule is the
     // point-source one: exact from a vertex source.
-    let (nx, ny, sx, sy) = (14usize, 11usize, 0.1, 0.08);
-    let mut p = Vec::new();
-    for j in 0..=ny {
-        for i in 0..=nx {
-            p.push(DVec3::new(i as f64 * sx, j as f64 * sy, 0.0));
-        }
-    }
+    let (nx, sx, sy) = (14usize, 0.1, 0.08);
+    let m = shapes::grid(nx, 11, Diagonals::Alternating, |i, j| {
+        DVec3::new(i as f64 * sx, j as f64 * sy, 0.0)
+    })
+    .unwrap();
     let idx = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
-    let mut t = Vec::new();
-    for j in 0..ny {
-        for i in 0..nx {
-            if (i + j) % 2 == 0 {
-                t.push([idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)]);
-                t.push([idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)]);
-            } else {
-                t.push([idx(i, j), idx(i + 1, j), idx(i, j + 1)]);
-                t.push([idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1)]);
-            }
-        }
-    }
-    let m = TriMesh::new(p, t).unwrap();
     let src = idx(6, 5);
     let c = m.position(src);
     let d = solve(&m, FmmUpdate::CurvedFront, &[Source::Vertex(src)]);
@@ -117,19 +96,10 @@ fn cylinder_unrolled_is_nearly_exact() {
     // plane. The polygonal cylinder is shorter around than the round one; compare with the
     // unrolled polygon (chord length per segment).
     let (na, nh, r, h) = (64usize, 48usize, 1.0, 3.0);
-    let m = meshcore::shapes::cylinder(r, h, na, nh);
-    let chord = 2.0 * r * (PI / na as f64).sin();
+    let m = shapes::cylinder(r, h, na, nh);
     let d = solve(&m, FmmUpdate::CurvedFront, &[Source::Vertex(0)]);
-    let mut worst: f64 = 0.0;
-    for i in 0..na {
-        for j in 0..=nh {
-            // Unrolled position: min(i, na - i) chords around, z up.
-            let k = i.min(na - i) as f64;
-            let exact = ((k * chord).powi(2) + (h * j as f64 / nh as f64).powi(2)).sqrt();
-            // Vertex (i, j) of the generated cylinder is j * na + i.
-            worst = worst.max((d[j * na + i] - exact).abs());
-        }
-    }
+    // Unrolled position: min(i, na - i) chords around, z up.
+    let worst = max_abs_diff(&d, &prism_geodesic(&m, r, na, 0));
     assert!(worst < 1e-9, "max error {worst}");
 }
 
@@ -152,27 +122,11 @@ type Height = fn(f64, f64) -> f64;
 /// Height field `z = f(x, y)` on an `n` x `n` grid of the unit square, alternating diagonals.
 fn height_field(n: usize, f: impl Fn(f64, f64) -> f64) -> TriMesh {
     let h = 1.0 / n as f64;
-    let mut p = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            let (x, y) = (i as f64 * h, j as f64 * h);
-            p.push(DVec3::new(x, y, f(x, y)));
-        }
-    }
-    let idx = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-    let mut t = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            if (i + j) % 2 == 0 {
-                t.push([idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)]);
-                t.push([idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)]);
-            } else {
-                t.push([idx(i, j), idx(i + 1, j), idx(i, j + 1)]);
-                t.push([idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1)]);
-            }
-        }
-    }
-    TriMesh::new(p, t).unwrap()
+    shapes::grid(n, n, Diagonals::Alternating, |i, j| {
+        let (x, y) = (i as f64 * h, j as f64 * h);
+        DVec3::new(x, y, f(x, y))
+    })
+    .unwrap()
 }
 
 #[test]

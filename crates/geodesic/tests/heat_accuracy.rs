@@ -17,10 +17,11 @@ use faer::sparse::{SparseColMat, Triplet};
 use faer::Side;
 use geodesic::{GeodesicSolver, HeatMethod, SolveOptions, Source, SurfacePoint, TriMesh};
 use glam::DVec3;
-use meshcore::shapes::icosphere;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::collections::HashMap;
+use testsupport::fields::sphere_geodesic;
+use testsupport::shapes::{self, icosphere, Diagonals};
 
 /// Icosphere with every vertex moved tangentially by up to `amount` mean edge lengths
 /// (seeded) and re-projected onto the unit sphere.
@@ -44,32 +45,12 @@ fn jittered_icosphere(level: usize, amount: f64, seed: u64) -> TriMesh {
     TriMesh::new(p, m.triangles().to_vec()).unwrap()
 }
 
-/// Planar grid with alternating diagonals (has a boundary).
+/// Planar grid with alternating diagonals (has a boundary), slightly stretched and bent.
 fn grid(nx: usize, ny: usize, s: f64) -> TriMesh {
-    let mut p = Vec::new();
-    for j in 0..=ny {
-        for i in 0..=nx {
-            p.push(DVec3::new(
-                i as f64 * s,
-                j as f64 * s * 1.1,
-                0.02 * (i * j) as f64 * s,
-            ));
-        }
-    }
-    let idx = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
-    let mut t = Vec::new();
-    for j in 0..ny {
-        for i in 0..nx {
-            if (i + j) % 2 == 0 {
-                t.push([idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)]);
-                t.push([idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)]);
-            } else {
-                t.push([idx(i, j), idx(i + 1, j), idx(i, j + 1)]);
-                t.push([idx(i + 1, j), idx(i + 1, j + 1), idx(i, j + 1)]);
-            }
-        }
-    }
-    TriMesh::new(p, t).unwrap()
+    shapes::grid(nx, ny, Diagonals::Alternating, |i, j| {
+        DVec3::new(i as f64 * s, j as f64 * s * 1.1, 0.02 * (i * j) as f64 * s)
+    })
+    .unwrap()
 }
 
 /// Two disjoint meshes in one (the second shifted), plus an isolated vertex.
@@ -86,11 +67,26 @@ fn two_components() -> TriMesh {
 }
 
 fn sphere_distance(mesh: &TriMesh, src: u32) -> Vec<f64> {
-    let p = mesh.position(src).normalize();
-    mesh.positions()
+    sphere_geodesic(mesh, mesh.position(src), 1.0)
+}
+
+/// `trip` without the rows and columns of the `fixed` vertices, which get a unit diagonal (a
+/// Dirichlet condition).
+fn fix_vertices(
+    trip: &[Triplet<usize, usize, f64>],
+    fixed: &[bool],
+) -> Vec<Triplet<usize, usize, f64>> {
+    let mut out: Vec<_> = trip
         .iter()
-        .map(|v| v.normalize().dot(p).clamp(-1.0, 1.0).acos())
-        .collect()
+        .filter(|e| !fixed[e.row] && !fixed[e.col])
+        .copied()
+        .collect();
+    out.extend(
+        (0..fixed.len())
+            .filter(|&v| fixed[v])
+            .map(|v| Triplet::new(v, v, 1.0)),
+    );
+    out
 }
 
 /// The heat method as formulated before the per-solve optimisation (the code this test pins
@@ -182,16 +178,11 @@ fn reference_heat(mesh: &TriMesh, sources: &[Source]) -> Vec<f64> {
         .iter()
         .map(|e| Triplet::new(e.row, e.col, t * e.val))
         .collect();
-    let mut pois_trip: Vec<_> = lap
-        .iter()
-        .filter(|e| !is_pin[e.row] && !is_pin[e.col])
-        .copied()
-        .collect();
+    // Untouched vertices have no Laplacian entries: fixing them only adds their unit diagonal.
+    let fixed: Vec<bool> = (0..n).map(|v| is_pin[v] || !touched[v]).collect();
+    let pois_trip = fix_vertices(&lap, &fixed);
     for v in 0..n {
         heat_trip.push(Triplet::new(v, v, if touched[v] { mass[v] } else { 1.0 }));
-        if is_pin[v] || !touched[v] {
-            pois_trip.push(Triplet::new(v, v, 1.0));
-        }
     }
     // Source weights.
     let mut u = vec![0.0f64; n];
@@ -214,16 +205,7 @@ fn reference_heat(mesh: &TriMesh, sources: &[Source]) -> Vec<f64> {
     let u0 = u.clone();
     factor(&heat_trip).solve_in_place(faer::MatMut::from_column_major_slice_mut(&mut u, n, 1));
     if is_boundary.iter().any(|&b| b) {
-        let mut trip: Vec<_> = heat_trip
-            .iter()
-            .filter(|e| !is_boundary[e.row] && !is_boundary[e.col])
-            .copied()
-            .collect();
-        for v in 0..n {
-            if is_boundary[v] {
-                trip.push(Triplet::new(v, v, 1.0));
-            }
-        }
+        let trip = fix_vertices(&heat_trip, &is_boundary);
         let mut ud: Vec<f64> = u0
             .iter()
             .zip(&is_boundary)

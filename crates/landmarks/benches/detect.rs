@@ -1,7 +1,7 @@
 //! Landmark detection on a paper-set face (6,706 vertices, cm, default generic model) and the
-//! curvature stage alone (on that face and on a UV sphere). The face is read from
-//! `$BIPOLAR_SHARED` (default `../shared` relative to the workspace root); without it only the
-//! sphere is measured. Run with `cargo bench -p landmarks`.
+//! curvature stage alone (on that face and on a UV sphere). The face comes from the shared data
+//! folder (found by `testsupport`); without it only the sphere is measured. Run with
+//! `cargo bench -p landmarks`.
 
 // criterion_group! generates an undocumented function.
 #![allow(missing_docs)]
@@ -10,17 +10,10 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use landmarks::{curvature::vertex_curvatures, CurvatureOptions, GenericModel};
 use meshcore::{DVec3, TriMesh};
 use std::hint::black_box;
-use std::path::PathBuf;
-
-fn shared_dir() -> PathBuf {
-    std::env::var_os("BIPOLAR_SHARED")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"))
-}
 
 /// A UV sphere of radius 5 (model units, about a face's size) with `n` latitude bands.
 fn uv_sphere(n: usize) -> TriMesh {
-    meshcore::shapes::uv_sphere(n, 2 * n)
+    testsupport::shapes::uv_sphere(n, 2 * n)
         .transformed(&meshcore::DAffine3::from_scale(DVec3::splat(5.0)))
 }
 
@@ -29,10 +22,9 @@ fn bench(c: &mut Criterion) {
     let copt = CurvatureOptions::with_radius(model.params.curvature_radius);
     let mut g = c.benchmark_group("landmarks");
     g.sample_size(20);
-    let path = shared_dir().join("faces/ict-facekit/paper-set/id1_happiness.obj");
-    match mesh_io::read_mesh(&path) {
-        Ok(loaded) => {
-            let face = loaded.mesh;
+    match testsupport::paper_face("id1_happiness.obj") {
+        Some(path) => {
+            let face = testsupport::read_mesh(path);
             g.bench_function("detect/face-6706", |b| {
                 b.iter(|| black_box(landmarks::detect(black_box(&face), &model).is_ok()))
             });
@@ -49,9 +41,9 @@ fn bench(c: &mut Criterion) {
                 b.iter(|| black_box(vertex_curvatures(black_box(&face), &copt).len()))
             });
         }
-        Err(e) => eprintln!(
-            "paper-set face not available ({e}); benchmarking the curvature of a sphere only"
-        ),
+        None => {
+            eprintln!("paper-set face not available; benchmarking the curvature of a sphere only")
+        }
     }
     let sphere = uv_sphere(58);
     g.bench_function(format!("curvature/sphere-{}", sphere.n_vertices()), |b| {

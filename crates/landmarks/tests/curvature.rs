@@ -2,54 +2,26 @@
 
 use landmarks::curvature::{taubin_smooth, vertex_curvatures, CurvatureOptions};
 use landmarks::{curvedness, shape_index};
-use meshcore::{DVec3, TriMesh};
+use meshcore::{DAffine3, DVec3, TriMesh};
+use testsupport::shapes;
 
 /// UV sphere of radius `r` (the shared generator, scaled).
 fn sphere(r: f64, n_lat: usize, n_lon: usize) -> TriMesh {
-    meshcore::shapes::uv_sphere(n_lat, n_lon)
-        .transformed(&meshcore::DAffine3::from_scale(DVec3::splat(r)))
+    shapes::uv_sphere(n_lat, n_lon).transformed(&DAffine3::from_scale(DVec3::splat(r)))
 }
 
-/// Open cylinder of radius `r` around z, outward normals.
+/// Open cylinder of radius `r` around z from `z = -len / 2` to `len / 2`, outward normals.
 fn cylinder(r: f64, len: f64, n_a: usize, n_z: usize) -> TriMesh {
-    let mut p = Vec::new();
-    for i in 0..=n_z {
-        let z = len * (i as f64 / n_z as f64 - 0.5);
-        for j in 0..n_a {
-            let a = std::f64::consts::TAU * j as f64 / n_a as f64;
-            p.push(DVec3::new(r * a.cos(), r * a.sin(), z));
-        }
-    }
-    let idx = |i: usize, j: usize| (i * n_a + j % n_a) as u32;
-    let mut t = Vec::new();
-    for i in 0..n_z {
-        for j in 0..n_a {
-            t.push([idx(i, j), idx(i, j + 1), idx(i + 1, j + 1)]);
-            t.push([idx(i, j), idx(i + 1, j + 1), idx(i + 1, j)]);
-        }
-    }
-    TriMesh::new(p, t).unwrap()
+    shapes::cylinder(r, len, n_a, n_z).transformed(&DAffine3::from_translation(DVec3::new(
+        0.0,
+        0.0,
+        -0.5 * len,
+    )))
 }
 
 /// Height field `z = f(x, y)` on a jittered-free grid over `[-1, 1]^2`, normals up.
 fn height_field(n: usize, f: impl Fn(f64, f64) -> f64) -> TriMesh {
-    let mut p = Vec::new();
-    for i in 0..=n {
-        for j in 0..=n {
-            let x = -1.0 + 2.0 * j as f64 / n as f64;
-            let y = -1.0 + 2.0 * i as f64 / n as f64;
-            p.push(DVec3::new(x, y, f(x, y)));
-        }
-    }
-    let idx = |i: usize, j: usize| (i * (n + 1) + j) as u32;
-    let mut t = Vec::new();
-    for i in 0..n {
-        for j in 0..n {
-            t.push([idx(i, j), idx(i, j + 1), idx(i + 1, j + 1)]);
-            t.push([idx(i, j), idx(i + 1, j + 1), idx(i + 1, j)]);
-        }
-    }
-    TriMesh::new(p, t).unwrap()
+    testsupport::height_field(n, 1.0, f)
 }
 
 fn flipped(m: &TriMesh) -> TriMesh {

@@ -7,47 +7,13 @@ use landmarks::{
 };
 use meshcore::{DAffine3, DQuat, DVec3, TriMesh};
 use std::path::PathBuf;
+use testsupport::read_mesh;
 
-fn shared() -> PathBuf {
-    std::env::var_os("BIPOLAR_SHARED")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"))
-}
-
+/// The paper-set folder, when it holds the ICT landmarks (else `None` after the skip line of
+/// `testsupport`).
 fn paper_set() -> Option<PathBuf> {
-    let d = shared().join("faces/ict-facekit/paper-set");
-    if d.join("landmarks.json").is_file() {
-        Some(d)
-    } else {
-        eprintln!("skipped: shared face data not found at {}", d.display());
-        None
-    }
-}
-
-/// Minimal OBJ reader (v / f lines) for the tests.
-fn read_obj(path: &std::path::Path) -> TriMesh {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut v = Vec::new();
-    let mut f = Vec::new();
-    for line in text.lines() {
-        let mut it = line.split_whitespace();
-        match it.next() {
-            Some("v") => {
-                let c: Vec<f64> = it.take(3).map(|s| s.parse().unwrap()).collect();
-                v.push(DVec3::new(c[0], c[1], c[2]));
-            }
-            Some("f") => {
-                let i: Vec<u32> = it
-                    .map(|s| s.split('/').next().unwrap().parse::<u32>().unwrap() - 1)
-                    .collect();
-                for k in 1..i.len() - 1 {
-                    f.push([i[0], i[k], i[k + 1]]);
-                }
-            }
-            _ => {}
-        }
-    }
-    TriMesh::new(v, f).unwrap()
+    let json = testsupport::paper_face("landmarks.json")?;
+    json.parent().map(PathBuf::from)
 }
 
 fn flipped(m: &TriMesh) -> TriMesh {
@@ -96,7 +62,7 @@ fn detections_follow_rigid_motions_and_match_the_truth() {
     let truth = ict_truth(&dir);
     let model = GenericModel::default_model().unwrap();
     for name in ["id2_neutral", "id1_happiness"] {
-        let mesh = read_obj(&dir.join(format!("{name}.obj")));
+        let mesh = read_mesh(&dir.join(format!("{name}.obj")));
         let gt = truth[name];
         let base = detect(&mesh, &model).unwrap();
         for (k, t) in motions().iter().enumerate() {
@@ -124,7 +90,7 @@ fn small_evaluation_on_the_paper_set() {
     let train: Vec<(TriMesh, [DVec3; 5])> = (2..=6)
         .map(|i| {
             let n = format!("id{i}_neutral");
-            (read_obj(&dir.join(format!("{n}.obj"))), truth[&n])
+            (read_mesh(&dir.join(format!("{n}.obj"))), truth[&n])
         })
         .collect();
     let model = GenericModel::train(&train).unwrap();
@@ -133,7 +99,7 @@ fn small_evaluation_on_the_paper_set() {
         .iter()
         .enumerate()
     {
-        let mesh = read_obj(&dir.join(format!("{name}.obj")));
+        let mesh = read_mesh(&dir.join(format!("{name}.obj")));
         let t = motions()[k];
         let lm = detect(&mesh.transformed(&t), &model).unwrap();
         for n in LandmarkName::ALL {
@@ -157,7 +123,7 @@ fn small_evaluation_on_the_paper_set() {
 fn face_seen_from_behind_is_not_found() {
     let Some(dir) = paper_set() else { return };
     let model = GenericModel::default_model().unwrap();
-    let mesh = flipped(&read_obj(&dir.join("id3_neutral.obj")));
+    let mesh = flipped(&read_mesh(&dir.join("id3_neutral.obj")));
     for t in motions() {
         match detect(&mesh.transformed(&t), &model) {
             Err(LandmarkError::NotFound { best_score, .. }) => assert!(best_score < 0.3),
@@ -168,7 +134,7 @@ fn face_seen_from_behind_is_not_found() {
 
 /// UV sphere of radius `r` (the shared generator, scaled).
 fn sphere(r: f64, n_lat: usize, n_lon: usize) -> TriMesh {
-    meshcore::shapes::uv_sphere(n_lat, n_lon)
+    testsupport::shapes::uv_sphere(n_lat, n_lon)
         .transformed(&meshcore::DAffine3::from_scale(DVec3::splat(r)))
 }
 
@@ -179,23 +145,7 @@ fn bumpy(n: usize) -> TriMesh {
             - 1.5 * (-((x + 3.0).powi(2) + (y - 3.0).powi(2))).exp()
             + 1.0 * (-((x - 3.0).powi(2) + (y + 3.0).powi(2)) / 0.5).exp()
     };
-    let mut p = Vec::new();
-    for i in 0..=n {
-        for j in 0..=n {
-            let x = -8.0 + 16.0 * j as f64 / n as f64;
-            let y = -8.0 + 16.0 * i as f64 / n as f64;
-            p.push(DVec3::new(x, y, f(x, y)));
-        }
-    }
-    let idx = |i: usize, j: usize| (i * (n + 1) + j) as u32;
-    let mut t = Vec::new();
-    for i in 0..n {
-        for j in 0..n {
-            t.push([idx(i, j), idx(i, j + 1), idx(i + 1, j + 1)]);
-            t.push([idx(i, j), idx(i + 1, j + 1), idx(i + 1, j)]);
-        }
-    }
-    TriMesh::new(p, t).unwrap()
+    testsupport::height_field(n, 8.0, f)
 }
 
 #[test]
@@ -221,7 +171,7 @@ fn non_faces_are_not_found() {
 fn units_are_recognised_from_the_face_size() {
     let Some(dir) = paper_set() else { return };
     let model = GenericModel::default_model().unwrap();
-    let mesh = read_obj(&dir.join("id2_neutral.obj"));
+    let mesh = read_mesh(&dir.join("id2_neutral.obj"));
     let cm = detect(&mesh, &model).unwrap();
     for (units, f) in [("mm", 10.0), ("m", 0.01)] {
         let scaled = mesh.transformed(&DAffine3::from_scale(DVec3::splat(f)));
@@ -266,7 +216,7 @@ fn part(m: &TriMesh, keep: impl Fn(DVec3) -> bool) -> TriMesh {
 fn each_verification_rejects_with_its_reason() {
     let Some(dir) = paper_set() else { return };
     let model = GenericModel::default_model().unwrap();
-    let mesh = read_obj(&dir.join("id2_neutral.obj"));
+    let mesh = read_mesh(&dir.join("id2_neutral.obj"));
     let defaults = DetectOptions::default();
     let lm = detect(&mesh, &model).unwrap();
     // A correct detection on a neutral face is mirror-symmetric and agrees with every template.
@@ -315,7 +265,7 @@ fn partial_faces_are_found_right_or_not_at_all() {
     let Some(dir) = paper_set() else { return };
     let truth = ict_truth(&dir);
     let model = GenericModel::default_model().unwrap();
-    let mesh = read_obj(&dir.join("id4_neutral.obj"));
+    let mesh = read_mesh(&dir.join("id4_neutral.obj"));
     let gt = truth["id4_neutral"];
     // Below the eyes (mouth, chin and nose only): there are no eye corners to find.
     let lower = part(&mesh, |p| p.y < 1.5);
@@ -377,7 +327,7 @@ fn regression_places_the_eye_corners_on_the_paper_set() {
     let mut names: Vec<&String> = truth.keys().collect();
     names.sort();
     for name in names {
-        let mesh = read_obj(&dir.join(format!("{name}.obj")));
+        let mesh = read_mesh(&dir.join(format!("{name}.obj")));
         let gt = truth[name.as_str()];
         let a = detect(&mesh, &model).unwrap();
         let b = detect_with(&mesh, &model, &plain).unwrap();

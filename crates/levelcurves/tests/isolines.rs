@@ -2,71 +2,10 @@
 
 use glam::DVec3;
 use levelcurves::{isolines, isolines_uniform, uniform_level_range, uniform_levels, Isoline};
-use meshcore::shapes::icosphere;
+use meshcore::shapes::{grid_plane, icosphere};
 use meshcore::{Topology, TriMesh};
 use proptest::prelude::*;
 use std::collections::HashSet;
-
-/// Grid of `n x n` cells on `[x0, x0 + n h]^2` (z = 0), vertices jittered by `jitter * h` with a
-/// deterministic pseudo-random sequence; faces whose centroid satisfies `drop` are removed.
-fn grid(
-    n: usize,
-    h: f64,
-    x0: f64,
-    jitter: f64,
-    seed: u64,
-    drop: impl Fn(DVec3) -> bool,
-) -> TriMesh {
-    let mut s = seed
-        .wrapping_mul(6364136223846793005)
-        .wrapping_add(1442695040888963407);
-    let mut rnd = move || {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((s >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-    };
-    let mut pos = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            let interior = i > 0 && j > 0 && i < n && j < n;
-            let (dx, dy) = if interior {
-                (rnd() * jitter * h, rnd() * jitter * h)
-            } else {
-                (0.0, 0.0)
-            };
-            pos.push(DVec3::new(
-                x0 + i as f64 * h + dx,
-                x0 + j as f64 * h + dy,
-                0.0,
-            ));
-        }
-    }
-    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-    let mut tris = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            let cand = if (i + j) % 2 == 0 {
-                [
-                    [id(i, j), id(i + 1, j), id(i + 1, j + 1)],
-                    [id(i, j), id(i + 1, j + 1), id(i, j + 1)],
-                ]
-            } else {
-                [
-                    [id(i, j), id(i + 1, j), id(i, j + 1)],
-                    [id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)],
-                ]
-            };
-            for t in cand {
-                let c = (pos[t[0] as usize] + pos[t[1] as usize] + pos[t[2] as usize]) / 3.0;
-                if !drop(c) {
-                    tris.push(t);
-                }
-            }
-        }
-    }
-    TriMesh::new(pos, tris).unwrap()
-}
 
 fn field(mesh: &TriMesh, f: impl Fn(DVec3) -> f64) -> Vec<f64> {
     mesh.positions().iter().map(|&p| f(p)).collect()
@@ -155,7 +94,7 @@ fn signed_area_xy(p: &[DVec3]) -> f64 {
 
 #[test]
 fn plane_circles_are_closed_ccw_loops() {
-    let mesh = grid(40, 0.05, -1.0, 0.3, 7, |_| false);
+    let mesh = grid_plane(40, 0.05, -1.0, 0.3, 7, |_| false);
     let topo = Topology::new(&mesh);
     let c0 = DVec3::new(0.03, -0.02, 0.0);
     let u = field(&mesh, |p| (p - c0).length());
@@ -186,7 +125,7 @@ fn plane_circles_are_closed_ccw_loops() {
 
 #[test]
 fn plane_arc_ends_on_border() {
-    let mesh = grid(20, 0.1, -1.0, 0.25, 3, |_| false);
+    let mesh = grid_plane(20, 0.1, -1.0, 0.25, 3, |_| false);
     let topo = Topology::new(&mesh);
     let corner = DVec3::new(-1.0, -1.0, 0.0);
     let u = field(&mesh, |p| (p - corner).length());
@@ -232,7 +171,7 @@ fn sphere_levels_are_single_closed_loops() {
 
 #[test]
 fn hole_splits_isolines_without_bridging() {
-    let mesh = grid(30, 2.0 / 30.0, -1.0, 0.2, 11, |c| c.length() < 0.35);
+    let mesh = grid_plane(30, 2.0 / 30.0, -1.0, 0.2, 11, |c| c.length() < 0.35);
     let topo = Topology::new(&mesh);
     assert_eq!(topo.boundary_loops().len(), 2);
     // Linear field: the isoline is exact, x = c.
@@ -262,7 +201,7 @@ fn hole_splits_isolines_without_bridging() {
 #[test]
 fn exact_level_vertices_give_clean_curves() {
     // Integer grid, integer field values, integer levels: many vertices exactly on the level.
-    let mesh = grid(10, 1.0, 0.0, 0.0, 0, |_| false);
+    let mesh = grid_plane(10, 1.0, 0.0, 0.0, 0, |_| false);
     let topo = Topology::new(&mesh);
     let u = field(&mesh, |p| (p.x + p.y).round());
     let levels: Vec<f64> = (0..=20).map(|i| i as f64).collect();
@@ -292,7 +231,7 @@ fn exact_level_vertices_give_clean_curves() {
 
 #[test]
 fn non_finite_values_are_skipped_like_holes() {
-    let mesh = grid(20, 0.1, -1.0, 0.0, 0, |_| false);
+    let mesh = grid_plane(20, 0.1, -1.0, 0.0, 0, |_| false);
     let topo = Topology::new(&mesh);
     let mut u = field(&mesh, |p| p.x);
     // Unreachable band along y in [-0.05, 0.05].
@@ -315,7 +254,7 @@ fn non_finite_values_are_skipped_like_holes() {
 
 #[test]
 fn errors_are_reported() {
-    let mesh = grid(2, 1.0, 0.0, 0.0, 0, |_| false);
+    let mesh = grid_plane(2, 1.0, 0.0, 0.0, 0, |_| false);
     let topo = Topology::new(&mesh);
     assert!(matches!(
         isolines(&mesh, &topo, &[0.0; 3], &[0.5]),
@@ -330,7 +269,7 @@ fn errors_are_reported() {
         Err(levelcurves::LevelCurveError::NonFiniteLevel { index: 1, .. })
     ));
     assert!(isolines_uniform(&mesh, &topo, &u, 0.0, 3).is_err());
-    let other = grid(3, 1.0, 0.0, 0.0, 0, |_| false);
+    let other = grid_plane(3, 1.0, 0.0, 0.0, 0, |_| false);
     assert!(isolines(&other, &topo, &[0.0; 16], &[0.5]).is_err());
 }
 
@@ -351,7 +290,7 @@ proptest! {
         a in -1.0f64..1.0, b in -1.0f64..1.0, q in 0.0f64..2.0,
         quant in prop::bool::ANY,
     ) {
-        let mesh = grid(12, 1.0 / 12.0, 0.0, 0.4, seed, |c| (c - DVec3::new(0.5, 0.5, 0.0)).length() < 0.15);
+        let mesh = grid_plane(12, 1.0 / 12.0, 0.0, 0.4, seed, |c| (c - DVec3::new(0.5, 0.5, 0.0)).length() < 0.15);
         let topo = Topology::new(&mesh);
         let u = field(&mesh, |p| {
             let v = a * p.x + b * p.y + q * (p.x * p.x - p.y * p.y + p.x * p.y);

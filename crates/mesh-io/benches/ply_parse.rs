@@ -4,6 +4,7 @@
 //! load time of the 12 ICT paper-set OBJ faces (skipped if the shared data is absent).
 
 use criterion::{black_box, Criterion};
+use meshcore::shapes::Diagonals;
 use meshcore::{DVec3, TriMesh};
 use rand::{Rng, SeedableRng};
 use std::path::{Path, PathBuf};
@@ -13,26 +14,15 @@ use std::time::Duration;
 fn big_mesh() -> TriMesh {
     let n = 709usize;
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
-    let pos = (0..n * n)
-        .map(|i| {
-            let (r, c) = ((i / n) as f64, (i % n) as f64);
-            DVec3::new(
-                c,
-                r,
-                0.1 * (0.05 * r).sin() * (0.03 * c).cos() + 1e-3 * rng.random::<f64>(),
-            )
-        })
-        .collect();
-    let mut tris = Vec::with_capacity(2 * (n - 1) * (n - 1));
-    for r in 0..n - 1 {
-        for c in 0..n - 1 {
-            let a = (r * n + c) as u32;
-            let (b, d, e) = (a + 1, a + n as u32, a + n as u32 + 1);
-            tris.push([a, b, e]);
-            tris.push([a, e, d]);
-        }
-    }
-    TriMesh::new(pos, tris).expect("valid grid")
+    testsupport::shapes::grid(n - 1, n - 1, Diagonals::Uniform, |c, r| {
+        let (r, c) = (r as f64, c as f64);
+        DVec3::new(
+            c,
+            r,
+            0.1 * (0.05 * r).sin() * (0.03 * c).cos() + 1e-3 * rng.random::<f64>(),
+        )
+    })
+    .expect("valid grid")
 }
 
 fn peer(path: &Path) {
@@ -71,10 +61,7 @@ for process in (False, True):
 }
 
 fn paper_set() -> Option<Vec<PathBuf>> {
-    let shared = std::env::var_os("BIPOLAR_SHARED")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"));
-    let dir = shared.join("faces/ict-facekit/paper-set");
+    let dir = testsupport::shared_path(testsupport::PAPER_SET)?;
     let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
         .ok()?
         .filter_map(|e| e.ok().map(|e| e.path()))

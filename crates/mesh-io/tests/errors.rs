@@ -16,30 +16,72 @@ fn at(e: &IoError) -> Option<Location> {
     }
 }
 
+/// Each case: the format, bad input, where the error must point (`None`: not checked) and what
+/// its message must contain (`""`: nothing in particular). A failure names the input.
+fn check(cases: &[(Format, &[u8], Option<Location>, &str)]) {
+    for &(f, bytes, loc, msg) in cases {
+        let e = err(bytes, f);
+        let input = String::from_utf8_lossy(bytes);
+        if loc.is_some() {
+            assert_eq!(at(&e), loc, "{input:?}: {e}");
+        }
+        assert!(e.to_string().contains(msg), "{input:?}: {e}");
+    }
+}
+
 #[test]
-fn obj_errors_name_the_line() {
-    let e = err(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", Format::Obj);
-    assert_eq!(at(&e), Some(Location::Line(4)), "{e}");
-    assert!(
-        e.to_string()
-            .contains("<memory>: line 4: face refers to vertex 4"),
-        "{e}"
-    );
-    let e = err(b"v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n", Format::Obj);
-    assert_eq!(at(&e), Some(Location::Line(2)), "{e}");
-    assert!(e.to_string().contains("not finite"), "{e}");
-    let e = err(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n", Format::Obj);
-    assert!(e.to_string().contains("line 4: face has 2 corner"), "{e}");
-    let e = err(b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 x 3\n", Format::Obj);
-    assert_eq!(at(&e), Some(Location::Line(4)));
-    let e = err(b"v 0 0 0\nv 1 0\n", Format::Obj);
-    assert_eq!(at(&e), Some(Location::Line(2)));
-    let e = err(b"v 0 0 0\nv 1 0 0\n", Format::Obj);
-    assert!(e.to_string().contains("no faces"), "{e}");
-    let e = err(b"", Format::Obj);
-    assert!(e.to_string().contains("no faces"), "{e}");
-    let e = err(b"v 0 0 0\nf -2 1 1\n", Format::Obj);
-    assert_eq!(at(&e), Some(Location::Line(2)));
+fn obj_and_off_errors_name_the_line() {
+    use Format::{Obj, Off};
+    use Location::Line;
+    check(&[
+        (
+            Obj,
+            b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n",
+            Some(Line(4)),
+            "<memory>: line 4: face refers to vertex 4",
+        ),
+        (
+            Obj,
+            b"v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n",
+            Some(Line(2)),
+            "not finite",
+        ),
+        (
+            Obj,
+            b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n",
+            None,
+            "line 4: face has 2 corner",
+        ),
+        (
+            Obj,
+            b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 x 3\n",
+            Some(Line(4)),
+            "",
+        ),
+        (Obj, b"v 0 0 0\nv 1 0\n", Some(Line(2)), ""),
+        (Obj, b"v 0 0 0\nv 1 0 0\n", None, "no faces"),
+        (Obj, b"", None, "no faces"),
+        (Obj, b"v 0 0 0\nf -2 1 1\n", Some(Line(2)), ""),
+        (
+            Off,
+            b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n",
+            Some(Line(6)),
+            "",
+        ),
+        (
+            Off,
+            b"OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+            None,
+            "line 2: file ends after 0 of 1 faces",
+        ),
+        (Off, b"OFF\n99999999 1 0\n0 0 0\n", Some(Line(2)), ""),
+        (
+            Off,
+            b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n1 2 3\n",
+            None,
+            "after the 3 vertices and 1 faces",
+        ),
+    ]);
 }
 
 fn ply_header(fmt: &str, nv: usize, nf: usize) -> String {
@@ -85,25 +127,29 @@ fn ply_errors() {
     let e = err(&binary_tri(3, 1, [0, -1, 2]), Format::Ply);
     assert!(e.to_string().contains("invalid vertex index -1"), "{e}");
     // ASCII: bad number on line 12, NaN, trailing data, counts too large.
-    let mut a = ply_header("ascii", 3, 1);
-    a.push_str("0 0 0\n1 0 0\n0 x 0\n3 0 1 2\n");
-    let e = err(a.as_bytes(), Format::Ply);
-    assert_eq!(at(&e), Some(Location::Line(12)), "{e}");
-    let mut a = ply_header("ascii", 3, 1);
-    a.push_str("0 0 0\n1 0 0\n0 inf 0\n3 0 1 2\n");
-    let e = err(a.as_bytes(), Format::Ply);
-    assert!(
-        e.to_string().contains("line 12: vertex 2 has a non-finite"),
-        "{e}"
+    let ascii = |nv: usize, body: &str| ply_header("ascii", nv, 1) + body;
+    let (bad, nan, trailing, huge) = (
+        ascii(3, "0 0 0\n1 0 0\n0 x 0\n3 0 1 2\n"),
+        ascii(3, "0 0 0\n1 0 0\n0 inf 0\n3 0 1 2\n"),
+        ascii(3, "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 2\n"),
+        ascii(1_000_000, "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"),
     );
-    let mut a = ply_header("ascii", 3, 1);
-    a.push_str("0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 2\n");
-    let e = err(a.as_bytes(), Format::Ply);
-    assert_eq!(at(&e), Some(Location::Line(14)), "{e}");
-    let mut a = ply_header("ascii", 1_000_000, 1);
-    a.push_str("0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
-    let e = err(a.as_bytes(), Format::Ply);
-    assert_eq!(at(&e), Some(Location::Line(3)), "{e}");
+    check(&[
+        (Format::Ply, bad.as_bytes(), Some(Location::Line(12)), ""),
+        (
+            Format::Ply,
+            nan.as_bytes(),
+            None,
+            "line 12: vertex 2 has a non-finite",
+        ),
+        (
+            Format::Ply,
+            trailing.as_bytes(),
+            Some(Location::Line(14)),
+            "",
+        ),
+        (Format::Ply, huge.as_bytes(), Some(Location::Line(3)), ""),
+    ]);
     let e = err(
         b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n",
         Format::Ply,
@@ -143,28 +189,6 @@ fn stl_errors() {
     assert!(
         e.to_string()
             .contains("file ends inside the facet opened on line 3"),
-        "{e}"
-    );
-}
-
-#[test]
-fn off_errors() {
-    let e = err(b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", Format::Off);
-    assert_eq!(at(&e), Some(Location::Line(6)), "{e}");
-    let e = err(b"OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", Format::Off);
-    assert!(
-        e.to_string()
-            .contains("line 2: file ends after 0 of 1 faces"),
-        "{e}"
-    );
-    let e = err(b"OFF\n99999999 1 0\n0 0 0\n", Format::Off);
-    assert_eq!(at(&e), Some(Location::Line(2)), "{e}");
-    let e = err(
-        b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n1 2 3\n",
-        Format::Off,
-    );
-    assert!(
-        e.to_string().contains("after the 3 vertices and 1 faces"),
         "{e}"
     );
 }

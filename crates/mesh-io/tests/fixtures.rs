@@ -30,16 +30,23 @@ fn check_closed_outward(m: &LoadedMesh, volume: f64) {
     assert!((vol - volume).abs() < 1e-12, "volume {vol}");
 }
 
+/// The fixture `name`, checked to have `nv` vertices and `nf` faces and to be a closed outward
+/// surface enclosing `volume`.
+fn load_closed(name: &str, nv: usize, nf: usize, volume: f64) -> LoadedMesh {
+    let m = load(name);
+    assert_eq!(m.mesh.n_vertices(), nv, "{name}");
+    assert_eq!(m.mesh.n_faces(), nf, "{name}");
+    check_closed_outward(&m, volume);
+    m
+}
+
 fn tetra_positions() -> Vec<DVec3> {
     vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z]
 }
 
 #[test]
 fn obj_cube_with_quads_groups_and_negative_indices() {
-    let m = load("cube.obj");
-    assert_eq!(m.mesh.n_vertices(), 8);
-    assert_eq!(m.mesh.n_faces(), 12);
-    check_closed_outward(&m, 1.0);
+    let m = load_closed("cube.obj", 8, 12, 1.0);
     assert!(
         m.warnings.iter().any(|w| w.contains("6 polygon")),
         "{:?}",
@@ -96,10 +103,7 @@ fn obj_agrees_with_tobj() {
 
 #[test]
 fn ply_ascii_cube_with_colours() {
-    let m = load("cube_ascii.ply");
-    assert_eq!(m.mesh.n_vertices(), 8);
-    assert_eq!(m.mesh.n_faces(), 12);
-    check_closed_outward(&m, 1.0);
+    let m = load_closed("cube_ascii.ply", 8, 12, 1.0);
     let c = m.colors.as_ref().expect("colours");
     assert_eq!(c[3], [90, 165, 7, 255]);
     assert!(m.scalars.is_empty());
@@ -128,20 +132,14 @@ fn ply_binary_both_endians_with_extra_properties() {
 #[test]
 fn stl_ascii_and_binary_welded() {
     for name in ["tetra_ascii.stl", "tetra_binary.stl"] {
-        let m = load(name);
-        assert_eq!(m.mesh.n_vertices(), 4, "{name}");
-        assert_eq!(m.mesh.n_faces(), 4);
-        check_closed_outward(&m, 1.0 / 6.0);
+        let m = load_closed(name, 4, 4, 1.0 / 6.0);
         assert!(m.warnings.is_empty(), "{name}: {:?}", m.warnings);
     }
 }
 
 #[test]
 fn off_cube() {
-    let m = load("cube.off");
-    assert_eq!(m.mesh.n_vertices(), 8);
-    assert_eq!(m.mesh.n_faces(), 12);
-    check_closed_outward(&m, 1.0);
+    load_closed("cube.off", 8, 12, 1.0);
 }
 
 #[test]

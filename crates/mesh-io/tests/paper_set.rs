@@ -4,14 +4,6 @@
 use meshcore::Topology;
 use std::path::PathBuf;
 
-/// `$BIPOLAR_SHARED`, else `../shared` relative to the workspace root.
-fn shared() -> PathBuf {
-    match std::env::var_os("BIPOLAR_SHARED") {
-        Some(p) => PathBuf::from(p),
-        None => PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared"),
-    }
-}
-
 /// Every paper-set face has 4 boundary loops (measured, and checked with an independent Python
 /// script): the outer rim of the narrow face area (138 edges), the mouth (74) and the two eyes
 /// (42 each).
@@ -48,11 +40,7 @@ fn components(m: &meshcore::TriMesh) -> usize {
 
 #[test]
 fn paper_set_faces_load() {
-    let dir = shared().join("faces/ict-facekit/paper-set");
-    if !dir.is_dir() {
-        println!("skipped: {} is absent (set BIPOLAR_SHARED)", dir.display());
-        return;
-    }
+    let dir = testsupport::require_shared!(testsupport::PAPER_SET);
     let mut names: Vec<PathBuf> = std::fs::read_dir(&dir)
         .unwrap()
         .map(|e| e.unwrap().path())
@@ -102,11 +90,7 @@ fn paper_set_faces_load() {
 
 #[test]
 fn ict_model_npy_files() {
-    let dir = shared().join("faces/ict-facekit/model");
-    if !dir.is_dir() {
-        println!("skipped: {} is absent (set BIPOLAR_SHARED)", dir.display());
-        return;
-    }
+    let dir = testsupport::require_shared!(testsupport::MODEL);
     let neutral = mesh_io::read_mesh(dir.join("neutral.obj")).unwrap();
     for name in ["identities.npy", "expressions.npy"] {
         let (shape, v) = mesh_io::read_npy_f32(dir.join(name)).unwrap();

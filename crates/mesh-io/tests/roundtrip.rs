@@ -16,6 +16,16 @@ fn coord() -> impl Strategy<Value = f64> {
     ]
 }
 
+/// `mesh` with every coordinate clamped to `[-1e30, 1e30]` (finite in f32).
+fn clamped(mesh: &TriMesh) -> TriMesh {
+    let p = mesh
+        .positions()
+        .iter()
+        .map(|p| p.clamp(DVec3::splat(-1e30), DVec3::splat(1e30)))
+        .collect();
+    TriMesh::new(p, mesh.triangles().to_vec()).unwrap()
+}
+
 prop_compose! {
     fn random_mesh()(n in 3usize..30)
         (pos in prop::collection::vec((coord(), coord(), coord()), n),
@@ -75,10 +85,7 @@ proptest! {
 
     #[test]
     fn stl_corners_within_f32((mesh, _c, _s) in random_mesh()) {
-        let small = TriMesh::new(
-            mesh.positions().iter().map(|p| p.clamp(DVec3::splat(-1e30), DVec3::splat(1e30))).collect(),
-            mesh.triangles().to_vec(),
-        ).unwrap();
+        let small = clamped(&mesh);
         let bytes = write_mesh_to_bytes(&LoadedMesh::new(small.clone()), Format::Stl).unwrap();
         let back = read_mesh_from_bytes(&bytes, Format::Stl).unwrap();
         prop_assert_eq!(back.mesh.n_faces(), small.n_faces());
@@ -93,10 +100,7 @@ proptest! {
 
     #[test]
     fn glb_within_f32_with_colours((mesh, colors, _s) in random_mesh()) {
-        let small = TriMesh::new(
-            mesh.positions().iter().map(|p| p.clamp(DVec3::splat(-1e30), DVec3::splat(1e30))).collect(),
-            mesh.triangles().to_vec(),
-        ).unwrap();
+        let small = clamped(&mesh);
         let mut scene = GltfScene::default();
         scene.add_mesh("m", &small, Some(colors.clone()));
         scene.add_points("pts", &small.positions()[..2], [255, 0, 0, 255]);
@@ -203,16 +207,9 @@ fn lm3_round_trip() {
 #[test]
 fn repairs_keep_extras_aligned() {
     // Two triangles as a soup sharing an edge, plus a degenerate face.
-    let p = vec![
-        DVec3::ZERO,
-        DVec3::X,
-        DVec3::Y,
-        DVec3::X,
-        DVec3::new(1.0, 1.0, 0.0),
-        DVec3::Y,
-    ];
-    let mesh = TriMesh::new(p, vec![[0, 1, 2], [3, 4, 5], [0, 0, 1]]).unwrap();
-    let mut m = LoadedMesh::new(mesh);
+    let soup = testsupport::triangle_soup();
+    let orig = soup.positions().to_vec();
+    let mut m = LoadedMesh::new(soup);
     assert_eq!(m.warnings.len(), 2, "{:?}", m.warnings);
     m.colors = Some((0..6).map(|i| [i, 0, 0, 255]).collect());
     m.grid_index = Some((10..16).collect());
@@ -233,14 +230,6 @@ fn repairs_keep_extras_aligned() {
     );
     assert_eq!(m.grid_index.as_ref().unwrap(), &[10, 11, 12, 14]);
     for (v, p) in m.mesh.positions().iter().enumerate() {
-        let orig = [
-            DVec3::ZERO,
-            DVec3::X,
-            DVec3::Y,
-            DVec3::X,
-            DVec3::new(1.0, 1.0, 0.0),
-            DVec3::Y,
-        ];
         assert_eq!(*p, orig[m.grid_index.as_ref().unwrap()[v] as usize - 10]);
     }
     assert!(m.warnings.is_empty());

@@ -271,26 +271,34 @@ fn each_artifact_switch_changes_only_what_it_should() {
             .filter(|&i| s.grid.xyz[i] != base.grid.xyz[i])
             .count()
     };
-    // Noise: every valid sample moves in depth only.
-    let s = with(Artifacts {
+    // Noise and quantisation keep every status and move valid samples in depth only: (depth
+    // before, depth after) of each valid sample.
+    let depths = |a: Artifacts| -> Vec<(f64, f64)> {
+        let s = with(a);
+        assert!(same_status(&s));
+        valid(&base)
+            .into_iter()
+            .map(|(i, p)| {
+                let q = s.grid.xyz[i];
+                assert!(q.x == p.x && q.y == p.y, "sample {i} moved sideways");
+                (p.z, q.z)
+            })
+            .collect()
+    };
+    // Noise: every valid sample moves.
+    for (p, q) in depths(Artifacts {
         noise: Some(DepthNoise { sigma_mm: 0.1 }),
         ..Artifacts::none()
-    });
-    assert!(same_status(&s));
-    for (i, p) in valid(&base) {
-        let q = s.grid.xyz[i];
-        assert!(q.x == p.x && q.y == p.y && q.z != p.z);
+    }) {
+        assert!(q != p);
     }
     // Quantisation: depths become multiples of the step, nothing else.
-    let s = with(Artifacts {
+    for (p, q) in depths(Artifacts {
         quantisation: Some(Quantisation { step_mm: 2.0 }),
         ..Artifacts::none()
-    });
-    assert!(same_status(&s));
-    for (i, p) in valid(&base) {
-        let q = s.grid.xyz[i];
-        assert!(q.x == p.x && q.y == p.y && (q.z - p.z).abs() <= 1.0 + 1e-12);
-        assert_eq!(q.z, (q.z / 2.0).round() * 2.0);
+    }) {
+        assert!((q - p).abs() <= 1.0 + 1e-12);
+        assert_eq!(q, (q / 2.0).round() * 2.0);
     }
     // Spikes: only the counted samples move, by the amounts put in.
     let s = with(Artifacts {
@@ -450,35 +458,7 @@ fn landmarks_in_holes_and_dropouts_are_marked() {
 #[test]
 fn bad_options_and_units_are_errors() {
     let m = plane(0.0);
-    let e = scan(
-        &m,
-        &ScanOptions {
-            pitch_mm: 0.0,
-            ..ScanOptions::default()
-        },
-    )
-    .unwrap_err();
-    assert!(
-        matches!(e, ScanError::InvalidOption(ref s) if s.contains("pitch_mm")),
-        "{e}"
-    );
-    // A 20 mm plane declared in metres is 20 m wide: far too many samples.
-    let e = scan(
-        &m,
-        &ScanOptions {
-            input_mm_per_unit: 1000.0,
-            ..ScanOptions::default()
-        },
-    )
-    .unwrap_err();
-    assert!(e.to_string().contains("is the input unit right"), "{e}");
-    let e = scan_with_landmarks(
-        &m,
-        &[("x".into(), DVec3::new(f64::NAN, 0.0, 0.0))],
-        &ScanOptions::default(),
-    )
-    .unwrap_err();
-    assert!(matches!(e, ScanError::BadLandmark { .. }));
+    let d = ScanOptions::default;
     let bad = Artifacts {
         spikes: Some(Spikes {
             fraction: 0.1,
@@ -487,26 +467,55 @@ fn bad_options_and_units_are_errors() {
         }),
         ..Artifacts::none()
     };
-    assert!(scan(
-        &m,
-        &ScanOptions {
-            artifacts: bad,
-            ..ScanOptions::default()
-        }
-    )
-    .is_err());
-    // Seen edge-on from the side nothing is in view.
-    let e = scan(
-        &m,
-        &ScanOptions {
-            pose: HeadPose {
-                yaw_deg: 90.0,
-                pitch_deg: 0.0,
+    let edge_on = HeadPose {
+        yaw_deg: 90.0,
+        pitch_deg: 0.0,
+    };
+    type Expect = fn(&ScanError) -> bool;
+    // (what is wrong, the options, what the error must be)
+    let cases: [(&str, ScanOptions, Expect); 4] = [
+        (
+            "zero pitch",
+            ScanOptions {
+                pitch_mm: 0.0,
+                ..d()
             },
-            ..ScanOptions::default()
-        },
-    );
-    assert!(matches!(e, Err(ScanError::NothingInView)), "{e:?}");
+            |e| matches!(e, ScanError::InvalidOption(s) if s.contains("pitch_mm")),
+        ),
+        // A 20 mm plane declared in metres is 20 m wide: far too many samples.
+        (
+            "metres",
+            ScanOptions {
+                input_mm_per_unit: 1000.0,
+                ..d()
+            },
+            |e| e.to_string().contains("is the input unit right"),
+        ),
+        (
+            "spikes with min above max",
+            ScanOptions {
+                artifacts: bad,
+                ..d()
+            },
+            |_| true,
+        ),
+        // Seen edge-on from the side nothing is in view.
+        (
+            "edge-on",
+            ScanOptions {
+                pose: edge_on,
+                ..d()
+            },
+            |e| matches!(e, ScanError::NothingInView),
+        ),
+    ];
+    for (what, o, expected) in &cases {
+        let e = scan(&m, o).unwrap_err();
+        assert!(expected(&e), "{what}: {e}");
+    }
+    let e =
+        scan_with_landmarks(&m, &[("x".into(), DVec3::new(f64::NAN, 0.0, 0.0))], &d()).unwrap_err();
+    assert!(matches!(e, ScanError::BadLandmark { .. }));
 }
 
 #[test]

@@ -9,54 +9,23 @@
 //! `.npy` files for the side-by-side with Open3D.
 #![allow(missing_docs)]
 
+// The point sets of the tests (the peers' patch, uniform noise).
+#[path = "../tests/common/mod.rs"]
+mod common;
+
 use criterion::{criterion_group, criterion_main, Criterion};
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use shapedist::glam::{DMat3, DVec3};
 use shapedist::*;
 
-fn patch(r: &mut ChaCha8Rng, n: usize) -> Vec<DVec3> {
-    let mut s = ChaCha8Rng::seed_from_u64(10_000);
-    let bumps: Vec<[f64; 4]> = (0..8)
-        .map(|_| {
-            [
-                (s.random::<f64>() * 1.4 - 0.7) * 0.8,
-                s.random::<f64>() * 1.4 - 0.7,
-                s.random::<f64>() * 0.37 - 0.12,
-                s.random::<f64>() * 0.23 + 0.12,
-            ]
-        })
-        .collect();
-    let mut out = Vec::with_capacity(n);
-    while out.len() < n {
-        let x = (r.random::<f64>() * 2.0 - 1.0) * 0.8;
-        let y = r.random::<f64>() * 2.0 - 1.0;
-        if (x / 0.8).powi(2) + y * y > 1.0 {
-            continue;
-        }
-        let mut z = 0.35 * (1.0 - (x / 0.8).powi(2) - y * y);
-        for b in &bumps {
-            z += b[2] * (-((x - b[0]).powi(2) + (y - b[1]).powi(2)) / (2.0 * b[3] * b[3])).exp();
-        }
-        out.push(DVec3::new(x, y, z));
-    }
-    out
-}
-
 fn case(deg: f64) -> (Vec<DVec3>, Vec<DVec3>) {
     let mut r = ChaCha8Rng::seed_from_u64(1);
-    let src = patch(&mut r, 10_000);
+    let src = common::patch(&mut r, 10_000, 0);
     let rot = DMat3::from_axis_angle(DVec3::new(0.3, -0.5, 0.8).normalize(), deg.to_radians());
     let tgt = src
         .iter()
-        .map(|&p| {
-            rot * p
-                + DVec3::new(
-                    r.random::<f64>() - 0.5,
-                    r.random::<f64>() - 0.5,
-                    r.random::<f64>() - 0.5,
-                ) * 0.017
-        })
+        .map(|&p| rot * p + common::noise(&mut r, 0.017))
         .collect();
     (tgt, src)
 }
@@ -97,8 +66,10 @@ fn benches(c: &mut Criterion) {
     });
     for deg in [30.0, 90.0, 180.0] {
         let (tgt, src) = case(deg);
-        let a = PreparedSet::new(&tgt, &po, Which::A).unwrap();
-        let b = PreparedSet::new(&src, &po, Which::B).unwrap();
+        let (a, b) = (
+            common::prepared(&tgt, Which::A),
+            common::prepared(&src, Which::B),
+        );
         let plain = IcpOptions {
             max_iterations: 50,
             tolerance: 0.0,

@@ -8,10 +8,6 @@ use rand::Rng;
 use shapedist::glam::{DAffine3, DMat3, DVec3};
 use shapedist::*;
 
-fn prep(p: &[DVec3], w: Which) -> PreparedSet {
-    PreparedSet::new(p, &PrepareOptions::default(), w).unwrap()
-}
-
 fn rotated(p: &[DVec3], r: DMat3, t: DVec3) -> Vec<DVec3> {
     p.iter().map(|&x| r * x + t).collect()
 }
@@ -23,7 +19,7 @@ fn plain_icp_converges_from_a_small_rotation_both_variants() {
     let rot = rotation_by(&mut r, 15.0);
     // b = rot^T a, so R(b -> a) = rot.
     let b = rotated(&a, rot.transpose(), DVec3::new(3.0, -1.0, 2.0));
-    let (pa, pb) = (prep(&a, Which::A), prep(&b, Which::B));
+    let (pa, pb) = (prepared(&a, Which::A), prepared(&b, Which::B));
     for variant in [IcpVariant::PointToPoint, IcpVariant::PointToPlane] {
         let res = icp(
             &pa,
@@ -52,7 +48,7 @@ fn plain_icp_fails_from_180_degrees_but_the_global_strategy_does_not() {
     let a = patch(&mut r, 2000, 3);
     let rot = rotation_by(&mut r, 180.0);
     let b = rotated(&a, rot.transpose(), DVec3::ZERO);
-    let (pa, pb) = (prep(&a, Which::A), prep(&b, Which::B));
+    let (pa, pb) = (prepared(&a, Which::A), prepared(&b, Which::B));
     let plain = icp(&pa, &pb, DMat3::IDENTITY, &IcpOptions::default()).unwrap();
     assert!(
         angle_deg(plain.motion.matrix3, rot) > 20.0,
@@ -77,16 +73,9 @@ fn global_icp_recovers_random_rotations_of_a_resampled_noisy_copy() {
         let rot = random_rotation(&mut r);
         let b: Vec<DVec3> = other
             .iter()
-            .map(|&p| {
-                rot.transpose() * p
-                    + DVec3::new(
-                        r.random::<f64>() - 0.5,
-                        r.random::<f64>() - 0.5,
-                        r.random::<f64>() - 0.5,
-                    ) * 0.01
-            })
+            .map(|&p| rot.transpose() * p + noise(&mut r, 0.01))
             .collect();
-        let (pa, pb) = (prep(&a, Which::A), prep(&b, Which::B));
+        let (pa, pb) = (prepared(&a, Which::A), prepared(&b, Which::B));
         let d = icp_distance(&pa, &pb, &GlobalOptions::default()).unwrap();
         // Resampled sets have no exact match: the objective's minimum is a few degrees from
         // the true rotation at this density. The global search must reach that minimum (ICP
@@ -123,7 +112,7 @@ fn trimmed_icp_ignores_a_partial_overlap() {
     for _ in 0..nb / 20 {
         b.push(DVec3::new(r.random(), r.random(), r.random::<f64>() + 2.0));
     }
-    let (pa, pb) = (prep(&a, Which::A), prep(&b, Which::B));
+    let (pa, pb) = (prepared(&a, Which::A), prepared(&b, Which::B));
     let opts = GlobalOptions {
         refine: IcpOptions {
             trim: 0.1,
@@ -143,7 +132,7 @@ fn reflection_is_not_a_rotation_for_icp_either() {
     let mut r = rng(5);
     let a = patch(&mut r, 1500, 2);
     let m: Vec<DVec3> = a.iter().map(|p| DVec3::new(-p.x, p.y, p.z)).collect();
-    let (pa, pm) = (prep(&a, Which::A), prep(&m, Which::B));
+    let (pa, pm) = (prepared(&a, Which::A), prepared(&m, Which::B));
     let d = icp_distance(&pa, &pm, &GlobalOptions::default()).unwrap();
     assert!((d.motion.matrix3.determinant() - 1.0).abs() < 1e-9);
     assert!(
@@ -158,7 +147,7 @@ fn closest_point_stats_match_brute_force_and_are_symmetric() {
     let mut r = rng(6);
     let a = random_cloud(&mut r, 150, 1.0);
     let b = random_cloud(&mut r, 97, 1.7);
-    let (pa, pb) = (prep(&a, Which::A), prep(&b, Which::B));
+    let (pa, pb) = (prepared(&a, Which::A), prepared(&b, Which::B));
     let rot = random_rotation(&mut r);
     let s = closest_point_stats(&pa, &pb, &DAffine3::from_mat3(rot));
     let s_rev = closest_point_stats(&pb, &pa, &DAffine3::from_mat3(rot.transpose()));
@@ -203,7 +192,7 @@ fn bad_input_is_rejected() {
         ShapeDistError::Degenerate { .. }
     ));
     let mut r = rng(8);
-    let a = prep(&random_cloud(&mut r, 20, 1.0), Which::A);
+    let a = prepared(&random_cloud(&mut r, 20, 1.0), Which::A);
     let bad = IcpOptions {
         trim: 0.95,
         ..Default::default()
@@ -226,7 +215,7 @@ fn many_points_sharing_one_coordinate_do_not_break_the_tree() {
             )
         })
         .collect();
-    let pa = prep(&a, Which::A);
+    let pa = prepared(&a, Which::A);
     let d = icp_distance(&pa, &pa, &GlobalOptions::default()).unwrap();
     assert!(d.stats.hausdorff < 1e-9);
 }
@@ -240,7 +229,7 @@ proptest! {
         let a = patch(&mut r, 800, seed % 5);
         let rot = random_rotation(&mut r);
         let b = rotated(&a, rot.transpose(), DVec3::new(1.0, 2.0, 3.0));
-        let (pa, pb) = (prep(&a, Which::A), prep(&b, Which::B));
+        let (pa, pb) = (prepared(&a, Which::A), prepared(&b, Which::B));
         let d = icp_distance(&pa, &pb, &GlobalOptions::default()).unwrap();
         prop_assert!(angle_deg(d.motion.matrix3, rot) < 1e-5, "{} deg", angle_deg(d.motion.matrix3, rot));
         prop_assert!(d.stats.hausdorff_normalised < 1e-8);
@@ -251,7 +240,7 @@ proptest! {
         let mut r = rng(seed);
         let a = random_cloud(&mut r, 60, 1.0);
         let b: Vec<DVec3> = random_cloud(&mut r, 45, s).iter().map(|p| *p * DVec3::new(1.0, 0.2, 3.0)).collect();
-        let (pa, pb) = (prep(&a, Which::A), prep(&b, Which::B));
+        let (pa, pb) = (prepared(&a, Which::A), prepared(&b, Which::B));
         let rot = random_rotation(&mut r);
         let st = closest_point_stats(&pa, &pb, &DAffine3::from_mat3(rot));
         for v in [st.hausdorff_normalised, st.mean_normalised, st.rms_normalised] {

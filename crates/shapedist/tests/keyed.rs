@@ -9,6 +9,37 @@ use rand::Rng;
 use shapedist::glam::{DMat3, DVec3};
 use shapedist::*;
 
+/// The options with rotation solver `method`, the rest default.
+fn with_method(method: RotationMethod) -> KeyedOptions {
+    KeyedOptions {
+        method,
+        ..Default::default()
+    }
+}
+
+/// Both rotation solvers.
+const METHODS: [RotationMethod; 2] = [RotationMethod::Kabsch, RotationMethod::Horn];
+
+/// The keyed distance by each rotation solver, after checking that each recovers `rot` to
+/// 1e-9 rad (a failure names the solver and `case`).
+fn recovered_by_both(
+    ka: &[u64],
+    a: &[DVec3],
+    kb: &[u64],
+    b: &[DVec3],
+    rot: DMat3,
+    case: &str,
+) -> [KeyedDistance; 2] {
+    METHODS.map(|method| {
+        let d = keyed_distance(ka, a, kb, b, &with_method(method)).unwrap();
+        assert!(
+            angle_deg(d.motion.matrix3, rot).to_radians() < 1e-9,
+            "{method:?} {case}"
+        );
+        d
+    })
+}
+
 fn keyed_copy(seed: u64, n: usize) -> (Vec<u64>, Vec<DVec3>, Vec<u64>, Vec<DVec3>, DMat3, DVec3) {
     let mut r = rng(seed);
     let a = random_cloud(&mut r, n, 10.0);
@@ -27,16 +58,7 @@ fn keyed_copy(seed: u64, n: usize) -> (Vec<u64>, Vec<DVec3>, Vec<u64>, Vec<DVec3
 fn known_rotations_are_recovered_to_1e9_by_kabsch_and_horn() {
     for seed in 0..20 {
         let (ka, a, kb, b, rot, t) = keyed_copy(seed, 50 + seed as usize * 13);
-        for method in [RotationMethod::Kabsch, RotationMethod::Horn] {
-            let o = KeyedOptions {
-                method,
-                ..Default::default()
-            };
-            let d = keyed_distance(&ka, &a, &kb, &b, &o).unwrap();
-            assert!(
-                angle_deg(d.motion.matrix3, rot).to_radians() < 1e-9,
-                "{method:?} seed {seed}"
-            );
+        for d in recovered_by_both(&ka, &a, &kb, &b, rot, &format!("seed {seed}")) {
             assert!((d.motion.translation - t).length() < 1e-9 * 100.0);
             assert!(d.distance < 1e-12, "{}", d.distance);
             assert_eq!(d.shared_keys, a.len());
@@ -66,16 +88,7 @@ fn rotations_of_180_degrees_and_near_planar_sets_are_recovered() {
     ] {
         let rot = DMat3::from_axis_angle(axis.normalize(), f64::to_radians(deg));
         let b: Vec<DVec3> = a.iter().map(|&p| rot.transpose() * p).collect();
-        for method in [RotationMethod::Kabsch, RotationMethod::Horn] {
-            let o = KeyedOptions {
-                method,
-                ..Default::default()
-            };
-            let d = keyed_distance(&keys, &a, &keys, &b, &o).unwrap();
-            assert!(
-                angle_deg(d.motion.matrix3, rot).to_radians() < 1e-9,
-                "{method:?} {deg}"
-            );
+        for d in recovered_by_both(&keys, &a, &keys, &b, rot, &format!("{deg}")) {
             assert!(d.distance < 1e-9);
         }
     }
@@ -87,11 +100,8 @@ fn a_reflection_is_not_mistaken_for_a_rotation() {
     let a = random_cloud(&mut r, 100, 1.0);
     let keys: Vec<u64> = (0..100).collect();
     let mirrored: Vec<DVec3> = a.iter().map(|p| DVec3::new(-p.x, p.y, p.z)).collect();
-    for method in [RotationMethod::Kabsch, RotationMethod::Horn] {
-        let o = KeyedOptions {
-            method,
-            ..Default::default()
-        };
+    for method in METHODS {
+        let o = with_method(method);
         let d = keyed_distance(&keys, &a, &keys, &mirrored, &o).unwrap();
         assert!((d.motion.matrix3.determinant() - 1.0).abs() < 1e-12);
         assert!(d.distance > 0.2, "mirror image at distance {}", d.distance);
@@ -110,17 +120,7 @@ fn distance_matches_the_singular_value_formula_and_kabsch_equals_horn() {
     let b = random_cloud(&mut r, 60, 3.0);
     let keys: Vec<u64> = (0..60).collect();
     let dk = keyed_distance(&keys, &a, &keys, &b, &KeyedOptions::default()).unwrap();
-    let dh = keyed_distance(
-        &keys,
-        &a,
-        &keys,
-        &b,
-        &KeyedOptions {
-            method: RotationMethod::Horn,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let dh = keyed_distance(&keys, &a, &keys, &b, &with_method(RotationMethod::Horn)).unwrap();
     assert!(angle_deg(dk.motion.matrix3, dh.motion.matrix3) < 1e-9);
     assert!((dk.distance - dh.distance).abs() < 1e-12);
     let (ca, cb) = (points::centroid(&a), points::centroid(&b));
@@ -245,18 +245,12 @@ fn with_outliers(seed: u64) -> (Vec<u64>, Vec<DVec3>, Vec<u64>, Vec<DVec3>, DMat
 #[test]
 fn residual_gate_removes_wrong_matches() {
     let (ka, a, kb, b, rot) = with_outliers(21);
-    let plain = keyed_distance(&ka, &a, &kb, &b, &KeyedOptions::default()).unwrap();
-    let gated = keyed_distance(
-        &ka,
-        &a,
-        &kb,
-        &b,
-        &KeyedOptions {
-            gate: Some(2.0),
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let gate = KeyedOptions {
+        gate: Some(2.0),
+        ..Default::default()
+    };
+    let [plain, gated] =
+        [KeyedOptions::default(), gate].map(|o| keyed_distance(&ka, &a, &kb, &b, &o).unwrap());
     assert!(plain.distance > 0.1);
     assert!(gated.distance < 1e-9, "{}", gated.distance);
     assert!(angle_deg(gated.motion.matrix3, rot) < 1e-7);
@@ -267,31 +261,17 @@ fn residual_gate_removes_wrong_matches() {
 #[test]
 fn irls_weights_reduce_the_influence_of_outliers() {
     let (ka, a, kb, b, rot) = with_outliers(22);
-    let plain = keyed_distance(&ka, &a, &kb, &b, &KeyedOptions::default()).unwrap();
-    let tukey = keyed_distance(
-        &ka,
-        &a,
-        &kb,
-        &b,
-        &KeyedOptions {
-            robust: Some(RobustLoss::Tukey(4.685)),
-            irls_iterations: 10,
-            ..Default::default()
-        },
-    )
-    .unwrap();
-    let huber = keyed_distance(
-        &ka,
-        &a,
-        &kb,
-        &b,
-        &KeyedOptions {
-            robust: Some(RobustLoss::Huber(1.345)),
-            irls_iterations: 10,
-            ..Default::default()
-        },
-    )
-    .unwrap();
+    let robust = |loss| KeyedOptions {
+        robust: Some(loss),
+        irls_iterations: 10,
+        ..Default::default()
+    };
+    let [plain, tukey, huber] = [
+        KeyedOptions::default(),
+        robust(RobustLoss::Tukey(4.685)),
+        robust(RobustLoss::Huber(1.345)),
+    ]
+    .map(|o| keyed_distance(&ka, &a, &kb, &b, &o).unwrap());
     let (ep, et, eh) = (
         angle_deg(plain.motion.matrix3, rot),
         angle_deg(tukey.motion.matrix3, rot),

@@ -37,6 +37,15 @@ fn cloud(r: &mut rand_chacha::ChaCha8Rng, n: usize, kind: u8) -> Vec<DVec3> {
     }
 }
 
+/// The generator of case `seed` (after drawing the points), a cloud of `n` points of `kind` and
+/// its tree.
+fn tree_case(seed: u64, n: usize, kind: u8) -> (rand_chacha::ChaCha8Rng, Vec<DVec3>, PointTree) {
+    let mut r = rng(seed);
+    let pts = cloud(&mut r, n, kind);
+    let tree = PointTree::new(&pts);
+    (r, pts, tree)
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
@@ -47,9 +56,7 @@ proptest! {
         kind in 0u8..3,
         far in 0.0f64..3.0,
     ) {
-        let mut r = rng(seed);
-        let pts = cloud(&mut r, n, kind);
-        let tree = PointTree::new(&pts);
+        let (mut r, pts, tree) = tree_case(seed, n, kind);
         prop_assert_eq!(tree.len(), n);
         // Queries near and far from the set; on the grid, half-integer offsets give ties.
         let qs: Vec<DVec3> = (0..3 * GROUP + 3)
@@ -170,9 +177,7 @@ proptest! {
         kind in 0u8..3,
         far in 0.0f64..2.0,
     ) {
-        let mut r = rng(seed);
-        let pts = cloud(&mut r, n, kind);
-        let tree = PointTree::new(&pts);
+        let (mut r, pts, tree) = tree_case(seed, n, kind);
         let qs: Vec<DVec3> = (0..2 * GROUP + 5)
             .map(|_| {
                 pts[r.random_range(0..n)]
@@ -204,9 +209,7 @@ proptest! {
         n in 1usize..300,
         kind in 0u8..3,
     ) {
-        let mut r = rng(seed);
-        let pts = cloud(&mut r, n, kind);
-        let tree = PointTree::new(&pts);
+        let (mut r, pts, tree) = tree_case(seed, n, kind);
         let graph = NeighbourGraph::new(&tree);
         prop_assert_eq!(graph.len(), n);
         for (i, &p) in pts.iter().enumerate() {
@@ -228,9 +231,7 @@ proptest! {
         kind in 0u8..3,
         off in 0.0f64..0.3,
     ) {
-        let mut r = rng(seed);
-        let pts = cloud(&mut r, n, kind);
-        let tree = PointTree::new(&pts);
+        let (mut r, pts, tree) = tree_case(seed, n, kind);
         let graph = NeighbourGraph::new(&tree);
         let mut certified = 0;
         let trials = 200;
@@ -364,9 +365,7 @@ proptest! {
             .iter()
             .map(|&p| rot * p + DVec3::new(0.3, -0.1, 0.2))
             .collect();
-        let po = PrepareOptions::default();
-        let a = PreparedSet::new(&tgt, &po, Which::A).unwrap();
-        let b = PreparedSet::new(&src, &po, Which::B).unwrap();
+        let (a, b) = (prepared(&tgt, Which::A), prepared(&src, Which::B));
         let trim = if trim_on { 0.2 } else { 0.0 };
         let iters = 25;
         let opts = IcpOptions {
@@ -393,9 +392,7 @@ fn icp_results_do_not_depend_on_the_thread_count() {
     let src = patch(&mut r, 3000, 5);
     let rot = rotation_by(&mut r, 40.0);
     let tgt: Vec<DVec3> = patch(&mut r, 3100, 5).iter().map(|&p| rot * p).collect();
-    let po = PrepareOptions::default();
-    let a = PreparedSet::new(&tgt, &po, Which::A).unwrap();
-    let b = PreparedSet::new(&src, &po, Which::B).unwrap();
+    let (a, b) = (prepared(&tgt, Which::A), prepared(&src, Which::B));
     let opts = IcpOptions {
         max_iterations: 8,
         tolerance: 0.0,

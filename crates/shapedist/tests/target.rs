@@ -56,7 +56,7 @@ proptest! {
     ) {
         let mut r = rng(seed);
         let pts = patch(&mut r, 800, seed);
-        let a = PreparedSet::new(&pts, &PrepareOptions::default(), Which::A).unwrap();
+        let a = prepared(&pts, Which::A);
         let m = motion_from(seed + 1, deg, 0.05);
         // Source = m^-1 applied to the (centred) target points: ICP must find m.
         let inv = rigid_inverse(&m);
@@ -99,10 +99,10 @@ fn icp_on_a_prepared_set_equals_the_loop_on_it() {
     // `icp` is the loop with `IcpOptions::loop_options` on B's points in tree leaf order.
     let mut r = rng(3);
     let pts = patch(&mut r, 1200, 3);
-    let a = PreparedSet::new(&pts, &PrepareOptions::default(), Which::A).unwrap();
+    let a = prepared(&pts, Which::A);
     let m = motion_from(4, 8.0, 0.0);
     let moved: Vec<DVec3> = pts.iter().map(|p| m.transform_point3(*p)).collect();
-    let b = PreparedSet::new(&moved, &PrepareOptions::default(), Which::B).unwrap();
+    let b = prepared(&moved, Which::B);
     let o = IcpOptions {
         trim: 0.1,
         ..IcpOptions::default()

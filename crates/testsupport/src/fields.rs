@@ -1,4 +1,5 @@
-//! Analytic distance fields: the oracles the tests compare computed geodesic fields with.
+//! Analytic distance fields, the oracles the tests compare computed geodesic fields with, and
+//! the differences between two fields that the comparisons bound.
 
 use meshcore::{DVec3, TriMesh};
 use std::f64::consts::{PI, TAU};
@@ -52,6 +53,58 @@ pub fn prism_geodesic(mesh: &TriMesh, r: f64, na: usize, src: u32) -> Vec<f64> {
             ((k * chord).powi(2) + (p.z - sz).powi(2)).sqrt()
         })
         .collect()
+}
+
+/// Largest `|a[i] - b[i]|` (0 for empty fields).
+pub fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
+
+/// Mean of `|a[i] - b[i]|` over the length of `a`.
+pub fn mean_abs_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y).abs()).sum::<f64>() / a.len() as f64
+}
+
+/// Largest relative error `|got[i] - want[i]| / want[i]` over the entries with
+/// `want[i] > min_want` (away from the source, where a relative error means something).
+pub fn max_rel_err(got: &[f64], want: &[f64], min_want: f64) -> f64 {
+    got.iter()
+        .zip(want)
+        .filter(|(_, w)| **w > min_want)
+        .map(|(g, w)| (g - w).abs() / w)
+        .fold(0.0, f64::max)
+}
+
+/// Largest relative difference `|a[i] - b[i]| / max(|b[i]|, floor)` over the finite entries;
+/// panics (naming the vertex) when `a` and `b` differ in length or in which entries are
+/// infinite.
+pub fn max_rel_diff(a: &[f64], b: &[f64], floor: f64) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let mut m = 0.0f64;
+    for (i, (&x, &y)) in a.iter().zip(b).enumerate() {
+        assert_eq!(x.is_finite(), y.is_finite(), "vertex {i}: {x} vs {y}");
+        if x.is_finite() {
+            m = m.max((x - y).abs() / y.abs().max(floor));
+        }
+    }
+    m
+}
+
+/// Panics, naming the first vertex and `what`, unless every `got[v]` is within
+/// `rel * max(|want[v]|, 1)` of `want[v]` (relative for distances above 1, absolute below) and
+/// the fields have the same length.
+#[track_caller]
+pub fn assert_close(got: &[f64], want: &[f64], rel: f64, what: &str) {
+    assert_eq!(got.len(), want.len(), "{what}: field lengths");
+    for (v, (g, w)) in got.iter().zip(want).enumerate() {
+        assert!(
+            (g - w).abs() <= rel * w.abs().max(1.0),
+            "{what}: vertex {v}: {g} vs {w}"
+        );
+    }
 }
 
 #[cfg(test)]

@@ -7,11 +7,15 @@
 //!   the test panics with the lookup's message.
 //! * **Paths**: [`PAPER_SET`], [`MODEL`], [`paper_face`].
 //! * **Meshes**: [`read_mesh`] (through `mesh-io`, the project's one reader) and the generators
-//!   of [`meshcore::shapes`], re-exported as [`shapes`], plus [`jittered_unit_plane`] (the
-//!   plane of the straightest-geodesic, single-pole and face-frame tests).
-//! * **Analytic distance fields**: [`fields`].
+//!   of [`meshcore::shapes`], re-exported as [`shapes`], plus [`jittered_grid`],
+//!   [`jittered_unit_plane`] (the plane of the straightest-geodesic, single-pole and face-frame
+//!   tests), [`height_field`], [`uv_sphere_y_up`] and [`triangle_soup`].
+//! * **Analytic distance fields** and the differences between two fields: [`fields`].
+//! * **End-to-end runs** of the command-line tools: [`cli`]; the check of a crate's option
+//!   names: [`check_choice_error`].
 //! * **The independent descriptor and distance** the crates are checked against: [`oracle`].
 
+pub mod cli;
 pub mod fields;
 pub mod oracle;
 
@@ -25,11 +29,32 @@ use std::path::{Path, PathBuf};
 /// Planar grid on [0, 1]^2 (z = 0) of `n` cells a side, uniform diagonals, interior vertices
 /// jittered by up to `jitter` cells per axis (ChaCha8 seeded by `seed`; boundary kept straight).
 pub fn jittered_unit_plane(n: usize, jitter: f64, seed: u64) -> TriMesh {
+    jittered_grid(
+        n,
+        n,
+        1.0 / n as f64,
+        shapes::Diagonals::Uniform,
+        jitter,
+        seed,
+    )
+}
+
+/// Planar grid of `nx x ny` square cells of side `h` from the origin (z = 0), vertex `(i, j)`
+/// with id `j * (nx + 1) + i` (as [`shapes::grid`]), interior vertices jittered by up to
+/// `jitter` cells per axis (ChaCha8 seeded by `seed`, two draws per interior vertex in id order
+/// when `jitter > 0`; the boundary stays straight).
+pub fn jittered_grid(
+    nx: usize,
+    ny: usize,
+    h: f64,
+    diagonals: shapes::Diagonals,
+    jitter: f64,
+    seed: u64,
+) -> TriMesh {
     use rand::{Rng, SeedableRng};
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-    let h = 1.0 / n as f64;
-    shapes::grid(n, n, shapes::Diagonals::Uniform, |i, j| {
-        let inner = i > 0 && j > 0 && i < n && j < n;
+    shapes::grid(nx, ny, diagonals, |i, j| {
+        let inner = i > 0 && j > 0 && i < nx && j < ny;
         let (dx, dy) = if inner && jitter > 0.0 {
             (
                 rng.random_range(-jitter..jitter) * h,
@@ -40,7 +65,52 @@ pub fn jittered_unit_plane(n: usize, jitter: f64, seed: u64) -> TriMesh {
         };
         meshcore::DVec3::new(i as f64 * h + dx, j as f64 * h + dy, 0.0)
     })
-    .expect("a unit grid is a valid mesh")
+    .expect("a jittered grid is a valid mesh")
+}
+
+/// Height field `z = f(x, y)` on the square `[-half, half]^2`: [`shapes::grid`] of `n x n`
+/// cells with uniform diagonals, vertex `(i, j)` at `x = -half + 2 half i / n` (and `y` alike
+/// from `j`), normals up.
+pub fn height_field(n: usize, half: f64, f: impl Fn(f64, f64) -> f64) -> TriMesh {
+    let side = 2.0 * half;
+    shapes::grid(n, n, shapes::Diagonals::Uniform, |i, j| {
+        let (x, y) = (
+            -half + side * i as f64 / n as f64,
+            -half + side * j as f64 / n as f64,
+        );
+        meshcore::DVec3::new(x, y, f(x, y))
+    })
+    .expect("a height field of finite heights is a valid mesh")
+}
+
+/// The unit square's two triangles written as a soup (STL style: the two vertices of the shared
+/// edge written twice, so 2 duplicate vertices), plus the degenerate face `[0, 0, 1]`: 6
+/// vertices, 3 faces, the input of the repair tests.
+pub fn triangle_soup() -> TriMesh {
+    use meshcore::DVec3;
+    let p = vec![
+        DVec3::ZERO,
+        DVec3::X,
+        DVec3::Y,
+        DVec3::X,
+        DVec3::new(1.0, 1.0, 0.0),
+        DVec3::Y,
+    ];
+    TriMesh::new(p, vec![[0, 1, 2], [3, 4, 5], [0, 0, 1]]).expect("the soup is a valid mesh")
+}
+
+/// UV sphere of radius `r` with its poles on the y axis (vertex 0 at `+r y`, the last vertex at
+/// `-r y`, the rings in between at `y = r cos(theta)`), the view-friendly sphere of the render
+/// tests: [`shapes::uv_sphere`] with y and z exchanged and every face reversed so that it stays
+/// outward.
+pub fn uv_sphere_y_up(r: f64, n_lat: usize, n_lon: usize) -> TriMesh {
+    let (pos, tris) = shapes::uv_sphere(n_lat, n_lon).into_parts();
+    let pos = pos
+        .into_iter()
+        .map(|p| meshcore::DVec3::new(r * p.x, r * p.z, r * p.y))
+        .collect();
+    let tris = tris.into_iter().map(|[a, b, c]| [a, c, b]).collect();
+    TriMesh::new(pos, tris).expect("a reflected sphere is a valid mesh")
 }
 
 /// `rel` inside the shared data folder, or `None` after printing why the caller skips:
@@ -88,6 +158,21 @@ macro_rules! require_shared {
             None => return Default::default(),
         }
     };
+}
+
+/// [`meshcore::choice::check_choice`] of `T` with the rejected name `bad`, and that parsing
+/// `bad` gives the error `unknown` accepts (the crate's error for an unknown name).
+#[track_caller]
+pub fn check_choice_error<T>(bad: &str, unknown: impl Fn(&T::Err) -> bool)
+where
+    T: meshcore::Choice + PartialEq + std::fmt::Debug + std::str::FromStr + std::fmt::Display,
+    T::Err: std::fmt::Display + std::fmt::Debug,
+{
+    meshcore::choice::check_choice::<T>(bad).unwrap_or_else(|e| panic!("{e}"));
+    match bad.parse::<T>() {
+        Err(e) => assert!(unknown(&e), "{bad:?}: unexpected error {e:?}"),
+        Ok(v) => panic!("{bad:?} parses to {v:?}"),
+    }
 }
 
 /// Reads a mesh file with `mesh-io`; panics with the reader's message (test code).

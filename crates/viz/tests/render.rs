@@ -8,37 +8,9 @@ use viz::{
     VizError,
 };
 
-/// UV sphere of radius `r` centred at the origin (outward-oriented triangles).
+/// UV sphere of radius `r` centred at the origin (outward-oriented triangles), poles on y.
 fn sphere(r: f64, n_lat: usize, n_lon: usize) -> TriMesh {
-    let mut pos = vec![DVec3::new(0.0, r, 0.0)];
-    for i in 1..n_lat {
-        let th = PI * i as f64 / n_lat as f64;
-        for j in 0..n_lon {
-            let ph = TAU * j as f64 / n_lon as f64;
-            pos.push(r * DVec3::new(th.sin() * ph.cos(), th.cos(), th.sin() * ph.sin()));
-        }
-    }
-    pos.push(DVec3::new(0.0, -r, 0.0));
-    let south = (pos.len() - 1) as u32;
-    let ring = |i: usize, j: usize| (1 + (i - 1) * n_lon + j % n_lon) as u32;
-    let mut tris = Vec::new();
-    for j in 0..n_lon {
-        tris.push([0, ring(1, j + 1), ring(1, j)]);
-        tris.push([south, ring(n_lat - 1, j), ring(n_lat - 1, j + 1)]);
-    }
-    for i in 1..n_lat - 1 {
-        for j in 0..n_lon {
-            let (a, b, c, d) = (
-                ring(i, j),
-                ring(i, j + 1),
-                ring(i + 1, j),
-                ring(i + 1, j + 1),
-            );
-            tris.push([a, b, d]);
-            tris.push([a, d, c]);
-        }
-    }
-    let m = TriMesh::new(pos, tris).unwrap();
+    let m = testsupport::uv_sphere_y_up(r, n_lat, n_lon);
     // Orientation check: the normal of the first face points outwards.
     let f0 = m.face_corners(0);
     assert!(m.face_normal(0).dot(f0[0] + f0[1] + f0[2]) > 0.0);
@@ -291,9 +263,7 @@ fn write_sample_pictures() {
 
 #[test]
 fn picture_format_names_round_trip() {
-    meshcore::choice::check_choice::<viz::Format>("jpg").unwrap();
-    assert!(matches!(
-        "jpg".parse::<viz::Format>(),
-        Err(viz::VizError::UnknownChoice(_))
-    ));
+    testsupport::check_choice_error::<viz::Format>("jpg", |e| {
+        matches!(e, viz::VizError::UnknownChoice(_))
+    });
 }

@@ -3,6 +3,7 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use shapedist::glam::{DMat3, DQuat, DVec3};
+use shapedist::{PrepareOptions, PreparedSet, Which};
 
 pub fn rng(seed: u64) -> ChaCha8Rng {
     ChaCha8Rng::seed_from_u64(seed)
@@ -32,16 +33,23 @@ pub fn rotation_by(r: &mut ChaCha8Rng, deg: f64) -> DMat3 {
     DMat3::from_axis_angle(axis, deg.to_radians())
 }
 
+/// A vector uniform in the cube of side `scale` centred at the origin (three draws).
+pub fn noise(r: &mut ChaCha8Rng, scale: f64) -> DVec3 {
+    DVec3::new(
+        r.random::<f64>() - 0.5,
+        r.random::<f64>() - 0.5,
+        r.random::<f64>() - 0.5,
+    ) * scale
+}
+
+/// `n` points uniform in the cube of side `scale` centred at the origin.
 pub fn random_cloud(r: &mut ChaCha8Rng, n: usize, scale: f64) -> Vec<DVec3> {
-    (0..n)
-        .map(|_| {
-            DVec3::new(
-                r.random::<f64>() - 0.5,
-                r.random::<f64>() - 0.5,
-                r.random::<f64>() - 0.5,
-            ) * scale
-        })
-        .collect()
+    (0..n).map(|_| noise(r, scale)).collect()
+}
+
+/// `p` prepared as set `w` with the default options.
+pub fn prepared(p: &[DVec3], w: Which) -> PreparedSet {
+    PreparedSet::new(p, &PrepareOptions::default(), w).unwrap()
 }
 
 /// A smooth asymmetric "face-like" height field over an ellipse (as the ICP peers' patch).
