@@ -5,6 +5,8 @@
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
+// Not every test file uses both.
+#[allow(unused_imports)]
 pub use testsupport::cli::{arg, Run};
 
 /// Runs the `bipolar` binary of this crate with `args`.
