@@ -46,24 +46,7 @@ pub fn to_csv_string(d: &Descriptor) -> String {
     let mut s = String::with_capacity(64 * (d.points.len() + 1));
     s.push_str(CSV_HEADER);
     s.push('\n');
-    for p in &d.points {
-        let k = p.key;
-        let _ = writeln!(
-            s,
-            "{},{},{},{},{},{},{},{},{},{},{}",
-            p.position.x,
-            p.position.y,
-            p.position.z,
-            k.a,
-            k.b,
-            k.i,
-            k.j,
-            k.side,
-            k.sign,
-            p.cos,
-            u8::from(p.ambiguous)
-        );
-    }
+    push_points(&mut s, d, ',');
     s
 }
 
@@ -283,25 +266,23 @@ pub fn to_ply_string(d: &Descriptor) -> String {
         "property char side\nproperty char sign\nproperty double cos\nproperty uchar ambiguous\n",
     );
     s.push_str("end_header\n");
+    push_points(&mut s, d, ' ');
+    s
+}
+
+/// One line per point, the fields separated by `sep`: the CSV columns and the PLY vertex
+/// properties, in the order of [`CSV_HEADER`].
+fn push_points(s: &mut String, d: &Descriptor, sep: char) {
     for p in &d.points {
         let k = p.key;
+        let (x, y, z) = (p.position.x, p.position.y, p.position.z);
+        let (a, b, i, j, side, sign) = (k.a, k.b, k.i, k.j, k.side, k.sign);
+        let (cos, amb) = (p.cos, u8::from(p.ambiguous));
         let _ = writeln!(
             s,
-            "{} {} {} {} {} {} {} {} {} {} {}",
-            p.position.x,
-            p.position.y,
-            p.position.z,
-            k.a,
-            k.b,
-            k.i,
-            k.j,
-            k.side,
-            k.sign,
-            p.cos,
-            u8::from(p.ambiguous)
+            "{x}{sep}{y}{sep}{z}{sep}{a}{sep}{b}{sep}{i}{sep}{j}{sep}{side}{sep}{sign}{sep}{cos}{sep}{amb}"
         );
     }
-    s
 }
 
 /// Writes the PLY file.
@@ -309,14 +290,16 @@ pub fn write_ply(path: &Path, d: &Descriptor) -> Result<(), BipolarError> {
     write_file(path, &to_ply_string(d))
 }
 
-/// Writes `d` in the format named by the extension of `path` (`.csv`, `.json`, `.ply`).
-pub fn write_auto(path: &Path, d: &Descriptor) -> Result<(), BipolarError> {
-    match path
-        .extension()
+/// The extension of `path` in lower case.
+fn extension(path: &Path) -> Option<String> {
+    path.extension()
         .and_then(|e| e.to_str())
         .map(|e| e.to_ascii_lowercase())
-        .as_deref()
-    {
+}
+
+/// Writes `d` in the format named by the extension of `path` (`.csv`, `.json`, `.ply`).
+pub fn write_auto(path: &Path, d: &Descriptor) -> Result<(), BipolarError> {
+    match extension(path).as_deref() {
         Some("csv") => write_csv(path, d),
         Some("json") => write_json(path, d),
         Some("ply") => write_ply(path, d),
@@ -329,12 +312,7 @@ pub fn write_auto(path: &Path, d: &Descriptor) -> Result<(), BipolarError> {
 
 /// Reads `.csv` or `.json` descriptor files by extension.
 pub fn read_auto(path: &Path) -> Result<Descriptor, BipolarError> {
-    match path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(|e| e.to_ascii_lowercase())
-        .as_deref()
-    {
+    match extension(path).as_deref() {
         Some("csv") => read_csv(path),
         Some("json") => read_json(path),
         _ => Err(io_err(

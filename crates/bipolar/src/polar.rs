@@ -237,9 +237,14 @@ mod tests {
     use meshcore::shapes::icosphere;
     use meshcore::TriMesh;
 
-    /// The shared jittered unit plane ([`testsupport::jittered_unit_plane`]).
-    fn plane(n: usize, jitter: f64, seed: u64) -> TriMesh {
-        testsupport::jittered_unit_plane(n, jitter, seed)
+    /// The shared jittered unit plane of `n` cells a side ([`testsupport::jittered_unit_plane`],
+    /// `n` even), its centre vertex, that vertex's position and the Euclidean distance from it.
+    fn centred_plane(n: usize, jitter: f64, seed: u64) -> (TriMesh, u32, DVec3, Vec<f64>) {
+        let m = testsupport::jittered_unit_plane(n, jitter, seed);
+        let v = (n / 2 * (n + 1) + n / 2) as u32;
+        let c = m.position(v);
+        let u = m.positions().iter().map(|p| (*p - c).length()).collect();
+        (m, v, c, u)
     }
 
     fn parts(k: u64) -> (u32, u32) {
@@ -262,11 +267,8 @@ mod tests {
 
     #[test]
     fn bad_input_is_an_error() {
-        let m = plane(6, 0.0, 1);
+        let (m, v, c, u) = centred_plane(6, 0.0, 1);
         let w = Walker::new(&m);
-        let v = 3 * 7 + 3;
-        let c = m.position(v);
-        let u: Vec<f64> = m.positions().iter().map(|p| (*p - c).length()).collect();
         let opts = PolarOptions {
             step: 0.1,
             levels: 2,
@@ -319,11 +321,8 @@ mod tests {
 
     #[test]
     fn plane_polar_points_are_on_circles_at_their_angles() {
-        let m = plane(30, 0.3, 2);
+        let (m, v, c, u) = centred_plane(30, 0.3, 2);
         let w = Walker::new(&m);
-        let v = 15 * 31 + 15;
-        let c = m.position(v);
-        let u: Vec<f64> = m.positions().iter().map(|p| (*p - c).length()).collect();
         let opts = PolarOptions {
             step: 0.08,
             levels: 4,

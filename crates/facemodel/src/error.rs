@@ -1,6 +1,6 @@
 //! The error type of the crate.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 /// Errors of the face-model loader, the sampler, the face-set loader and the shared-folder
@@ -35,6 +35,16 @@ pub enum FaceModelError {
         /// The `.npy` file.
         path: PathBuf,
         /// What the `.npy` reader found.
+        #[source]
+        source: mesh_io::IoError,
+    },
+    /// The face set's `landmarks.json` is malformed (the message of `mesh-io` names the file
+    /// and what is wrong).
+    #[error("{source}")]
+    Landmarks {
+        /// The landmark file.
+        path: PathBuf,
+        /// What `mesh-io` found.
         #[source]
         source: mesh_io::IoError,
     },
@@ -149,37 +159,35 @@ fn fmt_paths(p: &[PathBuf]) -> String {
 
 impl FaceModelError {
     /// Wraps an error of `mesh_io::read_mesh` on `path`, keeping an OS error as [`Self::Io`].
-    pub(crate) fn mesh(path: &std::path::Path, e: mesh_io::IoError) -> Self {
-        match e {
-            mesh_io::IoError::Io { action, source, .. } => Self::Io {
-                action,
-                path: path.to_path_buf(),
-                source,
-            },
-            e => Self::Mesh {
-                path: path.to_path_buf(),
-                source: e,
-            },
-        }
+    pub(crate) fn mesh(path: &Path, e: mesh_io::IoError) -> Self {
+        Self::wrap(path, e, |path, source| Self::Mesh { path, source })
     }
 
     /// Wraps an error of `mesh_io::read_npy_f32` on `path`, keeping an OS error as [`Self::Io`].
-    pub(crate) fn npy(path: &std::path::Path, e: mesh_io::IoError) -> Self {
+    pub(crate) fn npy(path: &Path, e: mesh_io::IoError) -> Self {
+        Self::wrap(path, e, |path, source| Self::Npy { path, source })
+    }
+
+    /// Wraps an error of `mesh_io::read_ict_landmarks` on `path`, keeping an OS error as
+    /// [`Self::Io`].
+    pub(crate) fn landmarks(path: &Path, e: mesh_io::IoError) -> Self {
+        Self::wrap(path, e, |path, source| Self::Landmarks { path, source })
+    }
+
+    /// An OS error of `mesh-io` as [`Self::Io`], any other as `variant`.
+    fn wrap(
+        path: &Path,
+        e: mesh_io::IoError,
+        variant: impl FnOnce(PathBuf, mesh_io::IoError) -> Self,
+    ) -> Self {
         match e {
-            mesh_io::IoError::Io { action, source, .. } => Self::Io {
-                action,
-                path: path.to_path_buf(),
-                source,
-            },
-            e => Self::Npy {
-                path: path.to_path_buf(),
-                source: e,
-            },
+            mesh_io::IoError::Io { action, source, .. } => Self::io(action, path, source),
+            e => variant(path.to_path_buf(), e),
         }
     }
 
     /// An OS error on `path`.
-    pub(crate) fn io(action: &'static str, path: &std::path::Path, source: std::io::Error) -> Self {
+    pub(crate) fn io(action: &'static str, path: &Path, source: std::io::Error) -> Self {
         Self::Io {
             action,
             path: path.to_path_buf(),
@@ -188,7 +196,7 @@ impl FaceModelError {
     }
 
     /// A content problem of the JSON file `path`.
-    pub(crate) fn json(path: &std::path::Path, problem: impl Into<String>) -> Self {
+    pub(crate) fn json(path: &Path, problem: impl Into<String>) -> Self {
         Self::JsonContent {
             path: path.to_path_buf(),
             problem: problem.into(),

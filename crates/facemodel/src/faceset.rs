@@ -2,8 +2,7 @@
 //! `<shared>/faces/ict-facekit/paper-set`) and its optional `landmarks.json`.
 
 use crate::FaceModelError;
-use meshcore::{DVec3, TriMesh};
-use std::collections::BTreeMap;
+use meshcore::TriMesh;
 use std::path::Path;
 
 /// Vertex id of the right outer eye corner in the ICT face topology (ground truth).
@@ -50,42 +49,6 @@ pub struct Face {
     pub landmarks: FaceLandmarks,
 }
 
-/// Landmark positions per face from `landmarks.json` (`faces.<name>.<landmark> = [x, y, z]`).
-pub fn read_landmark_positions(
-    path: &Path,
-) -> Result<BTreeMap<String, BTreeMap<String, DVec3>>, FaceModelError> {
-    let text = std::fs::read_to_string(path).map_err(|e| FaceModelError::io("read", path, e))?;
-    let v: serde_json::Value = serde_json::from_str(&text).map_err(|e| FaceModelError::Json {
-        path: path.to_path_buf(),
-        source: e,
-    })?;
-    let faces = v
-        .get("faces")
-        .and_then(|f| f.as_object())
-        .ok_or_else(|| FaceModelError::json(path, "no \"faces\" object"))?;
-    let mut out = BTreeMap::new();
-    for (name, lms) in faces {
-        let mut m = BTreeMap::new();
-        if let Some(obj) = lms.as_object() {
-            for (lm, arr) in obj {
-                let a: Vec<f64> = arr
-                    .as_array()
-                    .map(|a| a.iter().filter_map(|x| x.as_f64()).collect())
-                    .unwrap_or_default();
-                if a.len() != 3 {
-                    return Err(FaceModelError::json(
-                        path,
-                        format!("faces.{name}.{lm} is not [x, y, z]"),
-                    ));
-                }
-                m.insert(lm.clone(), DVec3::new(a[0], a[1], a[2]));
-            }
-        }
-        out.insert(name.clone(), m);
-    }
-    Ok(out)
-}
-
 /// Sort key putting `id1_neutral` first, then person 1's expressions, then the other persons.
 fn order_key(name: &str) -> (String, u8, String) {
     let (person, expr) = name.split_once('_').unwrap_or((name, ""));
@@ -121,7 +84,10 @@ pub fn load_face_set(dir: &Path) -> Result<Vec<Face>, FaceModelError> {
     }
     let lm_path = dir.join("landmarks.json");
     let lms = if lm_path.is_file() {
-        Some(read_landmark_positions(&lm_path)?)
+        Some(
+            mesh_io::read_ict_landmarks(&lm_path)
+                .map_err(|e| FaceModelError::landmarks(&lm_path, e))?,
+        )
     } else {
         None
     };
@@ -153,7 +119,7 @@ pub fn load_face_set(dir: &Path) -> Result<Vec<Face>, FaceModelError> {
                 ("nose_tip", landmarks.nose_tip),
             ] {
                 if let Some(p) = m.get(key) {
-                    let d = (mesh.position(v) - *p).length();
+                    let d = (mesh.position(v) - p).length();
                     if d > tol {
                         return Err(FaceModelError::LandmarkMismatch {
                             face: name,
@@ -183,6 +149,7 @@ pub fn load_face_set(dir: &Path) -> Result<Vec<Face>, FaceModelError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use meshcore::DVec3;
     use std::path::PathBuf;
 
     #[test]
@@ -283,13 +250,16 @@ mod tests {
         .unwrap();
         let e = load_face_set(&dir).unwrap_err();
         assert!(
-            e.to_string().contains("faces.a.nose_tip is not [x, y, z]"),
+            matches!(e, FaceModelError::Landmarks { .. })
+                && e.to_string()
+                    .contains("faces.a.nose_tip: expected [x, y, z]")
+                && e.to_string().contains("landmarks.json"),
             "{e}"
         );
         std::fs::write(dir.join("landmarks.json"), "{\"faces\": ").unwrap();
         assert!(matches!(
             load_face_set(&dir),
-            Err(FaceModelError::Json { .. })
+            Err(FaceModelError::Landmarks { .. })
         ));
         std::fs::remove_file(dir.join("landmarks.json")).unwrap();
 

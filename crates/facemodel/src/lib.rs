@@ -8,13 +8,14 @@
 //!   deterministic under a seeded generator); [`random_rigid_motion`] draws a rigid motion as a
 //!   [`meshcore::DAffine3`]; landmark vertex ids and positions.
 //! * [`faceset`]: [`load_face_set`] reads a folder of faces in the ICT topology (the paper set)
-//!   in a stable order and checks them against `landmarks.json`; the ground-truth vertex ids
+//!   in a stable order and checks them against `landmarks.json` (read by
+//!   `mesh_io::read_ict_landmarks`); the ground-truth vertex ids
 //!   [`RIGHT_EYE_OUTER`], [`LEFT_EYE_OUTER`], [`NOSE_TIP`].
 //! * [`frame`]: the landmark-derived [`FaceFrame`] and the static-area vertex mask
 //!   [`static_mask`].
 //!
-//! Every fallible function returns [`FaceModelError`]. Meshes and `.npy` arrays are read with
-//! `mesh-io`.
+//! Every fallible function returns [`FaceModelError`]. Meshes, `.npy` arrays and the landmark
+//! file are read with `mesh-io`.
 
 mod error;
 pub mod faceset;
@@ -23,10 +24,7 @@ pub mod model;
 pub mod shared;
 
 pub use error::FaceModelError;
-pub use faceset::{
-    load_face_set, read_landmark_positions, Face, FaceLandmarks, LEFT_EYE_OUTER, NOSE_TIP,
-    RIGHT_EYE_OUTER,
-};
+pub use faceset::{load_face_set, Face, FaceLandmarks, LEFT_EYE_OUTER, NOSE_TIP, RIGHT_EYE_OUTER};
 pub use frame::{face_frame, static_mask, FaceFrame};
 pub use model::{random_rigid_motion, standard_normal, FaceModel, LANDMARK_NAMES};
 pub use shared::{

@@ -1,5 +1,6 @@
-use crate::{GeodesicError, GeodesicSolver, Method, SolveOptions, Source, TriMesh};
-use std::cmp::Ordering;
+use crate::solver::{seeds, Field, Item};
+use crate::{GeodesicError, Method, Source, TriMesh};
+use glam::DVec3;
 use std::collections::BinaryHeap;
 
 /// Dijkstra's shortest paths on the edge graph, the paper's approximation.
@@ -8,24 +9,10 @@ use std::collections::BinaryHeap;
 /// source starts from the three corners of its face with their straight-line distances.
 #[derive(Debug, Clone)]
 pub struct Dijkstra {
-    positions: Vec<glam::DVec3>,
+    positions: Vec<DVec3>,
     triangles: Vec<[u32; 3]>,
     offsets: Vec<u32>,
     neighbors: Vec<(u32, f64)>,
-}
-
-#[derive(PartialEq)]
-struct Item(f64, u32);
-impl Eq for Item {}
-impl Ord for Item {
-    fn cmp(&self, o: &Self) -> Ordering {
-        o.0.total_cmp(&self.0).then_with(|| o.1.cmp(&self.1))
-    }
-}
-impl PartialOrd for Item {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
 }
 
 impl Dijkstra {
@@ -60,65 +47,12 @@ impl Dijkstra {
     }
 }
 
-/// Validates sources and turns them into (vertex, initial distance) seeds.
-pub(crate) fn seeds(
-    positions: &[glam::DVec3],
-    triangles: &[[u32; 3]],
-    sources: &[Source],
-) -> Result<Vec<(u32, f64)>, GeodesicError> {
-    if sources.is_empty() {
-        return Err(GeodesicError::NoSource);
+impl Field for Dijkstra {
+    const METHOD: Method = Method::Dijkstra;
+    fn positions(&self) -> &[DVec3] {
+        &self.positions
     }
-    let mut out = Vec::new();
-    for s in sources {
-        match *s {
-            Source::Vertex(v) => {
-                if v as usize >= positions.len() {
-                    return Err(GeodesicError::SourceOutOfRange {
-                        vertex: v,
-                        vertices: positions.len(),
-                    });
-                }
-                out.push((v, 0.0));
-            }
-            Source::Point(sp) => {
-                let tri =
-                    triangles
-                        .get(sp.face as usize)
-                        .ok_or(meshcore::MeshError::FaceOutOfRange {
-                            face: sp.face,
-                            faces: triangles.len(),
-                        })?;
-                let b = sp.bary;
-                if !b.is_finite() || b.min_element() < -1e-9 || (b.element_sum() - 1.0).abs() > 1e-9
-                {
-                    return Err(meshcore::MeshError::InvalidBarycentric(b.x, b.y, b.z).into());
-                }
-                let p = b.x * positions[tri[0] as usize]
-                    + b.y * positions[tri[1] as usize]
-                    + b.z * positions[tri[2] as usize];
-                for &v in tri {
-                    out.push((v, (positions[v as usize] - p).length()));
-                }
-            }
-        }
-    }
-    Ok(out)
-}
-
-impl GeodesicSolver for Dijkstra {
-    fn method(&self) -> Method {
-        Method::Dijkstra
-    }
-    fn n_vertices(&self) -> usize {
-        self.positions.len()
-    }
-    fn distances(
-        &self,
-        sources: &[Source],
-        opts: &SolveOptions,
-    ) -> Result<Vec<f64>, GeodesicError> {
-        let cut = opts.cutoff()?;
+    fn field(&self, sources: &[Source], cut: f64) -> Result<Vec<f64>, GeodesicError> {
         let mut dist = vec![f64::INFINITY; self.positions.len()];
         let mut heap = BinaryHeap::new();
         for (v, d) in seeds(&self.positions, &self.triangles, sources)? {
@@ -143,11 +77,6 @@ impl GeodesicSolver for Dijkstra {
                 }
             }
         }
-        if cut.is_finite() {
-            dist.iter_mut()
-                .filter(|d| **d > cut)
-                .for_each(|d| *d = f64::INFINITY);
-        }
         Ok(dist)
     }
 }
@@ -155,7 +84,7 @@ impl GeodesicSolver for Dijkstra {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::DVec3;
+    use crate::{GeodesicSolver, SolveOptions};
 
     #[test]
     fn path_graph_distances() {

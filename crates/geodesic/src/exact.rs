@@ -6,7 +6,7 @@
 //! the lower envelope). Vertices are ordered by `(distance, vertex id)`; see
 //! `shared/docs/exact-geodesics.md` for the algorithm and the soundness argument.
 //!
-//! Besides the [`GeodesicSolver`] trait: [`ExactGeodesic::distances_with_stats`] (also returns
+//! Besides the [`GeodesicSolver`](crate::GeodesicSolver) trait: [`ExactGeodesic::distances_with_stats`] (also returns
 //! the number of window propagations), [`ExactGeodesic::distances_many`] (several source sets
 //! in parallel with rayon) and [`ExactGeodesic::trace_path`] (the shortest path itself, unfolded
 //! back through the windows).
@@ -25,7 +25,8 @@ mod solve;
 mod trace;
 mod window;
 
-use crate::{GeodesicError, GeodesicSolver, Method, SolveOptions, Source, SurfacePoint, TriMesh};
+use crate::solver::Field;
+use crate::{GeodesicError, Method, SolveOptions, Source, SurfacePoint, TriMesh};
 use glam::DVec3;
 use solve::{classify_point, Origin, Pred, Record, Seed, Solve};
 use window::Window;
@@ -132,7 +133,12 @@ impl ExactGeodesic {
         sources: &[Source],
         opts: &SolveOptions,
     ) -> Result<(Vec<f64>, u64), GeodesicError> {
-        let cut = opts.cutoff()?;
+        self.propagate(sources, opts.cutoff()?)
+    }
+
+    /// One propagation from `sources`, stopped past `cut`: the field and the number of window
+    /// propagations.
+    fn propagate(&self, sources: &[Source], cut: f64) -> Result<(Vec<f64>, u64), GeodesicError> {
         let mut s = Solve::new(self, cut, false);
         s.seed(sources)?;
         s.run();
@@ -142,17 +148,13 @@ impl ExactGeodesic {
 
     /// One distance field per source set, solved in parallel with rayon (one independent
     /// propagation per set; results in input order, identical to calling
-    /// [`GeodesicSolver::distances`] for each set).
+    /// [`GeodesicSolver::distances`](crate::GeodesicSolver::distances) for each set).
     pub fn distances_many(
         &self,
         source_sets: &[Vec<Source>],
         opts: &SolveOptions,
     ) -> Result<Vec<Vec<f64>>, GeodesicError> {
-        use rayon::prelude::*;
-        source_sets
-            .par_iter()
-            .map(|s| self.distances(s, opts))
-            .collect()
+        crate::distances_many(self, source_sets, opts)
     }
 
     #[inline]
@@ -190,18 +192,12 @@ fn prev(h: u32) -> u32 {
     }
 }
 
-impl GeodesicSolver for ExactGeodesic {
-    fn method(&self) -> Method {
-        Method::Exact
+impl Field for ExactGeodesic {
+    const METHOD: Method = Method::Exact;
+    fn positions(&self) -> &[DVec3] {
+        &self.positions
     }
-    fn n_vertices(&self) -> usize {
-        self.positions.len()
-    }
-    fn distances(
-        &self,
-        sources: &[Source],
-        opts: &SolveOptions,
-    ) -> Result<Vec<f64>, GeodesicError> {
-        self.distances_with_stats(sources, opts).map(|(d, _)| d)
+    fn field(&self, sources: &[Source], cut: f64) -> Result<Vec<f64>, GeodesicError> {
+        self.propagate(sources, cut).map(|(d, _)| d)
     }
 }

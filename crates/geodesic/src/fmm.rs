@@ -11,11 +11,10 @@
 //! update triangles `(c, a, w)` and `(c, w, b)`. The unfolded strip contains the segment `cw`,
 //! so its (unfolded) length is a real surface path length.
 
-use crate::dijkstra::seeds;
-use crate::{GeodesicError, GeodesicSolver, Method, SolveOptions, Source, TriMesh};
+use crate::solver::{seeds, Field, Item};
+use crate::{GeodesicError, Method, Source, TriMesh};
 use glam::{DVec2, DVec3};
 use meshcore::Topology;
-use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 /// Maximum number of faces unfolded when looking for the split vertex of one obtuse corner.
@@ -103,20 +102,6 @@ pub struct FastMarching {
     /// Obtuse corners found / split successfully (diagnostics).
     n_obtuse: usize,
     n_split: usize,
-}
-
-#[derive(PartialEq)]
-struct Item(f64, u32);
-impl Eq for Item {}
-impl Ord for Item {
-    fn cmp(&self, o: &Self) -> Ordering {
-        o.0.total_cmp(&self.0).then_with(|| o.1.cmp(&self.1))
-    }
-}
-impl PartialOrd for Item {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
 }
 
 /// Third point of a triangle with base `p`, `q` and side lengths `lp = |xp|`, `lq = |xq|`, placed
@@ -706,26 +691,13 @@ impl FastMarching {
     }
 }
 
-impl GeodesicSolver for FastMarching {
-    fn method(&self) -> Method {
-        Method::Fmm
+impl Field for FastMarching {
+    const METHOD: Method = Method::Fmm;
+    fn positions(&self) -> &[DVec3] {
+        &self.positions
     }
-    fn n_vertices(&self) -> usize {
-        self.positions.len()
-    }
-    fn distances(
-        &self,
-        sources: &[Source],
-        opts: &SolveOptions,
-    ) -> Result<Vec<f64>, GeodesicError> {
-        let cut = opts.cutoff()?;
-        let (mut dist, _) = self.march(sources, cut)?;
-        if cut.is_finite() {
-            dist.iter_mut()
-                .filter(|d| **d > cut)
-                .for_each(|d| *d = f64::INFINITY);
-        }
-        Ok(dist)
+    fn field(&self, sources: &[Source], cut: f64) -> Result<Vec<f64>, GeodesicError> {
+        Ok(self.march(sources, cut)?.0)
     }
 }
 
@@ -733,19 +705,24 @@ impl GeodesicSolver for FastMarching {
 mod tests {
     use super::*;
 
+    /// The update triangle with `c = 0`, `a = (1, 0)` and `b` in the upper half-plane.
+    fn unit_tri(b: DVec2) -> UpdTri {
+        UpdTri {
+            a: 0,
+            b: 1,
+            la: 1.0,
+            lb: b.length(),
+            bx: b.x,
+            by: b.y,
+            kg: 0.0,
+        }
+    }
+
     #[test]
     fn planar_update_is_exact_for_plane_waves() {
         // c = 0, a = (1, 0), b = (0, 1); plane wave travelling along direction (1, 1)/sqrt2
         // with zero time on the line x + y = 3.
-        let t = UpdTri {
-            a: 0,
-            b: 1,
-            la: 1.0,
-            lb: 1.0,
-            bx: 0.0,
-            by: 1.0,
-            kg: 0.0,
-        };
+        let t = unit_tri(DVec2::new(0.0, 1.0));
         let time = |x: f64, y: f64| (3.0 - x - y) / 2f64.sqrt();
         let got = update_plane(&t, time(1.0, 0.0), time(0.0, 1.0));
         assert!((got - time(0.0, 0.0)).abs() < 1e-14, "{got}");
@@ -757,15 +734,7 @@ mod tests {
     #[test]
     fn point_update_is_exact_for_point_sources() {
         // c = 0, a = (1, 0), b = (0.3, 0.9); source at (2, 1.5).
-        let t = UpdTri {
-            a: 0,
-            b: 1,
-            la: 1.0,
-            lb: DVec2::new(0.3, 0.9).length(),
-            bx: 0.3,
-            by: 0.9,
-            kg: 0.0,
-        };
+        let t = unit_tri(DVec2::new(0.3, 0.9));
         let s = DVec2::new(2.0, 1.5);
         let ta = (s - DVec2::new(1.0, 0.0)).length();
         let tb = (s - DVec2::new(0.3, 0.9)).length();
@@ -795,15 +764,7 @@ mod tests {
     #[test]
     fn curved_update_is_exact_for_flat_circles_both_ways() {
         // c = 0, a = (1, 0), b = (0.3, 0.9).
-        let t = UpdTri {
-            a: 0,
-            b: 1,
-            la: 1.0,
-            lb: DVec2::new(0.3, 0.9).length(),
-            bx: 0.3,
-            by: 0.9,
-            kg: 0.0,
-        };
+        let t = unit_tri(DVec2::new(0.3, 0.9));
         let (pa, pb) = (DVec2::new(1.0, 0.0), DVec2::new(0.3, 0.9));
         // Diverging from a source behind ab: the point-source update.
         let s = DVec2::new(2.0, 1.5);

@@ -25,7 +25,8 @@
 
 mod factor;
 
-use crate::{GeodesicError, GeodesicSolver, Method, SolveOptions, Source, TriMesh};
+use crate::solver::{seeds, Field};
+use crate::{GeodesicError, Method, Source, TriMesh};
 use factor::Factor;
 use faer::sparse::{Pair, Triplet};
 use glam::DVec3;
@@ -316,7 +317,7 @@ impl HeatMethod {
                 }
                 Source::Point(sp) => {
                     // Validation shared with the other solvers.
-                    crate::dijkstra::seeds(&self.positions, &self.triangles, &[*s])?;
+                    seeds(&self.positions, &self.triangles, &[*s])?;
                     let t = self.triangles[sp.face as usize];
                     for k in 0..3 {
                         out.push((t[k], sp.bary[k].max(0.0)));
@@ -354,19 +355,13 @@ impl HeatMethod {
     }
 }
 
-impl GeodesicSolver for HeatMethod {
-    fn method(&self) -> Method {
-        Method::Heat
+impl Field for HeatMethod {
+    const METHOD: Method = Method::Heat;
+    fn positions(&self) -> &[DVec3] {
+        &self.positions
     }
-    fn n_vertices(&self) -> usize {
-        self.positions.len()
-    }
-    fn distances(
-        &self,
-        sources: &[Source],
-        opts: &SolveOptions,
-    ) -> Result<Vec<f64>, GeodesicError> {
-        let cut = opts.cutoff()?;
+    /// Computes the whole field (the heat method cannot stop early).
+    fn field(&self, sources: &[Source], _cut: f64) -> Result<Vec<f64>, GeodesicError> {
         let n = self.positions.len();
         let weights = self.source_weights(sources)?;
         // 1. Heat flow (internal numbering). The right-hand side is zero before the smallest
@@ -458,10 +453,7 @@ impl GeodesicSolver for HeatMethod {
             if c != u32::MAX {
                 let o = offset[c as usize];
                 if o.is_finite() {
-                    let x = (phi[p] - o).max(0.0);
-                    if x <= cut {
-                        *d = x;
-                    }
+                    *d = (phi[p] - o).max(0.0);
                 }
             }
         }
@@ -478,25 +470,17 @@ impl GeodesicSolver for HeatMethod {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::{GeodesicSolver, SolveOptions};
+    use meshcore::shapes::{grid, Diagonals};
 
     #[test]
     fn flat_disc_with_boundary_is_finite_and_close() {
         let n = 12;
-        let mut p = Vec::new();
-        for j in 0..=n {
-            for i in 0..=n {
-                p.push(DVec3::new(i as f64, j as f64, 0.0));
-            }
-        }
         let idx = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-        let mut t = Vec::new();
-        for j in 0..n {
-            for i in 0..n {
-                t.push([idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)]);
-                t.push([idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)]);
-            }
-        }
-        let m = TriMesh::new(p, t).unwrap();
+        let m = grid(n, n, Diagonals::Uniform, |i, j| {
+            DVec3::new(i as f64, j as f64, 0.0)
+        })
+        .unwrap();
         let h = HeatMethod::new(&m).unwrap();
         assert!(h.heat_dirichlet.is_some());
         for src in [idx(6, 6), idx(0, 3)] {

@@ -23,6 +23,7 @@ mod error;
 mod exact;
 mod fmm;
 mod heat;
+mod solver;
 pub mod straightest;
 
 pub use dijkstra::Dijkstra;
@@ -89,7 +90,8 @@ impl Method {
     }
 }
 
-/// A geodesic distance solver prepared for one mesh.
+/// A geodesic distance solver prepared for one mesh: [`ExactGeodesic`], [`FastMarching`],
+/// [`HeatMethod`] or [`Dijkstra`].
 pub trait GeodesicSolver: Send + Sync + std::fmt::Debug {
     /// Which method this is.
     fn method(&self) -> Method;

@@ -4,7 +4,7 @@
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use meshcore::{DAffine3, DMat3, DQuat, DVec3};
 use shapedist::{
-    icp_to_target, Convergence, Damping, IcpLoopOptions, IcpTarget, IcpVariant, Match,
+    icp_to_target, Convergence, Damping, IcpLoopOptions, IcpVariant, Match, PointTarget,
     ShapeDistError,
 };
 
@@ -126,33 +126,15 @@ pub fn score(
 
 /// The detector's ICP target: partners are the nearest vertices ([`SurfaceIndex::query`]),
 /// with the approximate point-to-surface squared distance and the vertex normals.
-impl IcpTarget for SurfaceIndex {
-    type State = ();
-
-    fn start(&self, _n: usize) -> Self::State {}
-
-    fn has_normals(&self) -> bool {
-        true
-    }
-
-    fn correspond(
-        &self,
-        src: &[DVec3],
-        pose: &DAffine3,
-        _normals: bool,
-        _state: &mut (),
-        out: &mut [Match],
-    ) -> Result<usize, ShapeDistError> {
-        for (o, p) in out.iter_mut().zip(src) {
-            let h = self.query(pose.transform_point3(*p));
-            let v = h.vertex as usize;
-            *o = Match {
-                d2: h.d2,
-                point: self.pos[v],
-                normal: self.nrm[v],
-            };
-        }
-        Ok(src.len())
+impl PointTarget for SurfaceIndex {
+    fn partner(&self, q: DVec3, _normals: bool) -> Result<Match, ShapeDistError> {
+        let h = self.query(q);
+        let v = h.vertex as usize;
+        Ok(Match {
+            d2: h.d2,
+            point: self.pos[v],
+            normal: self.nrm[v],
+        })
     }
 }
 

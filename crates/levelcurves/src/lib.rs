@@ -384,20 +384,9 @@ impl<'a> Extractor<'a> {
             }
         };
 
-        for n in 0..nn as u32 {
-            if degree(n) == 2 {
-                continue;
-            }
-            for k in off[n as usize]..off[n as usize + 1] {
-                let l = adj[k as usize];
-                if used[l as usize] {
-                    continue;
-                }
-                let (ns, fs, closed) = walk(n, l, &mut used);
-                out.push(self.build(&nodes, ns, fs, closed, level_index));
-            }
-        }
-        for n in 0..nn as u32 {
+        // Open curves first, from their end (or branch) nodes; then the closed loops left.
+        let ends = (0..nn as u32).filter(|&n| degree(n) != 2);
+        for n in ends.chain(0..nn as u32) {
             for k in off[n as usize]..off[n as usize + 1] {
                 let l = adj[k as usize];
                 if used[l as usize] {

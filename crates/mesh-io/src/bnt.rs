@@ -260,18 +260,14 @@ pub(crate) fn parse_bnt_grid(bytes: &[u8], file: &str) -> Result<BntGrid, IoErro
 
 /// Reads a `.bnt` file into a grid.
 pub fn read_bnt_grid(path: impl AsRef<Path>) -> Result<BntGrid, IoError> {
-    let path = path.as_ref();
-    let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| IoError::io("read", path, e))?;
-    parse_bnt_grid(&bytes, &name)
+    crate::read_parsed(path.as_ref(), parse_bnt_grid)
 }
 
 /// Reads a `.bnt` file and triangulates it (see [`bnt_grid_to_mesh`]).
 pub fn read_bnt(path: impl AsRef<Path>, options: &BntOptions) -> Result<LoadedMesh, IoError> {
-    let path = path.as_ref();
-    let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| IoError::io("read", path, e))?;
-    read_bnt_bytes(&bytes, &name, options)
+    crate::read_parsed(path.as_ref(), |bytes, name| {
+        read_bnt_bytes(bytes, name, options)
+    })
 }
 
 pub(crate) fn read_bnt_bytes(

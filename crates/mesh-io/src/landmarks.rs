@@ -2,7 +2,7 @@
 //! coordinates), the landmark JSON written by `bipolar landmarks` (or a flat
 //! `{label: [x, y, z]}` object) and the ICT FaceKit `landmarks.json` layout.
 
-use crate::text::{lines, push_f64};
+use crate::text::{lines, next_record, push_xyz};
 use crate::IoError;
 use meshcore::DVec3;
 use std::collections::BTreeMap;
@@ -78,10 +78,13 @@ fn numbers(l: &str) -> Option<Vec<f64>> {
     v.filter(|v| !v.is_empty())
 }
 
-/// Parses an `.lm3` file: finds the line `<N> landmarks:`, then reads N pairs (label line,
-/// `x y z` line), skipping blank lines.
-pub fn parse_lm3(bytes: &[u8], file: &str) -> Result<Landmarks3d, IoError> {
-    let all: Vec<(usize, String)> = lines(bytes)
+/// Numbered, trimmed lines: `(1-based line number, line)`.
+type Lines = Vec<(usize, String)>;
+
+/// The trimmed lines of `.lm3` / `.lm2` text, the index among them of the `<N> landmarks:`
+/// line, and N.
+fn counted_lines(bytes: &[u8], file: &str) -> Result<(Lines, usize, usize), IoError> {
+    let all: Lines = lines(bytes)
         .map(|(n, l)| (n, l.trim().to_string()))
         .collect();
     let (start, n) = all
@@ -89,6 +92,13 @@ pub fn parse_lm3(bytes: &[u8], file: &str) -> Result<Landmarks3d, IoError> {
         .enumerate()
         .find_map(|(k, (_, l))| count_line(l).map(|n| (k, n)))
         .ok_or_else(|| IoError::whole(file, "no '<N> landmarks:' line"))?;
+    Ok((all, start, n))
+}
+
+/// Parses an `.lm3` file: finds the line `<N> landmarks:`, then reads N pairs (label line,
+/// `x y z` line), skipping blank lines.
+pub fn parse_lm3(bytes: &[u8], file: &str) -> Result<Landmarks3d, IoError> {
+    let (all, start, n) = counted_lines(bytes, file)?;
     let count_ln = all[start].0;
     if n > all.len() {
         return Err(IoError::line(
@@ -103,13 +113,7 @@ pub fn parse_lm3(bytes: &[u8], file: &str) -> Result<Landmarks3d, IoError> {
     let mut it = all[start + 1..].iter().filter(|(_, l)| !l.is_empty());
     let mut out = Landmarks3d::default();
     for k in 0..n {
-        let (_, label) = it.next().ok_or_else(|| {
-            IoError::line(
-                file,
-                count_ln,
-                format!("file ends after {k} of {n} landmarks"),
-            )
-        })?;
+        let (_, label) = next_record(&mut it, (file, count_ln), k, n, "landmarks")?;
         let (ln, coords) = it.next().ok_or_else(|| {
             IoError::line(
                 file,
@@ -146,24 +150,14 @@ pub fn parse_lm3(bytes: &[u8], file: &str) -> Result<Landmarks3d, IoError> {
 
 /// Reads an `.lm3` file.
 pub fn read_lm3(path: impl AsRef<Path>) -> Result<Landmarks3d, IoError> {
-    let path = path.as_ref();
-    let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| IoError::io("read", path, e))?;
-    parse_lm3(&bytes, &name)
+    crate::read_parsed(path.as_ref(), parse_lm3)
 }
 
 /// Parses an `.lm2` file: after the `<N> landmarks:` line, the labels are the N non-empty lines
 /// that do not end with `:` and are not two numbers; the coordinates are the N lines that are
 /// exactly two numbers.
 pub fn parse_lm2(bytes: &[u8], file: &str) -> Result<Landmarks2d, IoError> {
-    let all: Vec<(usize, String)> = lines(bytes)
-        .map(|(n, l)| (n, l.trim().to_string()))
-        .collect();
-    let (start, n) = all
-        .iter()
-        .enumerate()
-        .find_map(|(k, (_, l))| count_line(l).map(|n| (k, n)))
-        .ok_or_else(|| IoError::whole(file, "no '<N> landmarks:' line"))?;
+    let (all, start, n) = counted_lines(bytes, file)?;
     let count_ln = all[start].0;
     let mut out = Landmarks2d::default();
     for (ln, l) in &all[start + 1..] {
@@ -203,10 +197,7 @@ pub fn parse_lm2(bytes: &[u8], file: &str) -> Result<Landmarks2d, IoError> {
 
 /// Reads an `.lm2` file.
 pub fn read_lm2(path: impl AsRef<Path>) -> Result<Landmarks2d, IoError> {
-    let path = path.as_ref();
-    let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| IoError::io("read", path, e))?;
-    parse_lm2(&bytes, &name)
+    crate::read_parsed(path.as_ref(), parse_lm2)
 }
 
 /// Writes an `.lm3` file in the Bosphorus layout (coordinates in shortest exact decimal form).
@@ -278,11 +269,7 @@ pub fn write_lm3_with_notes(
     for (l, p) in lm.labels.iter().zip(&lm.points) {
         s.push_str(l);
         s.push('\n');
-        push_f64(&mut s, p.x);
-        s.push(' ');
-        push_f64(&mut s, p.y);
-        s.push(' ');
-        push_f64(&mut s, p.z);
+        push_xyz(&mut s, *p);
         s.push('\n');
     }
     std::fs::write(path, s).map_err(|e| IoError::io("write", path, e))
@@ -432,9 +419,7 @@ pub fn parse_ict_landmarks(
 pub fn read_ict_landmarks(
     path: impl AsRef<Path>,
 ) -> Result<BTreeMap<String, Landmarks3d>, IoError> {
-    let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|e| IoError::io("read", path, e))?;
-    parse_ict_landmarks(&bytes, &path.display().to_string())
+    crate::read_parsed(path.as_ref(), parse_ict_landmarks)
 }
 
 /// Reads any file of labelled 3D landmarks: `.lm3` by extension, otherwise JSON: the ICT
@@ -446,28 +431,28 @@ pub fn read_landmark_file(
     face: Option<&str>,
 ) -> Result<Landmarks3d, IoError> {
     let path = path.as_ref();
-    let name = path.display().to_string();
     if path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("lm3"))
     {
         return read_lm3(path);
     }
-    let bytes = std::fs::read(path).map_err(|e| IoError::io("read", path, e))?;
-    let v = json_value(&bytes, &name)?;
-    if v.get("faces").is_some_and(|f| f.is_object()) {
-        let mut faces = parse_ict_landmarks(&bytes, &name)?;
+    crate::read_parsed(path, |bytes, name| {
+        let v = json_value(bytes, name)?;
+        if !v.get("faces").is_some_and(|f| f.is_object()) {
+            return parse_landmarks_json(bytes, name);
+        }
+        let mut faces = parse_ict_landmarks(bytes, name)?;
         let names: Vec<String> = faces.keys().cloned().collect();
-        return face.and_then(|f| faces.remove(f)).ok_or_else(|| {
+        face.and_then(|f| faces.remove(f)).ok_or_else(|| {
             IoError::whole(
-                &name,
+                name,
                 format!(
                     "no face named {:?} in this ICT landmark file; it has: {}",
                     face.unwrap_or(""),
                     names.join(", ")
                 ),
             )
-        });
-    }
-    parse_landmarks_json(&bytes, &name)
+        })
+    })
 }

@@ -198,29 +198,52 @@ impl LoadedMesh {
 
     /// Checks that the extras have one entry per vertex.
     pub(crate) fn check_extras(&self, file: &str) -> Result<(), IoError> {
-        let n = self.mesh.n_vertices();
-        if let Some(c) = &self.colors {
-            if c.len() != n {
-                return Err(IoError::invalid(
-                    file,
-                    format!("{} colours for {n} vertices", c.len()),
-                ));
-            }
-        }
-        for s in &self.scalars {
-            if s.values.len() != n {
-                return Err(IoError::invalid(
-                    file,
-                    format!(
-                        "scalar {:?} has {} values for {n} vertices",
-                        s.name,
-                        s.values.len()
-                    ),
-                ));
-            }
-        }
-        Ok(())
+        check_extras(
+            file,
+            self.mesh.n_vertices(),
+            self.colors.as_deref(),
+            &self.scalars,
+        )
     }
+}
+
+/// Checks that colours and scalar fields have one entry per each of `n` vertices.
+pub(crate) fn check_extras(
+    file: &str,
+    n: usize,
+    colors: Option<&[[u8; 4]]>,
+    scalars: &[ScalarField],
+) -> Result<(), IoError> {
+    if let Some(c) = colors {
+        if c.len() != n {
+            return Err(IoError::invalid(
+                file,
+                format!("{} colours for {n} vertices", c.len()),
+            ));
+        }
+    }
+    for s in scalars {
+        if s.values.len() != n {
+            return Err(IoError::invalid(
+                file,
+                format!(
+                    "scalar {:?} has {} values for {n} vertices",
+                    s.name,
+                    s.values.len()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Reads the file `path` and hands its bytes and its name (for error messages) to `parse`.
+pub(crate) fn read_parsed<T>(
+    path: &Path,
+    parse: impl FnOnce(&[u8], &str) -> Result<T, IoError>,
+) -> Result<T, IoError> {
+    let bytes = std::fs::read(path).map_err(|e| IoError::io("read", path, e))?;
+    parse(&bytes, &path.display().to_string())
 }
 
 pub use meshcore::repair::{count_degenerate_faces, count_duplicate_vertices};
@@ -247,10 +270,9 @@ pub fn diagnose(mesh: &TriMesh) -> Vec<String> {
 pub fn read_mesh(path: impl AsRef<Path>) -> Result<LoadedMesh, IoError> {
     let path = path.as_ref();
     let format = Format::from_path(path)?;
-    let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| IoError::io("read", path, e))?;
-    let base = path.parent();
-    read_bytes_named(&bytes, format, &name, base)
+    read_parsed(path, |bytes, name| {
+        read_bytes_named(bytes, format, name, path.parent())
+    })
 }
 
 /// Reads a mesh held in memory. For [`Format::Gltf`], only embedded (data URI) buffers can be

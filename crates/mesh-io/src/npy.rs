@@ -6,10 +6,7 @@ use std::path::Path;
 /// Reads an `.npy` array of `<f4` or `<f8` values in C order; returns the shape and the values
 /// as `f32` (float64 data is rounded).
 pub fn read_npy_f32(path: impl AsRef<Path>) -> Result<(Vec<usize>, Vec<f32>), IoError> {
-    let path = path.as_ref();
-    let name = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| IoError::io("read", path, e))?;
-    parse_npy_f32(&bytes, &name)
+    crate::read_parsed(path.as_ref(), parse_npy_f32)
 }
 
 fn dict_value<'a>(header: &'a str, key: &str) -> Option<&'a str> {

@@ -1,6 +1,6 @@
 //! Wavefront OBJ reader (positions and faces; polygons fan-triangulated) and writer.
 
-use crate::text::{lines, parse_f64, push_f64};
+use crate::text::{fan, lines, parse_num, parse_xyz, push_xyz};
 use crate::{finish, IoError, LoadedMesh};
 use meshcore::{DVec3, TriMesh};
 
@@ -15,7 +15,7 @@ pub(crate) fn read_obj(bytes: &[u8], file: &str) -> Result<LoadedMesh, IoError> 
     let mut tris: Vec<[u32; 3]> = Vec::new();
     // For deferred range checks of positive indices: (line, index) of each triangle's source.
     let mut tri_lines: Vec<usize> = Vec::new();
-    let mut corners: Vec<i64> = Vec::new();
+    let mut corners: Vec<u32> = Vec::new();
     let mut n_polygons = 0usize;
     let mut n_lines = 0usize;
     for (ln, line) in lines(bytes) {
@@ -41,15 +41,11 @@ pub(crate) fn read_obj(bytes: &[u8], file: &str) -> Result<LoadedMesh, IoError> 
                         format!("vertex needs 3 coordinates, found {}", vals.len()),
                     ));
                 }
-                let mut it = vals.iter().copied();
-                let x = parse_f64(it.next(), file, ln, "x coordinate")?;
-                let y = parse_f64(it.next(), file, ln, "y coordinate")?;
-                let z = parse_f64(it.next(), file, ln, "z coordinate")?;
-                pos.push(DVec3::new(x, y, z));
+                pos.push(parse_xyz(&mut vals.iter().copied(), file, ln)?);
                 if vals.len() == 6 && all_colored {
                     let mut c = [255u8; 4];
                     for k in 0..3 {
-                        let v = parse_f64(Some(vals[3 + k]), file, ln, "vertex colour")?;
+                        let v: f64 = parse_num(Some(vals[3 + k]), file, ln, "vertex colour")?;
                         c[k] = (v.clamp(0.0, 1.0) * 255.0).round() as u8;
                     }
                     colors.push(c);
@@ -93,22 +89,19 @@ pub(crate) fn read_obj(bytes: &[u8], file: &str) -> Result<LoadedMesh, IoError> 
                             format!("face index {i} is too large"),
                         ));
                     }
-                    corners.push(resolved);
+                    corners.push(resolved as u32);
                 }
-                if corners.len() < 3 {
-                    return Err(IoError::line(
-                        file,
-                        ln,
-                        format!("face has {} corner(s); at least 3 needed", corners.len()),
-                    ));
+                match fan(&corners, &mut tris) {
+                    None => {
+                        return Err(IoError::line(
+                            file,
+                            ln,
+                            format!("face has {} corner(s); at least 3 needed", corners.len()),
+                        ))
+                    }
+                    Some(polygon) => n_polygons += usize::from(polygon),
                 }
-                if corners.len() > 3 {
-                    n_polygons += 1;
-                }
-                for k in 1..corners.len() - 1 {
-                    tris.push([corners[0] as u32, corners[k] as u32, corners[k + 1] as u32]);
-                    tri_lines.push(ln);
-                }
+                tri_lines.resize(tris.len(), ln);
             }
             Some("l") => n_lines += 1,
             _ => {}
@@ -158,11 +151,7 @@ pub(crate) fn write_obj(mesh: &TriMesh) -> Vec<u8> {
     s.push_str("# written by bipolar mesh-io\n");
     for p in mesh.positions() {
         s.push_str("v ");
-        push_f64(&mut s, p.x);
-        s.push(' ');
-        push_f64(&mut s, p.y);
-        s.push(' ');
-        push_f64(&mut s, p.z);
+        push_xyz(&mut s, *p);
         s.push('\n');
     }
     for t in mesh.triangles() {

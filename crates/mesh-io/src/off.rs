@@ -1,6 +1,6 @@
 //! OFF (Object File Format) reader and writer.
 
-use crate::text::{lines, parse_usize, parse_xyz, push_f64};
+use crate::text::{fan, lines, next_record, parse_num, parse_xyz, push_xyz};
 use crate::{finish, IoError, LoadedMesh};
 use meshcore::TriMesh;
 
@@ -40,8 +40,8 @@ pub(crate) fn read_off(bytes: &[u8], file: &str) -> Result<LoadedMesh, IoError> 
         }
     }
     let mut c = toks.iter().copied();
-    let nv = parse_usize(c.next(), file, count_line, "vertex count")?;
-    let nf = parse_usize(c.next(), file, count_line, "face count")?;
+    let nv: usize = parse_num(c.next(), file, count_line, "vertex count")?;
+    let nf: usize = parse_num(c.next(), file, count_line, "face count")?;
     // Each vertex line is at least 6 bytes ("0 0 0\n"), each face at least 8 ("3 0 0 0\n").
     if (nv as u128) * 6 + (nf as u128) * 8 > bytes.len() as u128 + 2 {
         return Err(IoError::line(
@@ -50,29 +50,18 @@ pub(crate) fn read_off(bytes: &[u8], file: &str) -> Result<LoadedMesh, IoError> 
             format!("header claims {nv} vertices and {nf} faces, more than the {} bytes of the file can hold", bytes.len()),
         ));
     }
+    let counts = (file, count_line);
     let mut pos = Vec::with_capacity(nv);
     for k in 0..nv {
-        let (ln, l) = it.next().ok_or_else(|| {
-            IoError::line(
-                file,
-                count_line,
-                format!("file ends after {k} of {nv} vertices"),
-            )
-        })?;
+        let (ln, l) = next_record(&mut it, counts, k, nv, "vertices")?;
         pos.push(parse_xyz(&mut l.split_ascii_whitespace(), file, ln)?);
     }
     let mut tris = Vec::with_capacity(nf);
     let mut n_poly = 0;
     for k in 0..nf {
-        let (ln, l) = it.next().ok_or_else(|| {
-            IoError::line(
-                file,
-                count_line,
-                format!("file ends after {k} of {nf} faces"),
-            )
-        })?;
+        let (ln, l) = next_record(&mut it, counts, k, nf, "faces")?;
         let mut t = l.split_ascii_whitespace();
-        let deg = parse_usize(t.next(), file, ln, "face size")?;
+        let deg: usize = parse_num(t.next(), file, ln, "face size")?;
         if deg < 3 {
             return Err(IoError::line(
                 file,
@@ -80,12 +69,9 @@ pub(crate) fn read_off(bytes: &[u8], file: &str) -> Result<LoadedMesh, IoError> 
                 format!("face with {deg} corner(s)"),
             ));
         }
-        if deg > 3 {
-            n_poly += 1;
-        }
         let mut c = Vec::with_capacity(deg.min(64));
         for _ in 0..deg {
-            let i = parse_usize(t.next(), file, ln, "vertex index")?;
+            let i: usize = parse_num(t.next(), file, ln, "vertex index")?;
             if i >= nv {
                 return Err(IoError::line(
                     file,
@@ -95,8 +81,8 @@ pub(crate) fn read_off(bytes: &[u8], file: &str) -> Result<LoadedMesh, IoError> 
             }
             c.push(i as u32);
         }
-        for j in 1..deg - 1 {
-            tris.push([c[0], c[j], c[j + 1]]);
+        if fan(&c, &mut tris) == Some(true) {
+            n_poly += 1;
         }
     }
     if let Some((ln, l)) = it.next() {
@@ -122,11 +108,7 @@ pub(crate) fn write_off(mesh: &TriMesh) -> Vec<u8> {
     use std::fmt::Write;
     let mut s = format!("OFF\n{} {} 0\n", mesh.n_vertices(), mesh.n_faces());
     for p in mesh.positions() {
-        push_f64(&mut s, p.x);
-        s.push(' ');
-        push_f64(&mut s, p.y);
-        s.push(' ');
-        push_f64(&mut s, p.z);
+        push_xyz(&mut s, *p);
         s.push('\n');
     }
     for t in mesh.triangles() {

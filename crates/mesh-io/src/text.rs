@@ -24,18 +24,40 @@ pub(crate) fn lines(bytes: &[u8]) -> impl Iterator<Item = (usize, std::borrow::C
     })
 }
 
-/// Parses a finite f64, with an error naming `what`, the file and the line.
-pub(crate) fn parse_f64(
+/// A number type of the text formats and the words its parse error uses.
+pub(crate) trait Number: std::str::FromStr + Copy {
+    /// What a token of this type is ("a number").
+    const KIND: &'static str;
+    /// Whether a parsed value is acceptable (floats: finite).
+    fn acceptable(self) -> bool {
+        true
+    }
+}
+
+impl Number for f64 {
+    const KIND: &'static str = "a number";
+    fn acceptable(self) -> bool {
+        self.is_finite()
+    }
+}
+
+impl Number for usize {
+    const KIND: &'static str = "a non-negative integer";
+}
+
+/// Parses a number (a finite `f64`, a `usize`), with an error naming `what`, the file and the
+/// line.
+pub(crate) fn parse_num<T: Number>(
     tok: Option<&str>,
     file: &str,
     line: usize,
     what: &str,
-) -> Result<f64, IoError> {
+) -> Result<T, IoError> {
     let tok = tok.ok_or_else(|| IoError::line(file, line, format!("missing {what}")))?;
-    let v: f64 = tok
+    let v: T = tok
         .parse()
-        .map_err(|_| IoError::line(file, line, format!("{what}: {tok:?} is not a number")))?;
-    if !v.is_finite() {
+        .map_err(|_| IoError::line(file, line, format!("{what}: {tok:?} is not {}", T::KIND)))?;
+    if !v.acceptable() {
         return Err(IoError::line(
             file,
             line,
@@ -45,21 +67,34 @@ pub(crate) fn parse_f64(
     Ok(v)
 }
 
-/// Parses an unsigned integer, with an error naming `what`, the file and the line.
-pub(crate) fn parse_usize(
-    tok: Option<&str>,
-    file: &str,
-    line: usize,
+/// The next of the `n` records (`what`: "vertices", "landmarks") that the line `count_line`
+/// announced, `k` of them read so far, or an error saying where the file ended.
+pub(crate) fn next_record<T>(
+    it: &mut impl Iterator<Item = T>,
+    (file, count_line): (&str, usize),
+    k: usize,
+    n: usize,
     what: &str,
-) -> Result<usize, IoError> {
-    let tok = tok.ok_or_else(|| IoError::line(file, line, format!("missing {what}")))?;
-    tok.parse().map_err(|_| {
+) -> Result<T, IoError> {
+    it.next().ok_or_else(|| {
         IoError::line(
             file,
-            line,
-            format!("{what}: {tok:?} is not a non-negative integer"),
+            count_line,
+            format!("file ends after {k} of {n} {what}"),
         )
     })
+}
+
+/// Fan-triangulates a face from its first corner onto `tris`: `None` (nothing added) when it
+/// has fewer than 3 corners, else whether it was a polygon (more than 3).
+pub(crate) fn fan(corners: &[u32], tris: &mut Vec<[u32; 3]>) -> Option<bool> {
+    if corners.len() < 3 {
+        return None;
+    }
+    for k in 1..corners.len() - 1 {
+        tris.push([corners[0], corners[k], corners[k + 1]]);
+    }
+    Some(corners.len() > 3)
 }
 
 /// Parses three finite coordinates.
@@ -68,9 +103,9 @@ pub(crate) fn parse_xyz<'a>(
     file: &str,
     line: usize,
 ) -> Result<meshcore::DVec3, IoError> {
-    let x = parse_f64(toks.next(), file, line, "x coordinate")?;
-    let y = parse_f64(toks.next(), file, line, "y coordinate")?;
-    let z = parse_f64(toks.next(), file, line, "z coordinate")?;
+    let x = parse_num(toks.next(), file, line, "x coordinate")?;
+    let y = parse_num(toks.next(), file, line, "y coordinate")?;
+    let z = parse_num(toks.next(), file, line, "z coordinate")?;
     Ok(meshcore::DVec3::new(x, y, z))
 }
 
@@ -78,4 +113,13 @@ pub(crate) fn parse_xyz<'a>(
 pub(crate) fn push_f64(out: &mut String, v: f64) {
     use std::fmt::Write;
     let _ = write!(out, "{v:?}");
+}
+
+/// Appends `x y z`, each by [`push_f64`].
+pub(crate) fn push_xyz(out: &mut String, p: meshcore::DVec3) {
+    push_f64(out, p.x);
+    out.push(' ');
+    push_f64(out, p.y);
+    out.push(' ');
+    push_f64(out, p.z);
 }

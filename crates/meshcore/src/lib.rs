@@ -4,6 +4,7 @@
 //!   (non-empty, finite coordinates, indices in range).
 //! * [`Topology`]: adjacency built once (vertex-face incidence, unique edges with their faces,
 //!   boundary loops, connected components, manifold and orientation checks); read-only.
+//! * [`VertexAdjacency`]: the sorted one-ring of every vertex (CSR), from the triangles.
 //! * [`Surface`]: a mesh with its topology, built together (what APIs needing both take).
 //! * [`SurfacePoint`]: a point on the surface as (face, barycentric coordinates), with conversion
 //!   to a position and [`FaceLocator`] for the nearest surface point to an arbitrary 3D point.
@@ -16,6 +17,7 @@
 //!
 //! Nothing here panics on user data: constructors return [`MeshError`].
 
+mod adjacency;
 pub mod choice;
 mod error;
 pub mod linalg;
@@ -27,6 +29,7 @@ mod surface;
 mod topology;
 pub mod units;
 
+pub use adjacency::VertexAdjacency;
 pub use choice::{Choice, UnknownChoice};
 pub use error::MeshError;
 pub use glam::{DAffine3, DMat3, DQuat, DVec3};

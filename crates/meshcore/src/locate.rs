@@ -239,22 +239,11 @@ mod tests {
     }
 
     fn bumpy(n: usize) -> TriMesh {
-        let mut p = Vec::new();
-        for j in 0..=n {
-            for i in 0..=n {
-                let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
-                p.push(DVec3::new(x, y, 0.2 * (6.0 * x).sin() * (5.0 * y).cos()));
-            }
-        }
-        let idx = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-        let mut t = Vec::new();
-        for j in 0..n {
-            for i in 0..n {
-                t.push([idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)]);
-                t.push([idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)]);
-            }
-        }
-        TriMesh::new(p, t).unwrap()
+        crate::shapes::grid(n, n, crate::shapes::Diagonals::Uniform, |i, j| {
+            let (x, y) = (i as f64 / n as f64, j as f64 / n as f64);
+            DVec3::new(x, y, 0.2 * (6.0 * x).sin() * (5.0 * y).cos())
+        })
+        .unwrap()
     }
 
     #[test]

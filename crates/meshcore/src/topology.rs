@@ -355,21 +355,10 @@ mod tests {
     use glam::DVec3;
 
     fn grid(nx: usize, ny: usize) -> TriMesh {
-        let mut p = Vec::new();
-        for j in 0..=ny {
-            for i in 0..=nx {
-                p.push(DVec3::new(i as f64, j as f64, 0.0));
-            }
-        }
-        let idx = |i: usize, j: usize| (j * (nx + 1) + i) as u32;
-        let mut t = Vec::new();
-        for j in 0..ny {
-            for i in 0..nx {
-                t.push([idx(i, j), idx(i + 1, j), idx(i + 1, j + 1)]);
-                t.push([idx(i, j), idx(i + 1, j + 1), idx(i, j + 1)]);
-            }
-        }
-        TriMesh::new(p, t).unwrap()
+        crate::shapes::grid(nx, ny, crate::shapes::Diagonals::Uniform, |i, j| {
+            DVec3::new(i as f64, j as f64, 0.0)
+        })
+        .unwrap()
     }
 
     #[test]

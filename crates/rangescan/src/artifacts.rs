@@ -134,64 +134,66 @@ impl Artifacts {
 
     /// Checks every part's sizes.
     pub fn validate(&self) -> Result<(), ScanError> {
-        let bad = |what: &str, v: f64, range: &str| {
-            Err(ScanError::InvalidOption(format!(
-                "{what} = {v} (expected {range})"
-            )))
-        };
-        let in_range = |v: f64, lo: f64, hi: f64| v.is_finite() && v >= lo && v <= hi;
-        if let Some(n) = self.noise {
-            if !in_range(n.sigma_mm, 0.0, 50.0) {
-                return bad("noise sigma_mm", n.sigma_mm, "0 to 50");
+        // `what` must lie in `[lo, hi]` (and be finite); the error names the expected `range`.
+        let check = |what: &str, v: f64, (lo, hi): (f64, f64), range: &str| {
+            if v.is_finite() && v >= lo && v <= hi {
+                Ok(())
+            } else {
+                Err(ScanError::InvalidOption(format!(
+                    "{what} = {v} (expected {range})"
+                )))
             }
+        };
+        if let Some(n) = self.noise {
+            check("noise sigma_mm", n.sigma_mm, (0.0, 50.0), "0 to 50")?;
         }
         if let Some(q) = self.quantisation {
-            if !(in_range(q.step_mm, 0.0, 100.0) && q.step_mm > 0.0) {
-                return bad(
-                    "quantisation step_mm",
-                    q.step_mm,
-                    "greater than 0, at most 100",
-                );
-            }
+            // From the smallest positive f64: greater than 0.
+            let range = (f64::from_bits(1), 100.0);
+            check(
+                "quantisation step_mm",
+                q.step_mm,
+                range,
+                "greater than 0, at most 100",
+            )?;
         }
         if let Some(s) = self.spikes {
-            if !in_range(s.fraction, 0.0, 1.0) {
-                return bad("spikes fraction", s.fraction, "0 to 1");
-            }
-            if !in_range(s.min_mm, 0.0, 1e4) {
-                return bad("spikes min_mm", s.min_mm, "0 to 10000");
-            }
-            if !in_range(s.max_mm, s.min_mm, 1e4) {
-                return bad("spikes max_mm", s.max_mm, "min_mm to 10000");
-            }
+            check("spikes fraction", s.fraction, (0.0, 1.0), "0 to 1")?;
+            check("spikes min_mm", s.min_mm, (0.0, 1e4), "0 to 10000")?;
+            check(
+                "spikes max_mm",
+                s.max_mm,
+                (s.min_mm, 1e4),
+                "min_mm to 10000",
+            )?;
         }
         if let Some(o) = self.outliers {
-            if o.count > 10_000_000 {
-                return bad("outliers count", o.count as f64, "at most 10^7");
-            }
+            check("outliers count", o.count as f64, (0.0, 1e7), "at most 10^7")?;
         }
         if let Some(g) = self.grazing {
-            if !in_range(g.start_deg, 0.0, 90.0) {
-                return bad("grazing start_deg", g.start_deg, "0 to 90");
-            }
-            if !in_range(g.full_deg, g.start_deg, 90.0) {
-                return bad("grazing full_deg", g.full_deg, "start_deg to 90");
-            }
+            check("grazing start_deg", g.start_deg, (0.0, 90.0), "0 to 90")?;
+            check(
+                "grazing full_deg",
+                g.full_deg,
+                (g.start_deg, 90.0),
+                "start_deg to 90",
+            )?;
         }
         if let Some(h) = self.holes {
-            if h.count > 10_000 {
-                return bad("holes count", h.count as f64, "at most 10000");
-            }
-            if !in_range(h.min_radius_mm, 0.0, 1e4) {
-                return bad("holes min_radius_mm", h.min_radius_mm, "0 to 10000");
-            }
-            if !in_range(h.max_radius_mm, h.min_radius_mm, 1e4) {
-                return bad(
-                    "holes max_radius_mm",
-                    h.max_radius_mm,
-                    "min_radius_mm to 10000",
-                );
-            }
+            check("holes count", h.count as f64, (0.0, 1e4), "at most 10000")?;
+            check(
+                "holes min_radius_mm",
+                h.min_radius_mm,
+                (0.0, 1e4),
+                "0 to 10000",
+            )?;
+            let range = (h.min_radius_mm, 1e4);
+            check(
+                "holes max_radius_mm",
+                h.max_radius_mm,
+                range,
+                "min_radius_mm to 10000",
+            )?;
         }
         if let Some(b) = self.border {
             for (what, v) in [
@@ -200,9 +202,7 @@ impl Artifacts {
                 ("border left_mm", b.left_mm),
                 ("border right_mm", b.right_mm),
             ] {
-                if !in_range(v, 0.0, 1e5) {
-                    return bad(what, v, "0 to 100000");
-                }
+                check(what, v, (0.0, 1e5), "0 to 100000")?;
             }
         }
         Ok(())

@@ -64,7 +64,7 @@ pub fn check_grid(grid: &BntGrid, min_coverage: f64) -> Result<GridCheck, ScanPr
             });
         }
     }
-    let valid: Vec<bool> = (0..n).map(|i| grid.is_valid(i)).collect();
+    let (_, _, valid) = valid_mask(grid);
     let n_valid = valid.iter().filter(|&&v| v).count();
     if n_valid == 0 {
         return Err(ScanPrepError::Empty(
@@ -109,6 +109,14 @@ fn silhouette(valid: &[bool], nr: usize, nc: usize) -> Vec<bool> {
         }
     }
     out
+}
+
+/// The grid's rows, columns and per-sample validity (row-major).
+fn valid_mask(grid: &BntGrid) -> (usize, usize, Vec<bool>) {
+    let valid = (0..grid.nrows * grid.ncols)
+        .map(|i| grid.is_valid(i))
+        .collect();
+    (grid.nrows, grid.ncols, valid)
 }
 
 /// Median 3D distance between valid 4-neighbouring samples; `None` when there is no such pair.
@@ -200,9 +208,8 @@ pub fn remove_grid_spikes(
             )));
         }
     }
-    let (nr, nc) = (grid.nrows, grid.ncols);
+    let (nr, nc, valid) = valid_mask(grid);
     let n = nr * nc;
-    let valid: Vec<bool> = (0..n).map(|i| grid.is_valid(i)).collect();
     let thr = grid_spacing(grid).map(|s| o.threshold_spacings * s);
     let w = o.window_radius as isize;
     let at = |r: usize, c: usize, dr: isize, dc: isize| -> Option<usize> {
@@ -304,9 +311,8 @@ pub fn fill_grid_holes(
             "max hole diameter {max_diameter_mm} mm (expected a finite value >= 0)"
         )));
     }
-    let (nr, nc) = (grid.nrows, grid.ncols);
+    let (nr, nc, valid) = valid_mask(grid);
     let n = nr * nc;
-    let valid: Vec<bool> = (0..n).map(|i| grid.is_valid(i)).collect();
     let mut label = vec![u32::MAX; n];
     let mut holes = Vec::new();
     let mut stack = Vec::new();

@@ -1,7 +1,7 @@
 //! Steps on a triangle mesh (mm): spikes, small components, hole filling, cropping, smoothing.
 
 use crate::{Hole, ScanPrepError};
-use meshcore::{DVec3, Topology, TriMesh};
+use meshcore::{DVec3, Topology, TriMesh, VertexAdjacency};
 
 /// Rebuilds a mesh from positions and the triangles kept, dropping the vertices no triangle
 /// uses (the others keep their order). Returns the mesh and, per old vertex, its new index
@@ -71,25 +71,6 @@ pub fn remove_small_components(
     Ok((m, removed_c, removed_v))
 }
 
-/// Vertex neighbours (sorted, unique) from the mesh's triangles.
-pub(crate) fn neighbours(mesh: &TriMesh) -> Vec<Vec<u32>> {
-    let mut nb = vec![Vec::new(); mesh.n_vertices()];
-    for t in mesh.triangles() {
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
-            if a != b {
-                nb[a as usize].push(b);
-                nb[b as usize].push(a);
-            }
-        }
-    }
-    for l in &mut nb {
-        l.sort_unstable();
-        l.dedup();
-    }
-    nb
-}
-
 /// Vertices on a boundary edge (an edge with exactly one face) or a non-manifold one.
 pub(crate) fn boundary_vertices(mesh: &TriMesh, topo: &Topology) -> Vec<bool> {
     let mut b = vec![false; mesh.n_vertices()];
@@ -114,7 +95,7 @@ pub fn remove_mesh_spikes(mesh: &TriMesh, factor: f64) -> Result<(TriMesh, usize
         )));
     }
     let p = mesh.positions();
-    let nb = neighbours(mesh);
+    let nb = VertexAdjacency::new(mesh);
     let mut spike = vec![false; p.len()];
     for (v, l) in nb.iter().enumerate() {
         if l.len() < 3 {
@@ -124,7 +105,7 @@ pub fn remove_mesh_spikes(mesh: &TriMesh, factor: f64) -> Result<(TriMesh, usize
         // Mean length of the ring edges: edges between two neighbours of v.
         let (mut sum, mut cnt) = (0.0, 0usize);
         for &a in l {
-            for &b in &nb[a as usize] {
+            for &b in nb.neighbours(a) {
                 if b > a && l.binary_search(&b).is_ok() {
                     sum += (p[a as usize] - p[b as usize]).length();
                     cnt += 1;
@@ -275,7 +256,7 @@ pub fn taubin_smooth(mesh: &TriMesh, iterations: usize) -> Result<TriMesh, ScanP
     }
     let topo = Topology::new(mesh);
     let fixed = boundary_vertices(mesh, &topo);
-    let nb = neighbours(mesh);
+    let nb = VertexAdjacency::new(mesh);
     let mut p = mesh.positions().to_vec();
     let mut next = p.clone();
     for _ in 0..iterations {

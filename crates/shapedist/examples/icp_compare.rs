@@ -200,55 +200,57 @@ fn main() {
         if only_plain {
             continue;
         }
-        let sched = IcpOptions {
-            max_iterations: 10,
-            tolerance: 0.0,
-            coarse_iterations: 40,
-            ..Default::default()
-        };
-        let (ms, res) = median_ms(reps, || icp(&a, &b, DMat3::IDENTITY, &sched).unwrap());
-        row(
-            "shapedist p2p, 40 it @500 + 10 it @all",
-            ms,
-            format!("{}+{}", res.coarse_iterations, res.iterations),
-            res.motion.matrix3,
-        );
-        let sched2 = IcpOptions {
-            max_iterations: 50,
-            tolerance: 1e-6,
-            coarse_iterations: 50,
-            ..Default::default()
-        };
-        let (ms, res) = median_ms(reps, || icp(&a, &b, DMat3::IDENTITY, &sched2).unwrap());
-        row(
-            "shapedist p2p, <=50 it @500 + <=50 it @all, tol 1e-6",
-            ms,
-            format!("{}+{}", res.coarse_iterations, res.iterations),
-            res.motion.matrix3,
-        );
-        let conv = IcpOptions {
-            max_iterations: 500,
-            ..Default::default()
-        };
-        let (ms, res) = median_ms(reps, || icp(&a, &b, DMat3::IDENTITY, &conv).unwrap());
-        row(
-            "shapedist p2p, <=500 it, tol 1e-6",
-            ms,
-            res.iterations.to_string(),
-            res.motion.matrix3,
-        );
-        let plane = IcpOptions {
-            variant: IcpVariant::PointToPlane,
-            ..Default::default()
-        };
-        let _ = a.normals();
-        let (ms, res) = median_ms(reps, || icp(&a, &b, DMat3::IDENTITY, &plane).unwrap());
-        row(
-            "shapedist point-to-plane <=50 (normals not timed)",
-            ms,
-            res.iterations.to_string(),
-            res.motion.matrix3,
-        );
+        // (row name, options, whether the iterations column shows coarse + fine)
+        let runs = [
+            (
+                "shapedist p2p, 40 it @500 + 10 it @all",
+                IcpOptions {
+                    max_iterations: 10,
+                    tolerance: 0.0,
+                    coarse_iterations: 40,
+                    ..Default::default()
+                },
+                true,
+            ),
+            (
+                "shapedist p2p, <=50 it @500 + <=50 it @all, tol 1e-6",
+                IcpOptions {
+                    max_iterations: 50,
+                    tolerance: 1e-6,
+                    coarse_iterations: 50,
+                    ..Default::default()
+                },
+                true,
+            ),
+            (
+                "shapedist p2p, <=500 it, tol 1e-6",
+                IcpOptions {
+                    max_iterations: 500,
+                    ..Default::default()
+                },
+                false,
+            ),
+            (
+                "shapedist point-to-plane <=50 (normals not timed)",
+                IcpOptions {
+                    variant: IcpVariant::PointToPlane,
+                    ..Default::default()
+                },
+                false,
+            ),
+        ];
+        for (name, o, coarse) in &runs {
+            if o.variant == IcpVariant::PointToPlane {
+                let _ = a.normals();
+            }
+            let (ms, res) = median_ms(reps, || icp(&a, &b, DMat3::IDENTITY, o).unwrap());
+            let iters = if *coarse {
+                format!("{}+{}", res.coarse_iterations, res.iterations)
+            } else {
+                res.iterations.to_string()
+            };
+            row(name, ms, iters, res.motion.matrix3);
+        }
         for (name, g) in [
             (
                 "shapedist global (28 starts@500 + p2p refine <=100)",

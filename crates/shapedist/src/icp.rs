@@ -289,19 +289,21 @@ const BACKOFF: u8 = 3;
 /// a previous partner, the partner of the preceding source point: the source is in a
 /// spatially coherent order). Seeds only bound the search, the result is the same exact
 /// minimum. Returns the number of tree queries.
-#[allow(clippy::too_many_arguments)]
 #[inline]
 fn correspond_chunk(
-    tree: &PointTree,
-    graph: Option<&NeighbourGraph>,
-    tgt: &[DVec3],
+    pass: &Pass<'_>,
     src: &[DVec3],
-    r: DMat3,
-    t: DVec3,
     out: &mut [(f64, u32)],
     skip: &mut [u8],
-    warm: bool,
 ) -> usize {
+    let Pass {
+        tree,
+        graph,
+        tgt,
+        r,
+        t,
+        warm,
+    } = *pass;
     let mut prev = NONE;
     let mut queries = 0;
     let mut ps = [DVec3::ZERO; GROUP];
@@ -351,23 +353,29 @@ fn correspond_chunk(
     queries
 }
 
-/// Correspondences of all source points (see [`correspond_chunk`]), chunk by chunk (in
-/// parallel when `parallel`); returns the number of tree queries.
-#[allow(clippy::too_many_arguments)]
-fn correspond(
-    tree: &PointTree,
-    graph: Option<&NeighbourGraph>,
-    tgt: &[DVec3],
-    src: &[DVec3],
+/// What the chunks of one correspondence pass share: the target's tree, neighbour graph and
+/// points, the source pose `(r, t)`, and whether `out` holds the previous partners.
+#[derive(Clone, Copy)]
+struct Pass<'a> {
+    tree: &'a PointTree,
+    graph: Option<&'a NeighbourGraph>,
+    tgt: &'a [DVec3],
     r: DMat3,
     t: DVec3,
+    warm: bool,
+}
+
+/// Correspondences of all source points (see [`correspond_chunk`]), chunk by chunk (in
+/// parallel when `parallel`); returns the number of tree queries.
+fn correspond(
+    pass: &Pass<'_>,
+    src: &[DVec3],
     out: &mut [(f64, u32)],
     skip: &mut [u8],
     parallel: bool,
-    warm: bool,
 ) -> usize {
     type Part<'a> = ((&'a mut [(f64, u32)], &'a mut [u8]), &'a [DVec3]);
-    let run = |((o, k), s): Part<'_>| correspond_chunk(tree, graph, tgt, s, r, t, o, k, warm);
+    let run = |((o, k), s): Part<'_>| correspond_chunk(pass, s, o, k);
     if parallel {
         out.par_chunks_mut(CHUNK)
             .zip(skip.par_chunks_mut(CHUNK))
@@ -435,18 +443,15 @@ impl IcpTarget for SetTarget<'_> {
     ) -> Result<usize, ShapeDistError> {
         let (pts, tree, graph) = self.parts();
         let parallel = !self.sub && src.len() >= PAR_MIN;
-        let nq = correspond(
+        let pass = Pass {
             tree,
-            Some(graph),
-            pts,
-            src,
-            pose.matrix3,
-            pose.translation,
-            &mut st.corr,
-            &mut st.skip,
-            parallel,
-            st.warm,
-        );
+            graph: Some(graph),
+            tgt: pts,
+            r: pose.matrix3,
+            t: pose.translation,
+            warm: st.warm,
+        };
+        let nq = correspond(&pass, src, &mut st.corr, &mut st.skip, parallel);
         st.warm = true;
         let nrm = (normals && !self.sub).then(|| self.set.normals());
         for (o, c) in out.iter_mut().zip(&st.corr) {

@@ -49,7 +49,8 @@ pub use keyed::{
 };
 pub use matrix::{pairwise_matrix, write_matrix_csv, PairError};
 pub use target::{
-    icp_to_target, Convergence, Damping, IcpLoopOptions, IcpTarget, Match, TrimRounding,
+    icp_to_target, Convergence, Damping, IcpLoopOptions, IcpTarget, Match, PointTarget,
+    TrimRounding,
 };
 
 /// Result of [`icp_distance`]: the global alignment and the closest-point distances after it.

@@ -101,25 +101,16 @@ fn max(a: f64, b: f64) -> f64 {
     }
 }
 
+/// Squared distance of `q` to the box `[lo, hi]` (the box-box formula with a point box).
 #[inline(always)]
 fn box_dist2(lo: DVec3, hi: DVec3, q: DVec3) -> f64 {
-    let gx = max(max(lo.x - q.x, q.x - hi.x), 0.0);
-    let gy = max(max(lo.y - q.y, q.y - hi.y), 0.0);
-    let gz = max(max(lo.z - q.z, q.z - hi.z), 0.0);
-    gx * gx + gy * gy + gz * gz
+    box_box_dist2(lo, hi, q, q)
 }
 
 /// Squared distances of `q` to the two child boxes of `n` (same formula as [`box_dist2`]).
 #[inline(always)]
 fn child_dist2(n: &Inner, q: [f64; 3]) -> [f64; 2] {
-    let mut acc = [0.0; 2];
-    for k in 0..3 {
-        for c in 0..2 {
-            let g = max(max(n.lo[k][c] - q[k], q[k] - n.hi[k][c]), 0.0);
-            acc[c] = if k == 0 { g * g } else { acc[c] + g * g };
-        }
-    }
-    acc
+    child_box_dist2(n, q, q)
 }
 
 /// Squared distance between the boxes `[lo, hi]` and `[glo, ghi]` (a lower bound of
@@ -143,6 +134,45 @@ fn child_box_dist2(n: &Inner, gl: [f64; 3], gh: [f64; 3]) -> [f64; 2] {
         }
     }
     acc
+}
+
+/// The subtrees a depth-first tree walk has put aside, `(node, squared box distance)`: at most
+/// 64, a push onto a full stack is ignored.
+struct Pending {
+    items: [(u32, f64); 64],
+    len: usize,
+}
+
+impl Pending {
+    #[inline(always)]
+    fn new() -> Self {
+        Self {
+            items: [(0, 0.0); 64],
+            len: 0,
+        }
+    }
+
+    #[inline(always)]
+    fn push(&mut self, node: u32, d2: f64) {
+        if self.len < self.items.len() {
+            self.items[self.len] = (node, d2);
+            self.len += 1;
+        }
+    }
+
+    /// The most recently put aside subtree within `bound`, dropping those beyond it; `None`
+    /// when none is left.
+    #[inline(always)]
+    fn pop_within(&mut self, bound: f64) -> Option<u32> {
+        while self.len > 0 {
+            self.len -= 1;
+            let (node, d2) = self.items[self.len];
+            if d2 <= bound {
+                return Some(node);
+            }
+        }
+        None
+    }
 }
 
 /// `(d, id)` precedes `(bd, bid)` in the lexicographic order of the answer.
@@ -277,8 +307,7 @@ impl PointTree {
         }
         let qa = q.to_array();
         let mut buf: Scratch = [[0.0; LANES]; LEAF_SIZE / LANES + 1];
-        let mut stack: [(u32, f64); 64] = [(0, 0.0); 64];
-        let mut sp = 0usize;
+        let mut stack = Pending::new();
         let mut cur = self.root;
         loop {
             // `cur` is a node whose box is within the best distance.
@@ -290,25 +319,17 @@ impl PointTree {
                 let d = child_dist2(n, qa);
                 let (f, s) = if d[0] <= d[1] { (0, 1) } else { (1, 0) };
                 if d[f] <= best.0 {
-                    if d[s] <= best.0 && sp < stack.len() {
-                        stack[sp] = (n.child[s], d[s]);
-                        sp += 1;
+                    if d[s] <= best.0 {
+                        stack.push(n.child[s], d[s]);
                     }
                     cur = n.child[f];
                     continue;
                 }
             }
-            // Pop the next subtree still within the best distance.
-            loop {
-                if sp == 0 {
-                    return;
-                }
-                sp -= 1;
-                let (c, dc) = stack[sp];
-                if dc <= best.0 {
-                    cur = c;
-                    break;
-                }
+            // The next subtree still within the best distance.
+            match stack.pop_within(best.0) {
+                Some(c) => cur = c,
+                None => return,
             }
         }
     }
@@ -343,8 +364,7 @@ impl PointTree {
             return;
         }
         let (gl, gh, centre) = (glo.to_array(), ghi.to_array(), centre.to_array());
-        let mut stack: [(u32, f64); 64] = [(0, 0.0); 64];
-        let mut sp = 0usize;
+        let mut stack = Pending::new();
         let mut cur = self.root;
         loop {
             if cur & LEAF_BIT != 0 {
@@ -355,25 +375,17 @@ impl PointTree {
                 let d = child_box_dist2(n, gl, gh);
                 let o = child_dist2(n, centre);
                 let (f, s) = if o[0] <= o[1] { (0, 1) } else { (1, 0) };
-                if d[s] <= bnd && sp < stack.len() {
-                    stack[sp] = (n.child[s], d[s]);
-                    sp += 1;
+                if d[s] <= bnd {
+                    stack.push(n.child[s], d[s]);
                 }
                 if d[f] <= bnd {
                     cur = n.child[f];
                     continue;
                 }
             }
-            loop {
-                if sp == 0 {
-                    return;
-                }
-                sp -= 1;
-                let (c, dc) = stack[sp];
-                if dc <= bnd {
-                    cur = c;
-                    break;
-                }
+            match stack.pop_within(bnd) {
+                Some(c) => cur = c,
+                None => return,
             }
         }
     }

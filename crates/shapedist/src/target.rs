@@ -4,9 +4,10 @@
 //! the target (a point, optionally a unit normal, and a squared distance). [`icp_to_target`]
 //! then selects the pairs (distance and normal gates, trimming), takes a point-to-point
 //! (closed-form Kabsch) or point-to-plane (linearised, damped) step and applies the chosen
-//! convergence rule. Implementations: [`crate::PreparedSet`] (exact nearest points), a mesh
-//! surface through [`meshcore::FaceLocator`] (closest points on triangles), and the landmark
-//! detector's surface index (in the `landmarks` crate).
+//! convergence rule. Implementations: [`crate::PreparedSet`] (exact nearest points), and, as
+//! [`PointTarget`]s (one point at a time, no state), a mesh surface through
+//! [`meshcore::FaceLocator`] (closest points on triangles) and the landmark detector's surface
+//! index (in the `landmarks` crate).
 //!
 //! Arithmetic, in a fixed order whatever the thread count: the sums of the kept pairs are
 //! formed per chunk of `CHUNK` (512) source points and added in chunk order; the point-to-plane
@@ -75,6 +76,38 @@ pub trait IcpTarget: Sync {
         state: &mut Self::State,
         out: &mut [Match],
     ) -> Result<usize, ShapeDistError>;
+}
+
+/// A target without per-run state that answers one moved source point at a time and always
+/// has normals. Every such type is an [`IcpTarget`] (one query per source point): a mesh surface
+/// through [`FaceLocator`], the landmark detector's surface index.
+pub trait PointTarget: Sync {
+    /// The partner of the (moved) source point `q`, with its unit normal when `normals`.
+    fn partner(&self, q: DVec3, normals: bool) -> Result<Match, ShapeDistError>;
+}
+
+impl<T: PointTarget> IcpTarget for T {
+    type State = ();
+
+    fn start(&self, _n: usize) -> Self::State {}
+
+    fn has_normals(&self) -> bool {
+        true
+    }
+
+    fn correspond(
+        &self,
+        src: &[DVec3],
+        pose: &DAffine3,
+        normals: bool,
+        _state: &mut (),
+        out: &mut [Match],
+    ) -> Result<usize, ShapeDistError> {
+        for (o, p) in out.iter_mut().zip(src) {
+            *o = self.partner(pose.transform_point3(*p), normals)?;
+        }
+        Ok(src.len())
+    }
 }
 
 /// How a trim fraction becomes the number of pairs kept.
@@ -534,38 +567,18 @@ pub fn icp_to_target<T: IcpTarget + ?Sized>(
 
 /// Closest points on the triangles of a mesh (exact, [`FaceLocator::nearest`]); normals are
 /// the unit face normals.
-impl IcpTarget for FaceLocator<'_> {
-    type State = ();
-
-    fn start(&self, _n: usize) -> Self::State {}
-
-    fn has_normals(&self) -> bool {
-        true
-    }
-
-    fn correspond(
-        &self,
-        src: &[DVec3],
-        pose: &DAffine3,
-        normals: bool,
-        _state: &mut (),
-        out: &mut [Match],
-    ) -> Result<usize, ShapeDistError> {
+impl PointTarget for FaceLocator<'_> {
+    fn partner(&self, q: DVec3, normals: bool) -> Result<Match, ShapeDistError> {
+        let (sp, d) = self.nearest(q)?;
         let mesh = self.mesh();
-        for (o, p) in out.iter_mut().zip(src) {
-            let (sp, d) = self.nearest(pose.transform_point3(*p))?;
-            let point = mesh.point_position(&sp)?;
-            let normal = if normals {
+        Ok(Match {
+            d2: d * d,
+            point: mesh.point_position(&sp)?,
+            normal: if normals {
                 mesh.face_normal(sp.face)
             } else {
                 DVec3::ZERO
-            };
-            *o = Match {
-                d2: d * d,
-                point,
-                normal,
-            };
-        }
-        Ok(src.len())
+            },
+        })
     }
 }

@@ -104,16 +104,10 @@ meshcore::choice!(Format, "picture format", VizError {
 impl Format {
     /// Format of a path by its (case-insensitive) extension.
     pub fn from_path(path: &Path) -> Result<Self, VizError> {
-        match path
-            .extension()
+        path.extension()
             .and_then(|e| e.to_str())
-            .map(|e| e.to_ascii_lowercase())
-            .as_deref()
-        {
-            Some(ext) => <Format as meshcore::Choice>::from_name(ext)
-                .map_err(|_| VizError::UnsupportedFormat(path.to_path_buf())),
-            None => Err(VizError::UnsupportedFormat(path.to_path_buf())),
-        }
+            .and_then(|e| <Format as meshcore::Choice>::from_name(e).ok())
+            .ok_or_else(|| VizError::UnsupportedFormat(path.to_path_buf()))
     }
 }
 

@@ -1,6 +1,7 @@
 //! Line plots, heatmaps and histograms (plotters SVG; PNG by rasterising the SVG with resvg).
 
 use crate::{colormap, write_bytes, Format, VizError};
+use plotters::coord::ranged1d::ValueFormatter;
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
@@ -133,6 +134,42 @@ fn perr<E: std::fmt::Display>(e: E) -> VizError {
 }
 
 /// Padded range of values (a degenerate range is widened).
+/// Draws the grid, tick labels and axis descriptions in the style of every plot here.
+fn draw_axes<DB, X, Y>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<X, Y>>,
+    x_label: &str,
+    y_label: &str,
+) -> Result<(), VizError>
+where
+    DB: DrawingBackend,
+    X: Ranged + ValueFormatter<X::ValueType>,
+    Y: Ranged + ValueFormatter<Y::ValueType>,
+{
+    chart
+        .configure_mesh()
+        .x_desc(x_label)
+        .y_desc(y_label)
+        .label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 16))
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()
+        .map_err(perr)
+}
+
+/// Draws the series legend (upper right) in the style of every plot here.
+fn draw_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+) -> Result<(), VizError> {
+    chart
+        .configure_series_labels()
+        .label_font(("sans-serif", 14))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()
+        .map_err(perr)
+}
+
 fn padded(lo: f64, hi: f64, log: bool) -> (f64, f64) {
     if log {
         let (a, b) = (lo.log10(), hi.log10());
@@ -219,15 +256,7 @@ pub fn line_plot_svg(spec: &PlotSpec) -> Result<String, VizError> {
         macro_rules! body {
             ($chart:expr) => {{
                 let mut chart = $chart;
-                chart
-                    .configure_mesh()
-                    .x_desc(spec.x_label.as_str())
-                    .y_desc(spec.y_label.as_str())
-                    .label_style(("sans-serif", 14))
-                    .axis_desc_style(("sans-serif", 16))
-                    .light_line_style(RGBColor(235, 235, 235))
-                    .draw()
-                    .map_err(perr)?;
+                draw_axes(&mut chart, &spec.x_label, &spec.y_label)?;
                 for (i, (s, pts)) in spec.series.iter().zip(&clean).enumerate() {
                     let c = pick(i);
                     let style = c.stroke_width(2);
@@ -257,14 +286,7 @@ pub fn line_plot_svg(spec: &PlotSpec) -> Result<String, VizError> {
                         .draw_series(pts.iter().map(|&(x, y)| Circle::new((x, y), 3, c.filled())))
                         .map_err(perr)?;
                 }
-                chart
-                    .configure_series_labels()
-                    .label_font(("sans-serif", 14))
-                    .background_style(WHITE.mix(0.85))
-                    .border_style(BLACK)
-                    .position(SeriesLabelPosition::UpperRight)
-                    .draw()
-                    .map_err(perr)?;
+                draw_legend(&mut chart)?;
             }};
         }
         if spec.log_y {
@@ -566,15 +588,7 @@ pub fn histogram_svg(
             .y_label_area_size(64)
             .build_cartesian_2d(lo..hi, 0f64..cmax as f64 * 1.08)
             .map_err(perr)?;
-        chart
-            .configure_mesh()
-            .x_desc(x_label)
-            .y_desc("count")
-            .label_style(("sans-serif", 14))
-            .axis_desc_style(("sans-serif", 16))
-            .light_line_style(RGBColor(235, 235, 235))
-            .draw()
-            .map_err(perr)?;
+        draw_axes(&mut chart, x_label, "count")?;
         let alpha = if series.len() > 1 { 0.45 } else { 0.75 };
         for (i, ((name, _), c)) in series.iter().zip(&counts).enumerate() {
             let col = pick(i);
@@ -595,14 +609,7 @@ pub fn histogram_svg(
                 }))
                 .map_err(perr)?;
         }
-        chart
-            .configure_series_labels()
-            .label_font(("sans-serif", 14))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(perr)?;
+        draw_legend(&mut chart)?;
         root.present().map_err(perr)?;
     }
     Ok(buf)

@@ -3,6 +3,7 @@
 
 use super::window::{pair_trim, BoundStats, Trim, TAU};
 use super::*;
+use crate::solver::Item;
 use std::cmp::Ordering;
 use std::collections::{BinaryHeap, VecDeque};
 
@@ -38,20 +39,6 @@ pub(crate) struct Record {
     pub h: u32,
     pub w: Window,
     pub origin: Origin,
-}
-
-#[derive(PartialEq)]
-struct Item(f64, u32);
-impl Eq for Item {}
-impl Ord for Item {
-    fn cmp(&self, o: &Self) -> Ordering {
-        o.0.total_cmp(&self.0).then_with(|| o.1.cmp(&self.1))
-    }
-}
-impl PartialOrd for Item {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
 }
 
 /// [`Solve::flags`] bit: the half-edge is in the FIFO.
@@ -534,19 +521,7 @@ impl<'a> Solve<'a> {
         let sx = w.sx * cs + w.sy * sn;
         let sy = -w.sx * sn + w.sy * cs;
         // T' = (t cos, -t sin).
-        let x_of = |t: f64| -> f64 {
-            let (tx, ty) = (t * cs, -t * sn);
-            let den = sy - ty;
-            if den > -1e-15 * ell {
-                if tx > sx {
-                    ell
-                } else {
-                    0.0
-                }
-            } else {
-                sx + (tx - sx) * sy / den
-            }
-        };
+        let x_of = |t: f64| -> f64 { edge_crossing(sx, sy, t * cs, -t * sn, ell) };
         let x0 = if t0 <= 0.0 { 0.0 } else { x_of(t0) };
         let x1 = if apex_end { ell } else { x_of(t1) };
         self.push_child(tw, ell, w, sx, sy, x0, x1);
@@ -562,17 +537,7 @@ impl<'a> Solve<'a> {
         let sy = -dx * uy + dy * ux;
         let x_of = |t: f64| -> f64 {
             let (ex, ey) = (t - geo.cx, -geo.cy);
-            let (tx, ty) = (ex * ux + ey * uy, -ex * uy + ey * ux);
-            let den = sy - ty;
-            if den > -1e-15 * ell {
-                if tx > sx {
-                    ell
-                } else {
-                    0.0
-                }
-            } else {
-                sx + (tx - sx) * sy / den
-            }
+            edge_crossing(sx, sy, ex * ux + ey * uy, -ex * uy + ey * ux, ell)
         };
         let x0 = if apex_end { 0.0 } else { x_of(t0) };
         let x1 = if t1 >= geo.l { ell } else { x_of(t1) };
@@ -694,6 +659,23 @@ pub(super) fn classify_point(g: &ExactGeodesic, sp: &SurfacePoint) -> Result<See
             let k = (0..3).find(|&k| bb[k] > 0.0).unwrap_or(0);
             Ok(Seed::Vertex(t[k]))
         }
+    }
+}
+
+/// Where the line from the source `(sx, sy)` through `(tx, ty)` meets the x axis of a child
+/// edge's frame (the edge is `[0, ell]`), for the left and the right child edge alike; when
+/// `sy - ty > -1e-15 ell` (no usable crossing), the end of the edge on the side of `tx`.
+#[inline]
+fn edge_crossing(sx: f64, sy: f64, tx: f64, ty: f64, ell: f64) -> f64 {
+    let den = sy - ty;
+    if den > -1e-15 * ell {
+        if tx > sx {
+            ell
+        } else {
+            0.0
+        }
+    } else {
+        sx + (tx - sx) * sy / den
     }
 }
 

@@ -263,20 +263,20 @@ const BOUND_MARGIN: f64 = 1.0 - 4.0 * TAU;
 /// overlap, otherwise its ends lying in the overlap move to the overlap's other end.
 #[inline]
 fn dominated_on_overlap(w1: &mut Window, w2: &mut Window, l: f64, r: f64) -> Option<Trim> {
-    if min_on(w1, l, r) * BOUND_MARGIN > max_on(w2, l, r) {
-        if w1.b0 >= l && w1.b1 <= r {
-            w1.kill();
-            return Some(Trim::FirstDead);
+    loses_overlap(w1, w2, l, r, Trim::FirstDead)
+        .or_else(|| loses_overlap(w2, w1, l, r, Trim::SecondDead))
+}
+
+/// One side of [`dominated_on_overlap`]: if `loser` loses `[l, r]` to `winner` by the bound, it
+/// dies (`dead`) or is trimmed ([`Trim::Both`]).
+#[inline]
+fn loses_overlap(loser: &mut Window, winner: &Window, l: f64, r: f64, dead: Trim) -> Option<Trim> {
+    if min_on(loser, l, r) * BOUND_MARGIN > max_on(winner, l, r) {
+        if loser.b0 >= l && loser.b1 <= r {
+            loser.kill();
+            return Some(dead);
         }
-        lose_overlap(w1, l, r);
-        return Some(Trim::Both);
-    }
-    if min_on(w2, l, r) * BOUND_MARGIN > max_on(w1, l, r) {
-        if w2.b0 >= l && w2.b1 <= r {
-            w2.kill();
-            return Some(Trim::SecondDead);
-        }
-        lose_overlap(w2, l, r);
+        lose_overlap(loser, l, r);
         return Some(Trim::Both);
     }
     None

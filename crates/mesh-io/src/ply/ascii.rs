@@ -2,7 +2,7 @@
 
 use super::header::{Header, Prop, Ty};
 use super::records::{
-    check_index, color_value, face_list_index, push_face, push_strip, vertex_roles, Role, Sink,
+    check_index, face_list_index, list_length, push_face, push_strip, vertex_roles, Role, Sink,
 };
 use crate::IoError;
 use meshcore::DVec3;
@@ -112,26 +112,12 @@ pub(super) fn read_ascii(
                     Prop::Scalar(ty, _) => {
                         let (v, ln) = ascii_value(toks.next(), *ty, file, last, &el.name)?;
                         rec_line = ln;
-                        match roles[k] {
-                            Role::X => p.x = v,
-                            Role::Y => p.y = v,
-                            Role::Z => p.z = v,
-                            Role::Color(k, f) => c[k] = color_value(v, f),
-                            Role::Scalar(k) => sink.scalars[k].1.values.push(v),
-                            Role::Ignore => {}
-                        }
+                        roles[k].store(v, &mut p, &mut c, sink);
                     }
                     Prop::List(ct, it, _) => {
                         let (n, ln) = ascii_value(toks.next(), *ct, file, last, &el.name)?;
                         rec_line = ln;
-                        if n < 0.0 {
-                            return Err(IoError::line(
-                                file,
-                                ln,
-                                format!("negative list length {n}"),
-                            ));
-                        }
-                        let n = n as usize;
+                        let n = list_length(n, file, crate::Location::Line(ln))?;
                         if n > body.len() {
                             return Err(IoError::line(
                                 file,

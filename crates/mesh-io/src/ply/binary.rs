@@ -2,7 +2,7 @@
 
 use super::header::{Header, Prop, Ty};
 use super::records::{
-    check_index, color_value, face_list_index, push_face, push_strip, vertex_roles, Role, Sink,
+    check_index, face_list_index, list_length, push_face, push_strip, vertex_roles, Sink,
 };
 use crate::IoError;
 use meshcore::DVec3;
@@ -89,14 +89,7 @@ pub(super) fn read_binary(
                                 }
                                 let v = get(bytes, off, *ty, be);
                                 off += ty.size();
-                                match *role {
-                                    Role::X => p.x = v,
-                                    Role::Y => p.y = v,
-                                    Role::Z => p.z = v,
-                                    Role::Color(k, f) => c[k] = color_value(v, f),
-                                    Role::Scalar(k) => sink.scalars[k].1.values.push(v),
-                                    Role::Ignore => {}
-                                }
+                                role.store(v, &mut p, &mut c, sink);
                             }
                             Prop::List(ct, it, _) => {
                                 off = skip_list(bytes, off, *ct, *it, be, file, &el.name)?;
@@ -181,14 +174,7 @@ pub(super) fn read_binary(
                                 }
                                 let n = get(bytes, off, *ct, be);
                                 off += ct.size();
-                                if n < 0.0 {
-                                    return Err(IoError::byte(
-                                        file,
-                                        rec,
-                                        format!("negative list length {n}"),
-                                    ));
-                                }
-                                let n = n as usize;
+                                let n = list_length(n, file, crate::Location::Byte(rec))?;
                                 if n.saturating_mul(it.size()) > bytes.len() - off {
                                     return Err(IoError::byte(file, rec, format!("face list of {n} indices runs past the end of the file")));
                                 }
@@ -267,14 +253,7 @@ pub(super) fn skip_list(
         ));
     }
     let n = get(bytes, off, ct, be);
-    if n < 0.0 {
-        return Err(IoError::byte(
-            file,
-            off,
-            format!("negative list length {n}"),
-        ));
-    }
-    let len = (n as usize).saturating_mul(it.size());
+    let len = list_length(n, file, crate::Location::Byte(off))?.saturating_mul(it.size());
     let start = off + ct.size();
     if len > bytes.len() - start {
         return Err(IoError::byte(

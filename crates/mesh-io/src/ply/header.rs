@@ -127,7 +127,7 @@ pub(super) fn parse_header(bytes: &[u8], file: &str) -> Result<Header, IoError> 
                     .next()
                     .ok_or_else(|| IoError::line(file, ln, "element without a name"))?
                     .to_string();
-                let count = crate::text::parse_usize(t.next(), file, ln, "element count")?;
+                let count = crate::text::parse_num(t.next(), file, ln, "element count")?;
                 elements.push(Element {
                     name,
                     count,

@@ -29,6 +29,22 @@ pub(super) enum Role {
     Ignore,
 }
 
+impl Role {
+    /// Puts the value `v` of a vertex property with this role where it belongs: the position
+    /// `p`, the colour `c` or its scalar field in `sink`.
+    #[inline]
+    pub(super) fn store(self, v: f64, p: &mut DVec3, c: &mut [u8; 4], sink: &mut Sink) {
+        match self {
+            Role::X => p.x = v,
+            Role::Y => p.y = v,
+            Role::Z => p.z = v,
+            Role::Color(k, f) => c[k] = color_value(v, f),
+            Role::Scalar(k) => sink.scalars[k].1.values.push(v),
+            Role::Ignore => {}
+        }
+    }
+}
+
 pub(super) fn vertex_roles(
     el: &Element,
     file: &str,
@@ -110,6 +126,18 @@ pub(super) fn color_value(v: f64, is_float: bool) -> u8 {
     }
 }
 
+/// A list length read from the file; negative is an error at `at`.
+pub(super) fn list_length(n: f64, file: &str, at: crate::Location) -> Result<usize, IoError> {
+    if n < 0.0 {
+        return Err(IoError::malformed(
+            file,
+            at,
+            format!("negative list length {n}"),
+        ));
+    }
+    Ok(n as usize)
+}
+
 pub(super) fn check_index(v: f64, file: &str, at: crate::Location) -> Result<u32, IoError> {
     if v < 0.0 || v.fract() != 0.0 || v > (u32::MAX - 1) as f64 {
         return Err(IoError::malformed(
@@ -128,20 +156,15 @@ pub(super) fn push_face(
     at: crate::Location,
     where_: usize,
 ) -> Result<(), IoError> {
-    if corners.len() < 3 {
-        return Err(IoError::malformed(
+    let polygon = crate::text::fan(corners, &mut sink.tris).ok_or_else(|| {
+        IoError::malformed(
             file,
             at,
             format!("face with {} corner(s); at least 3 needed", corners.len()),
-        ));
-    }
-    if corners.len() > 3 {
-        sink.n_polygons += 1;
-    }
-    for k in 1..corners.len() - 1 {
-        sink.tris.push([corners[0], corners[k], corners[k + 1]]);
-        sink.tri_at.push(where_);
-    }
+        )
+    })?;
+    sink.n_polygons += usize::from(polygon);
+    sink.tri_at.resize(sink.tris.len(), where_);
     Ok(())
 }
 

@@ -1,7 +1,7 @@
 //! The PLY writer (ASCII or binary, optional colours and scalar properties).
 
 use super::{PlyEncoding, PlyWriteOptions};
-use crate::text::push_f64;
+use crate::text::{push_f64, push_xyz};
 use crate::{IoError, ScalarType};
 use meshcore::TriMesh;
 
@@ -12,25 +12,8 @@ pub(crate) fn write_ply(
     file: &str,
 ) -> Result<Vec<u8>, IoError> {
     let n = mesh.n_vertices();
-    if let Some(c) = o.colors {
-        if c.len() != n {
-            return Err(IoError::invalid(
-                file,
-                format!("{} colours for {n} vertices", c.len()),
-            ));
-        }
-    }
+    crate::check_extras(file, n, o.colors, o.scalars)?;
     for s in o.scalars {
-        if s.values.len() != n {
-            return Err(IoError::invalid(
-                file,
-                format!(
-                    "scalar {:?} has {} values for {n} vertices",
-                    s.name,
-                    s.values.len()
-                ),
-            ));
-        }
         if s.name.is_empty()
             || s.name.chars().any(|c| c.is_whitespace())
             || ["x", "y", "z", "red", "green", "blue", "alpha"].contains(&s.name.as_str())
@@ -69,11 +52,7 @@ pub(crate) fn write_ply(
         PlyEncoding::Ascii => {
             let mut s = String::with_capacity(n * 60 + mesh.n_faces() * 20);
             for (i, p) in mesh.positions().iter().enumerate() {
-                push_f64(&mut s, p.x);
-                s.push(' ');
-                push_f64(&mut s, p.y);
-                s.push(' ');
-                push_f64(&mut s, p.z);
+                push_xyz(&mut s, *p);
                 if let Some(c) = o.colors {
                     s.push_str(&format!(" {} {} {} {}", c[i][0], c[i][1], c[i][2], c[i][3]));
                 }
