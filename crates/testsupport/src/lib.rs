@@ -9,6 +9,7 @@
 //! * **Meshes**: [`read_mesh`] (through `mesh-io`, the project's one reader) and the generators
 //!   of [`meshcore::shapes`], re-exported as [`shapes`], plus [`jittered_unit_plane`] (the
 //!   plane of the straightest-geodesic, single-pole and face-frame tests).
+//! * **Temporary folders**: [`fresh_temp_dir`].
 //! * **Analytic distance fields**: [`fields`].
 //! * **The independent descriptor and distance** the crates are checked against: [`oracle`].
 
@@ -88,6 +89,17 @@ macro_rules! require_shared {
             None => return Default::default(),
         }
     };
+}
+
+/// An empty folder `<temp>/<prefix>-<process id>-<name>` for a test's files (emptied first
+/// when a previous run left it).
+pub fn fresh_temp_dir(prefix: &str, name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("{prefix}-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    if let Err(e) = std::fs::create_dir_all(&d) {
+        panic!("creating {}: {e}", d.display());
+    }
+    d
 }
 
 /// Reads a mesh file with `mesh-io`; panics with the reader's message (test code).
