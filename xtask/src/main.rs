@@ -1,6 +1,6 @@
 //! Project tasks, run as `cargo xtask <task>` (the alias lives in `.cargo/config.toml`).
 
-use clap::{Parser, Subcommand};
+use clap::Parser;
 
 mod experiments;
 mod landmarks_eval;
@@ -12,12 +12,6 @@ mod sphere_validate;
 /// Experiments and evaluations of the bipolar workspace.
 #[derive(Debug, Parser)]
 #[command(name = "xtask")]
-struct Cli {
-    #[command(subcommand)]
-    task: Task,
-}
-
-#[derive(Debug, Subcommand)]
 enum Task {
     /// The paper's section 3: the descriptor on a sphere against analytic curves.
     SphereValidate(sphere_validate::Args),
@@ -30,8 +24,7 @@ enum Task {
 }
 
 fn main() -> anyhow::Result<()> {
-    let cli = Cli::parse();
-    match cli.task {
+    match Task::parse() {
         Task::SphereValidate(args) => sphere_validate::run(args),
         Task::Robustness(args) => robustness::run(args),
         Task::Recognition(args) => recognition::run(args),

@@ -9,15 +9,15 @@
 //! probe x gallery pairs, and the ROC curve. Results: `report.md`, `summary.json`, `roc.svg` (and `roc.png`),
 //! CSV tables, in the output folder printed on the last line.
 
-use crate::experiments::keyed::KeyedPoints;
 use crate::experiments::pipeline::{
     bar, bipolar, dist, resolve_methods, DescriptorRule, Refs, Region,
 };
-use crate::experiments::polar::{polar_descriptor, PolarOptions, Pole};
+use crate::experiments::polar::{self, polar_descriptor, PolarOptions, Pole};
 use crate::experiments::report::{f4, line_plot, Report, Series};
 use crate::experiments::walk::Walker;
 use crate::paths::{default_model_dir, default_out_dir};
 use anyhow::{bail, Context, Result};
+use bipolar::PolarDescriptor;
 use facemodel::{face_frame, random_rigid_motion, FaceModel};
 use geodesic::{SolveOptions, Source};
 use meshcore::linalg::fit_rigid;
@@ -81,7 +81,7 @@ struct Lm {
 #[derive(Debug, Clone)]
 struct Described {
     bip: Option<bipolar::Descriptor>,
-    pol: KeyedPoints,
+    pol: PolarDescriptor,
     lm_pos: [DVec3; 3],
 }
 
@@ -348,7 +348,7 @@ pub fn run(args: Args) -> Result<()> {
                 };
                 let pol =
                     polar_descriptor(&walker, &un, Pole::Vertex(lm.nose), 0.5 * (r + q), &opts)
-                        .unwrap_or_default();
+                        .unwrap_or_else(|_| polar::empty(&opts));
                 out[k] = Some(Described {
                     bip,
                     pol,

@@ -15,6 +15,7 @@
 //! Reported: the normalised keyed shape distance `min_R ||A - R B|| / sqrt(|A|^2 + |B|^2)`
 //! (common keys, centred, rotation only), mean position error and mean angle (cosine) error.
 
+use crate::experiments::report::markers;
 use anyhow::Context;
 use bipolar::{
     Descriptor, DescriptorOptions, Key, LevelSpec, SelectionRule, Source, TangentMethod,
@@ -35,6 +36,55 @@ struct SphereMesh {
     name: String,
     mesh: TriMesh,
     refs: [Source; 2],
+}
+
+impl SphereMesh {
+    /// The distance fields of the two poles from the exact solver (the Dijkstra one when the
+    /// exact solver refuses the mesh), and the name of the solver used.
+    fn pole_fields(&self) -> anyhow::Result<(Vec<Vec<f64>>, &'static str)> {
+        let (solver, used) = match geodesic::new_solver(&self.mesh, geodesic::Method::Exact) {
+            Ok(s) => (s, "exact"),
+            Err(_) => (
+                geodesic::new_solver(&self.mesh, geodesic::Method::Dijkstra)?,
+                "dijkstra",
+            ),
+        };
+        let fields = self
+            .refs
+            .iter()
+            .map(|r| solver.distances(&[*r], &geodesic::SolveOptions::default()))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok((fields, used))
+    }
+
+    /// The descriptor with `n` levels between the poles (levels 1..2N-1 kept), rule and
+    /// tangent method, from the pole fields.
+    fn describe(
+        &self,
+        surface: &bipolar::Surface,
+        fields: &[Vec<f64>],
+        n: u32,
+        rule: SelectionRule,
+        tangent: TangentMethod,
+    ) -> Result<Descriptor, bipolar::BipolarError> {
+        let opts = DescriptorOptions {
+            levels: LevelSpec::Count(n),
+            max_level: Some(2 * n - 1),
+            angles: K,
+            alpha: ALPHA,
+            rule,
+            tangent,
+            ..DescriptorOptions::default()
+        };
+        bipolar::describe(
+            surface,
+            bipolar::Fields::Precomputed {
+                fields,
+                references: Some(&self.refs),
+            },
+            &opts,
+        )
+    }
 }
 
 fn meshes() -> anyhow::Result<Vec<SphereMesh>> {
@@ -174,6 +224,50 @@ struct Row {
     ms: f64,
 }
 
+impl Row {
+    /// The cells of the row: every column at full precision for `results.csv` (`csv`), or the
+    /// columns of the report's tables.
+    fn cells(&self, csv: bool) -> Vec<String> {
+        let digits = if csv { 6 } else { 2 };
+        let mut c = vec![self.mesh.clone()];
+        if csv {
+            c.push(self.n_vertices.to_string());
+            c.push(format!("{:.6}", self.mean_edge));
+        }
+        c.push(self.levels.to_string());
+        if csv {
+            c.push(self.rule.to_string());
+        }
+        c.push(self.method.to_string());
+        for count in [self.n_points, self.n_analytic, self.n_common] {
+            c.push(count.to_string());
+        }
+        for x in [self.distance, self.pos_err, self.cos_err, self.cos_err_max] {
+            c.push(format!("{x:.digits$e}"));
+        }
+        c.push(if csv {
+            format!("{:.3}", self.ms)
+        } else {
+            format!("{:.1}", self.ms)
+        });
+        c
+    }
+}
+
+/// The value `field` of the row of `rows` for one configuration (NaN when there is none).
+fn lookup(
+    rows: &[Row],
+    (mesh, levels, rule): (&str, u32, &str),
+    m: TangentMethod,
+    field: fn(&Row) -> f64,
+) -> f64 {
+    rows.iter()
+        .find(|r| {
+            r.mesh == mesh && r.levels == levels && r.rule == rule && r.method == method_name(m)
+        })
+        .map_or(f64::NAN, field)
+}
+
 fn compare(d: &Descriptor, truth: &BTreeMap<Key, (DVec3, f64)>) -> (usize, f64, f64, f64, f64) {
     let mut a = Vec::new();
     let mut b = Vec::new();
@@ -267,19 +361,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     for sm in &meshes {
         pb.set_message(format!("geodesics on {}", sm.name));
         let tg = Instant::now();
-        let (solver, used) = match geodesic::new_solver(&sm.mesh, geodesic::Method::Exact) {
-            Ok(s) => (s, "exact"),
-            Err(_) => (
-                geodesic::new_solver(&sm.mesh, geodesic::Method::Dijkstra)?,
-                "dijkstra",
-            ),
-        };
+        let (fields, used) = sm.pole_fields()?;
         solver_name = used;
-        let fields = sm
-            .refs
-            .iter()
-            .map(|r| solver.distances(&[*r], &geodesic::SolveOptions::default()))
-            .collect::<Result<Vec<_>, _>>()?;
         geodesic_ms.push((sm.name.clone(), tg.elapsed().as_secs_f64() * 1e3));
         let surface = bipolar::Surface::new(sm.mesh.clone());
         for &n in &LEVELS {
@@ -288,24 +371,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 let truth = analytic(rule, n, max_level);
                 for &m in &methods {
                     pb.set_message(format!("{} N={n} {rname} {}", sm.name, method_name(m)));
-                    let opts = DescriptorOptions {
-                        levels: LevelSpec::Count(n),
-                        max_level: Some(max_level),
-                        angles: K,
-                        alpha: ALPHA,
-                        rule,
-                        tangent: m,
-                        ..DescriptorOptions::default()
-                    };
                     let t0 = Instant::now();
-                    let d = bipolar::describe(
-                        &surface,
-                        bipolar::Fields::Precomputed {
-                            fields: &fields,
-                            references: Some(&sm.refs),
-                        },
-                        &opts,
-                    )?;
+                    let d = sm.describe(&surface, &fields, n, rule, m)?;
                     let ms = t0.elapsed().as_secs_f64() * 1e3;
                     let (n_common, distance, pos_err, cos_err, cos_err_max) = compare(&d, &truth);
                     rows.push(Row {
@@ -336,24 +403,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         "mesh,vertices,mean_edge,levels,rule,method,points,analytic_points,common_keys,shape_distance,mean_position_error,mean_cos_error,max_cos_error,describe_ms\n",
     );
     for r in &rows {
-        let _ = writeln!(
-            csv,
-            "{},{},{:.6},{},{},{},{},{},{},{:.6e},{:.6e},{:.6e},{:.6e},{:.3}",
-            r.mesh,
-            r.n_vertices,
-            r.mean_edge,
-            r.levels,
-            r.rule,
-            r.method,
-            r.n_points,
-            r.n_analytic,
-            r.n_common,
-            r.distance,
-            r.pos_err,
-            r.cos_err,
-            r.cos_err_max,
-            r.ms
-        );
+        let _ = writeln!(csv, "{}", r.cells(true).join(","));
     }
     std::fs::write(out_dir.join("results.csv"), &csv)?;
 
@@ -411,35 +461,39 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
     }
     // Against mesh resolution (icospheres), N = 8.
-    plot(
-        "distance_vs_edge_isoangle_N8.svg".into(),
-        "Shape distance vs mesh resolution (icospheres, N = 8, iso-angle)".into(),
-        "mean edge length",
-        "normalised shape distance",
-        &|r| r.mesh.starts_with("ico") && r.levels == 8 && r.rule == "isoangle",
-        |r| (r.mean_edge, r.distance),
-    )?;
-    plot(
-        "cos_error_vs_edge_grid_N8.svg".into(),
-        "Mean |cos| error at grid intersections vs mesh resolution (N = 8)".into(),
-        "mean edge length",
-        "mean cos error",
-        &|r| r.mesh.starts_with("ico") && r.levels == 8 && r.rule == "all",
-        |r| (r.mean_edge, r.cos_err),
-    )?;
+    let by_edge: [(&str, &str, &str, &str, fn(&Row) -> (f64, f64)); 2] = [
+        (
+            "distance_vs_edge_isoangle_N8.svg",
+            "Shape distance vs mesh resolution (icospheres, N = 8, iso-angle)",
+            "normalised shape distance",
+            "isoangle",
+            |r| (r.mean_edge, r.distance),
+        ),
+        (
+            "cos_error_vs_edge_grid_N8.svg",
+            "Mean |cos| error at grid intersections vs mesh resolution (N = 8)",
+            "mean cos error",
+            "all",
+            |r| (r.mean_edge, r.cos_err),
+        ),
+    ];
+    for (file, title, y_label, rule, xy) in by_edge {
+        plot(
+            file.into(),
+            title.into(),
+            "mean edge length",
+            y_label,
+            &|r| r.mesh.starts_with("ico") && r.levels == 8 && r.rule == rule,
+            xy,
+        )?;
+    }
 
     // Renders: level curves and points on ico4, N = 8, iso-angle, each method.
     let mut renders = Vec::new();
     {
         let sm = &meshes[1];
         let surface = bipolar::Surface::new(sm.mesh.clone());
-        let solver = geodesic::new_solver(&sm.mesh, geodesic::Method::Exact)
-            .or_else(|_| geodesic::new_solver(&sm.mesh, geodesic::Method::Dijkstra))?;
-        let fields = sm
-            .refs
-            .iter()
-            .map(|r| solver.distances(&[*r], &geodesic::SolveOptions::default()))
-            .collect::<Result<Vec<_>, _>>()?;
+        let (fields, _) = sm.pole_fields()?;
         let n = 8;
         let step = std::f64::consts::FRAC_PI_2 / n as f64;
         let mut polylines = Vec::new();
@@ -465,36 +519,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let view = viz::View::new(-DVec3::new(1.0, 0.6, 1.0).normalize(), DVec3::Z);
         let truth = analytic(SelectionRule::IsoAngle, n, 2 * n - 1);
         for &m in &methods {
-            let opts = DescriptorOptions {
-                levels: LevelSpec::Count(n),
-                max_level: Some(2 * n - 1),
-                angles: K,
-                alpha: ALPHA,
-                rule: SelectionRule::IsoAngle,
-                tangent: m,
-                ..DescriptorOptions::default()
-            };
-            let d = bipolar::describe(
-                &surface,
-                bipolar::Fields::Precomputed {
-                    fields: &fields,
-                    references: Some(&sm.refs),
-                },
-                &opts,
-            )?;
-            let mut points: Vec<viz::Marker> = truth
-                .values()
-                .map(|(p, _)| viz::Marker {
-                    position: *p * 1.004,
-                    color: [30, 30, 30],
-                    radius: 3.0,
-                })
-                .collect();
-            points.extend(d.points.iter().map(|p| viz::Marker {
-                position: p.position * 1.004,
-                color: [250, 200, 0],
-                radius: 2.0,
-            }));
+            let d = sm.describe(&surface, &fields, n, SelectionRule::IsoAngle, m)?;
+            let mut points = markers(truth.values().map(|(p, _)| *p * 1.004), [30, 30, 30], 3.0);
+            points.extend(markers(
+                d.points.iter().map(|p| p.position * 1.004),
+                [250, 200, 0],
+                2.0,
+            ));
             let scene = viz::Scene {
                 mesh: &sm.mesh,
                 vertex_colors: None,
@@ -537,17 +568,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     for rule in ["isoangle", "filter"] {
         for sm in &meshes {
             for &n in &LEVELS {
-                let get = |m: TangentMethod| {
-                    rows.iter()
-                        .find(|r| {
-                            r.mesh == sm.name
-                                && r.levels == n
-                                && r.rule == rule
-                                && r.method == method_name(m)
-                        })
-                        .map(|r| r.distance)
-                        .unwrap_or(f64::NAN)
-                };
+                let get = |m| lookup(&rows, (&sm.name, n, rule), m, |r| r.distance);
                 let (s1, s2, g) = (
                     get(TangentMethod::Strip),
                     get(TangentMethod::Spline),
@@ -570,17 +591,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let mut grid_cmp = (0, 0, 0);
     for sm in &meshes {
         for &n in &LEVELS {
-            let get = |m: TangentMethod| {
-                rows.iter()
-                    .find(|r| {
-                        r.mesh == sm.name
-                            && r.levels == n
-                            && r.rule == "all"
-                            && r.method == method_name(m)
-                    })
-                    .map(|r| r.cos_err)
-                    .unwrap_or(f64::NAN)
-            };
+            let get = |m| lookup(&rows, (&sm.name, n, "all"), m, |r| r.cos_err);
             let (s1, s2, g) = (
                 get(TangentMethod::Strip),
                 get(TangentMethod::Spline),
@@ -616,21 +627,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let _ = writeln!(md, "| mesh | N | method | points | analytic | common | shape distance | mean pos. error | mean cos error | max cos error | ms |");
         let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|---|");
         for r in rows.iter().filter(|r| r.rule == rule) {
-            let _ = writeln!(
-                md,
-                "| {} | {} | {} | {} | {} | {} | {:.2e} | {:.2e} | {:.2e} | {:.2e} | {:.1} |",
-                r.mesh,
-                r.levels,
-                r.method,
-                r.n_points,
-                r.n_analytic,
-                r.n_common,
-                r.distance,
-                r.pos_err,
-                r.cos_err,
-                r.cos_err_max,
-                r.ms
-            );
+            let _ = writeln!(md, "| {} |", r.cells(false).join(" | "));
         }
         let _ = writeln!(md);
     }

@@ -290,20 +290,34 @@ pub fn write_ply(path: &Path, d: &Descriptor) -> Result<(), BipolarError> {
     write_file(path, &to_ply_string(d))
 }
 
-/// The extension of `path` in lower case.
-fn extension(path: &Path) -> Option<String> {
-    path.extension()
-        .and_then(|e| e.to_str())
-        .map(|e| e.to_ascii_lowercase())
+meshcore::choice! {
+    /// A descriptor file format, named by the file's extension.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum Format: "descriptor file", BipolarError {
+        /// [`write_csv`], [`read_csv`].
+        Csv = "csv",
+        /// [`write_json`], [`read_json`].
+        Json = "json",
+        /// [`write_ply`] (write only).
+        Ply = "ply",
+    }
+}
+
+impl Format {
+    /// The format named by the extension of `path` (ASCII case ignored), if any.
+    pub fn of_path(path: &Path) -> Option<Format> {
+        use meshcore::Choice;
+        Format::from_name(path.extension()?.to_str()?).ok()
+    }
 }
 
 /// Writes `d` in the format named by the extension of `path` (`.csv`, `.json`, `.ply`).
 pub fn write_auto(path: &Path, d: &Descriptor) -> Result<(), BipolarError> {
-    match extension(path).as_deref() {
-        Some("csv") => write_csv(path, d),
-        Some("json") => write_json(path, d),
-        Some("ply") => write_ply(path, d),
-        _ => Err(io_err(
+    match Format::of_path(path) {
+        Some(Format::Csv) => write_csv(path, d),
+        Some(Format::Json) => write_json(path, d),
+        Some(Format::Ply) => write_ply(path, d),
+        None => Err(io_err(
             path,
             "unknown descriptor file extension (expected .csv, .json or .ply)",
         )),
@@ -312,9 +326,9 @@ pub fn write_auto(path: &Path, d: &Descriptor) -> Result<(), BipolarError> {
 
 /// Reads `.csv` or `.json` descriptor files by extension.
 pub fn read_auto(path: &Path) -> Result<Descriptor, BipolarError> {
-    match extension(path).as_deref() {
-        Some("csv") => read_csv(path),
-        Some("json") => read_json(path),
+    match Format::of_path(path) {
+        Some(Format::Csv) => read_csv(path),
+        Some(Format::Json) => read_json(path),
         _ => Err(io_err(
             path,
             "unknown descriptor file extension (expected .csv or .json)",

@@ -13,26 +13,22 @@ pub enum LevelSpec {
     Step(f64),
 }
 
-/// The tangent method (specification §2.4).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-pub enum TangentMethod {
-    /// M0: exact tangent of the piecewise-linear isoline, `normalize(n_f x grad_f U)`
-    /// (for the iso-angle rule: the smoothed per-vertex gradient, M0s, interpolated).
-    #[default]
-    Gradient,
-    /// M1, the paper's method 1: principal axis of the strip of vertices with
-    /// `|U - lambda| <= epsilon` within a radius of the point.
-    Strip,
-    /// M2, the paper's method 2: derivative of a least-squares cubic B-spline fitted to the
-    /// level-curve polyline.
-    Spline,
+meshcore::choice! {
+    /// The tangent method (specification §2.4).
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+    pub enum TangentMethod: "tangent method", crate::BipolarError {
+        /// M0: exact tangent of the piecewise-linear isoline, `normalize(n_f x grad_f U)`
+        /// (for the iso-angle rule: the smoothed per-vertex gradient, M0s, interpolated).
+        #[default]
+        Gradient = "gradient",
+        /// M1, the paper's method 1: principal axis of the strip of vertices with
+        /// `|U - lambda| <= epsilon` within a radius of the point.
+        Strip = "strip",
+        /// M2, the paper's method 2: derivative of a least-squares cubic B-spline fitted to the
+        /// level-curve polyline.
+        Spline = "spline",
+    }
 }
-
-meshcore::choice!(TangentMethod, "tangent method", crate::BipolarError {
-    Gradient = "gradient",
-    Strip = "strip",
-    Spline = "spline",
-});
 
 /// Which intersection points are kept (the two readings of the paper's rule, §2.5).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -51,23 +47,20 @@ pub enum SelectionRule {
     All,
 }
 
-/// The name of a [`SelectionRule`] without its parameters (`filter`, `isoangle`, `all`), for
-/// choosing a rule by name.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-pub enum SelectionKind {
-    /// [`SelectionRule::Filter`].
-    Filter,
-    /// [`SelectionRule::IsoAngle`].
-    #[default]
-    IsoAngle,
-    /// [`SelectionRule::All`].
-    All,
+meshcore::choice! {
+    /// The name of a [`SelectionRule`] without its parameters (`filter`, `isoangle`, `all`), for
+    /// choosing a rule by name.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+    pub enum SelectionKind: "rule", crate::BipolarError {
+        /// [`SelectionRule::Filter`].
+        Filter = "filter",
+        /// [`SelectionRule::IsoAngle`].
+        #[default]
+        IsoAngle = "isoangle" | "iso-angle",
+        /// [`SelectionRule::All`].
+        All = "all",
+    }
 }
-meshcore::choice!(SelectionKind, "rule", crate::BipolarError {
-    Filter = "filter",
-    IsoAngle = "isoangle" | "iso-angle",
-    All = "all",
-});
 
 impl SelectionKind {
     /// The rule of this kind; `filter_tolerance` is the band of [`SelectionRule::Filter`]
@@ -246,6 +239,16 @@ impl Descriptor {
     /// Packed keys ([`Key::pack`]) of the points, in point order.
     pub fn packed_keys(&self) -> Vec<u64> {
         self.points.iter().map(|p| p.key.pack()).collect()
+    }
+
+    /// Packed keys and positions of the points a keyed comparison pairs: every point, or
+    /// (`keep_ambiguous` false) those not flagged ambiguous.
+    pub fn keyed_points(&self, keep_ambiguous: bool) -> (Vec<u64>, Vec<DVec3>) {
+        self.points
+            .iter()
+            .filter(|p| keep_ambiguous || !p.ambiguous)
+            .map(|p| (p.key.pack(), p.position))
+            .unzip()
     }
 
     /// Number of points.

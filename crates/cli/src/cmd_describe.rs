@@ -81,24 +81,11 @@ pub fn options(args: &Args) -> anyhow::Result<DescriptorOptions> {
     })
 }
 
-/// Descriptor file formats (by the extension of `--out`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum OutFormat {
-    Csv,
-    Json,
-    Ply,
-}
-meshcore::choice!(OutFormat, "descriptor file", meshcore::UnknownChoice {
-    Csv = "csv",
-    Json = "json",
-    Ply = "ply",
-});
-
 /// Runs the command.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let opts = options(&args)?;
     let method = args.method;
-    let _: OutFormat = from_extension(&args.out)?;
+    let _: bipolar::io::Format = from_extension(&args.out)?;
     let loaded = mesh_io::read_mesh(&args.mesh)
         .with_context(|| format!("reading {}", args.mesh.display()))?;
     let mesh = loaded.mesh;

@@ -45,20 +45,16 @@ pub struct Args {
     pub out: PathBuf,
 }
 
-/// Output formats.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum OutFormat {
-    Txt,
-    Csv,
-    Npy,
-    Ply,
+meshcore::choice! {
+    /// Output formats.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    enum OutFormat: "distance file", meshcore::UnknownChoice {
+        Txt = "txt",
+        Csv = "csv",
+        Npy = "npy",
+        Ply = "ply",
+    }
 }
-meshcore::choice!(OutFormat, "distance file", meshcore::UnknownChoice {
-    Txt = "txt",
-    Csv = "csv",
-    Npy = "npy",
-    Ply = "ply",
-});
 
 fn out_format(path: &Path) -> anyhow::Result<OutFormat> {
     from_extension(path)

@@ -5,7 +5,8 @@ use std::path::PathBuf;
 use anyhow::Context;
 use shapedist::Which;
 
-use crate::cmd_distance::{compare, load, prepare, CompareArgs, Mode};
+use crate::cmd_distance::{compare, load, CompareArgs};
+use shapedist::Mode;
 
 /// Arguments of `bipolar matrix`.
 #[derive(Debug, clap::Args)]
@@ -32,24 +33,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let sets = args
         .files
         .iter()
-        .map(|p| load(p, c.keep_ambiguous))
+        .map(|p| load(p, c, Which::A))
         .collect::<anyhow::Result<Vec<_>>>()?;
-    let prepared = if c.mode == Mode::Keys {
-        None
-    } else {
-        Some(
-            sets.iter()
-                .map(|s| prepare(s, Which::A))
-                .collect::<anyhow::Result<Vec<_>>>()?,
-        )
-    };
     let idx: Vec<usize> = (0..sets.len()).collect();
     let m = shapedist::pairwise_matrix(&idx, |&i, &j| {
-        let (pa, pb) = match &prepared {
-            Some(p) => (Some(&p[i]), Some(&p[j])),
-            None => (None, None),
-        };
-        compare(&sets[i], &sets[j], pa, pb, c).map(|(d, _)| d)
+        compare(&sets[i], &sets[j], c).map(|(r, _)| r.distance())
     })
     .map_err(|e| e.error.context(format!("pair ({}, {})", e.i, e.j)))?;
     let labels: Vec<String> = sets.iter().map(|s| s.label.clone()).collect();

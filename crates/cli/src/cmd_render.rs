@@ -83,15 +83,13 @@ const COLOR_POINT: [u8; 3] = [255, 150, 0];
 /// Safety cap on the number of levels drawn per field.
 const MAX_LEVELS: usize = 1000;
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum OutKind {
-    Picture,
-    Glb,
+meshcore::choice! {
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    enum OutKind: "picture", meshcore::UnknownChoice {
+        Picture = "svg" | "png",
+        Glb = "glb",
+    }
 }
-meshcore::choice!(OutKind, "picture", meshcore::UnknownChoice {
-    Picture = "svg" | "png",
-    Glb = "glb",
-});
 
 fn out_kind(path: &Path) -> anyhow::Result<OutKind> {
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");

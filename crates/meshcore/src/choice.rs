@@ -71,6 +71,33 @@ impl std::error::Error for UnknownChoice {}
 
 /// Implements [`Choice`], `FromStr` and `Display` for a fieldless enum.
 ///
+/// Two forms: for an enum declared elsewhere, `choice!(Enum, "what", Error { Variant = "name",
+/// ... })`; or the enum declared in the macro, each variant written once with its name (its
+/// attributes and doc comments kept):
+///
+/// ```
+/// #[derive(Debug)]
+/// struct MyError(meshcore::UnknownChoice);
+/// impl From<meshcore::UnknownChoice> for MyError {
+///     fn from(e: meshcore::UnknownChoice) -> Self { MyError(e) }
+/// }
+/// meshcore::choice! {
+///     /// How a surface is shaded.
+///     #[derive(Debug, Clone, Copy, PartialEq, Default)]
+///     pub enum Shade: "shading", MyError {
+///         /// One colour per face.
+///         #[default]
+///         Flat = "flat",
+///         /// Interpolated normals.
+///         Smooth = "smooth" | "gouraud",
+///     }
+/// }
+/// assert_eq!("gouraud".parse::<Shade>().unwrap(), Shade::Smooth);
+/// assert_eq!(Shade::default().to_string(), "flat");
+/// ```
+///
+/// The first form:
+///
 /// ```
 /// #[derive(Debug, Clone, Copy, PartialEq)]
 /// enum Shade { Flat, Smooth }
@@ -115,6 +142,18 @@ macro_rules! choice {
                 f.write_str($crate::Choice::name(*self))
             }
         }
+    };
+    (
+        $(#[$meta:meta])*
+        $vis:vis enum $ty:ident : $what:literal, $err:ty {
+            $($(#[$vmeta:meta])* $variant:ident = $name:literal $(| $alias:literal)*),+ $(,)?
+        }
+    ) => {
+        $(#[$meta])*
+        $vis enum $ty {
+            $($(#[$vmeta])* $variant),+
+        }
+        $crate::choice!($ty, $what, $err { $($variant = $name $(| $alias)*),+ });
     };
 }
 

@@ -44,6 +44,36 @@ fn dtype_name(a: &Bound<'_, PyUntypedArray>) -> String {
         .unwrap_or_else(|_| "?".into())
 }
 
+/// `a` if its dtype kind is one of `kinds` (numpy's one-letter kinds), else an
+/// `InputTypeError` saying it must be an array of `of`.
+fn check_kind(a: &Bound<'_, PyUntypedArray>, what: &str, kinds: &[u8], of: &str) -> PyResult<u8> {
+    let kind = a.dtype().kind();
+    if !kinds.contains(&kind) {
+        return Err(errors::type_error(format!(
+            "{what} must be an array of {of}, got dtype {}",
+            dtype_name(a)
+        )));
+    }
+    Ok(kind)
+}
+
+/// `a` as an aligned array of `T` (`name`: the numpy dtype name), converted with `astype` when
+/// its dtype is another one.
+fn typed<'py, T: numpy::Element>(
+    a: Bound<'py, PyUntypedArray>,
+    name: &str,
+    what: &str,
+) -> PyResult<Bound<'py, PyArrayDyn<T>>> {
+    let a = if a.dtype().is_equiv_to(&numpy::dtype::<T>(a.py())) {
+        a.into_any()
+    } else {
+        a.call_method1("astype", (name,))?
+    };
+    aligned(a)?
+        .cast_into::<PyArrayDyn<T>>()
+        .map_err(|_| errors::type_error(format!("{what}: expected an array of dtype {name}")))
+}
+
 /// `obj` as a float64 array: real floating and integer dtypes are converted (exactly for
 /// float16/32 and integers below 2^53), anything else (bool, complex, strings, objects) is an
 /// `InputTypeError`.
@@ -52,21 +82,8 @@ pub fn f64_array<'py>(
     what: &str,
 ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
     let a = as_ndarray(obj, what)?;
-    let kind = a.dtype().kind();
-    if !matches!(kind, b'f' | b'i' | b'u') {
-        return Err(errors::type_error(format!(
-            "{what} must be an array of real numbers, got dtype {}",
-            dtype_name(&a)
-        )));
-    }
-    let a = if a.dtype().is_equiv_to(&numpy::dtype::<f64>(obj.py())) {
-        a.into_any()
-    } else {
-        a.call_method1("astype", ("float64",))?
-    };
-    aligned(a)?
-        .cast_into::<PyArrayDyn<f64>>()
-        .map_err(|_| errors::type_error(format!("{what}: expected a float64 array")))
+    check_kind(&a, what, b"fiu", "real numbers")?;
+    typed(a, "float64", what)
 }
 
 /// `obj` as an int64 array; integer dtypes only (a float array of indices is an
@@ -77,13 +94,7 @@ pub fn i64_array<'py>(
     what: &str,
 ) -> PyResult<Bound<'py, PyArrayDyn<i64>>> {
     let a = as_ndarray(obj, what)?;
-    let kind = a.dtype().kind();
-    if !matches!(kind, b'i' | b'u') {
-        return Err(errors::type_error(format!(
-            "{what} must be an array of integers, got dtype {}",
-            dtype_name(&a)
-        )));
-    }
+    let kind = check_kind(&a, what, b"iu", "integers")?;
     if kind == b'u' && a.dtype().itemsize() == 8 {
         let max = a.call_method0("max");
         if let Ok(m) = max {
@@ -93,14 +104,7 @@ pub fn i64_array<'py>(
             }
         }
     }
-    let a = if a.dtype().is_equiv_to(&numpy::dtype::<i64>(obj.py())) {
-        a.into_any()
-    } else {
-        a.call_method1("astype", ("int64",))?
-    };
-    aligned(a)?
-        .cast_into::<PyArrayDyn<i64>>()
-        .map_err(|_| errors::type_error(format!("{what}: expected an int64 array")))
+    typed(a, "int64", what)
 }
 
 fn shape_str(shape: &[usize]) -> String {
@@ -112,24 +116,49 @@ fn shape_str(shape: &[usize]) -> String {
     }
 }
 
-/// An `(n, 3)` array of real numbers as points (`n` may be 0; callers decide).
-pub fn points(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<DVec3>> {
-    let a = f64_array(obj, what)?;
+/// How the shape of an array is checked by [`values`].
+#[derive(Debug, Clone, Copy)]
+enum Shape {
+    /// 1-dimensional (`scalar`: a 0-dimensional array is taken as one value).
+    Vector { scalar: bool },
+    /// `(rows, 3)`, `rows` naming the row count in the message (`n`, `m`).
+    Rows3(&'static str),
+}
+
+/// The values of `a` in row-major order (read through its strides) after checking its shape.
+fn values<T: numpy::Element + Copy>(
+    a: &Bound<'_, PyArrayDyn<T>>,
+    what: &str,
+    shape: Shape,
+) -> PyResult<Vec<T>> {
     let ro = a
         .try_readonly()
         .map_err(|e| errors::input(format!("{what}: {e}")))?;
     let v = ro.as_array();
-    if v.ndim() != 2 || v.shape()[1] != 3 {
+    let sh = v.shape();
+    let (ok, expected) = match shape {
+        Shape::Vector { scalar } => (
+            sh.len() == 1 || (scalar && sh.is_empty()),
+            "be 1-dimensional, got shape".to_string(),
+        ),
+        Shape::Rows3(rows) => (
+            sh.len() == 2 && sh[1] == 3,
+            format!("have shape ({rows}, 3), got"),
+        ),
+    };
+    if !ok {
         return Err(errors::input(format!(
-            "{what} must have shape (n, 3), got {}",
-            shape_str(v.shape())
+            "{what} must {expected} {}",
+            shape_str(sh)
         )));
     }
-    let v = v
-        .into_dimensionality::<numpy::ndarray::Ix2>()
-        .map_err(|e| errors::input(format!("{what}: {e}")))?;
-    Ok(v.rows()
-        .into_iter()
+    Ok(v.iter().copied().collect())
+}
+
+/// An `(n, 3)` array of real numbers as points (`n` may be 0; callers decide).
+pub fn points(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<DVec3>> {
+    let v = values(&f64_array(obj, what)?, what, Shape::Rows3("n"))?;
+    Ok(v.chunks_exact(3)
         .map(|r| DVec3::new(r[0], r[1], r[2]))
         .collect())
 }
@@ -148,36 +177,19 @@ pub fn point(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<DVec3> {
 
 /// A 1-D array of real numbers.
 pub fn f64_vec(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
-    let a = f64_array(obj, what)?;
-    let ro = a
-        .try_readonly()
-        .map_err(|e| errors::input(format!("{what}: {e}")))?;
-    let v = ro.as_array();
-    if v.ndim() != 1 {
-        return Err(errors::input(format!(
-            "{what} must be 1-dimensional, got shape {}",
-            shape_str(v.shape())
-        )));
-    }
-    Ok(v.iter().copied().collect())
+    values(
+        &f64_array(obj, what)?,
+        what,
+        Shape::Vector { scalar: false },
+    )
 }
 
 /// A 1-D array (or a scalar) of integers, each in `0..=u32::MAX`.
 pub fn u32_vec(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<u32>> {
-    let a = i64_array(obj, what)?;
-    let ro = a
-        .try_readonly()
-        .map_err(|e| errors::input(format!("{what}: {e}")))?;
-    let v = ro.as_array();
-    if v.ndim() > 1 {
-        return Err(errors::input(format!(
-            "{what} must be 1-dimensional, got shape {}",
-            shape_str(v.shape())
-        )));
-    }
-    v.iter()
+    let v = values(&i64_array(obj, what)?, what, Shape::Vector { scalar: true })?;
+    v.into_iter()
         .enumerate()
-        .map(|(k, &x)| {
+        .map(|(k, x)| {
             u32::try_from(x)
                 .map_err(|_| errors::index(format!("{what}[{k}] = {x} is not a valid index")))
         })
@@ -187,44 +199,15 @@ pub fn u32_vec(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<u32>> {
 /// A 1-D array of integers as `u64` (negative values rejected).
 pub fn u64_vec(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<u64>> {
     let a = as_ndarray(obj, what)?;
-    let kind = a.dtype().kind();
-    if !matches!(kind, b'i' | b'u') {
-        return Err(errors::type_error(format!(
-            "{what} must be an array of integers, got dtype {}",
-            dtype_name(&a)
-        )));
-    }
+    let kind = check_kind(&a, what, b"iu", "integers")?;
+    let vector = Shape::Vector { scalar: false };
     if kind == b'u' {
-        let a = aligned(a.call_method1("astype", ("uint64",))?)?;
-        let a = a
-            .cast_into::<PyArrayDyn<u64>>()
-            .map_err(|_| errors::type_error(format!("{what}: expected a uint64 array")))?;
-        let ro = a
-            .try_readonly()
-            .map_err(|e| errors::input(format!("{what}: {e}")))?;
-        let v = ro.as_array();
-        if v.ndim() != 1 {
-            return Err(errors::input(format!(
-                "{what} must be 1-dimensional, got shape {}",
-                shape_str(v.shape())
-            )));
-        }
-        return Ok(v.iter().copied().collect());
+        return values(&typed::<u64>(a, "uint64", what)?, what, vector);
     }
-    let a = i64_array(a.as_any(), what)?;
-    let ro = a
-        .try_readonly()
-        .map_err(|e| errors::input(format!("{what}: {e}")))?;
-    let v = ro.as_array();
-    if v.ndim() != 1 {
-        return Err(errors::input(format!(
-            "{what} must be 1-dimensional, got shape {}",
-            shape_str(v.shape())
-        )));
-    }
-    v.iter()
+    let v = values(&i64_array(a.as_any(), what)?, what, vector)?;
+    v.into_iter()
         .enumerate()
-        .map(|(k, &x)| {
+        .map(|(k, x)| {
             u64::try_from(x).map_err(|_| errors::input(format!("{what}[{k}] = {x} is negative")))
         })
         .collect()
@@ -251,22 +234,9 @@ pub fn bool_vec(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<bool>> {
 /// An `(m, 3)` array of vertex indices (range against the vertex count is checked by
 /// `TriMesh::new`).
 pub fn triangles(obj: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<[u32; 3]>> {
-    let a = i64_array(obj, what)?;
-    let ro = a
-        .try_readonly()
-        .map_err(|e| errors::input(format!("{what}: {e}")))?;
-    let v = ro.as_array();
-    if v.ndim() != 2 || v.shape()[1] != 3 {
-        return Err(errors::input(format!(
-            "{what} must have shape (m, 3), got {}",
-            shape_str(v.shape())
-        )));
-    }
-    let v = v
-        .into_dimensionality::<numpy::ndarray::Ix2>()
-        .map_err(|e| errors::input(format!("{what}: {e}")))?;
-    let mut out = Vec::with_capacity(v.nrows());
-    for (f, r) in v.rows().into_iter().enumerate() {
+    let v = values(&i64_array(obj, what)?, what, Shape::Rows3("m"))?;
+    let mut out = Vec::with_capacity(v.len() / 3);
+    for (f, r) in v.chunks_exact(3).enumerate() {
         let mut t = [0u32; 3];
         for k in 0..3 {
             t[k] = u32::try_from(r[k]).map_err(|_| {
@@ -333,4 +303,17 @@ pub fn with_threads<R: Send>(
             Ok(pool.install(f))
         }
     }
+}
+
+/// What `__reduce__` returns: the module function rebuilding the object, and its arguments.
+pub type Reduced<'py> = (Bound<'py, PyAny>, Bound<'py, pyo3::types::PyTuple>);
+
+/// The `__reduce__` value of an object rebuilt (unpickled) by `bipolar._bipolar.<rebuild>(*args)`.
+pub fn reduced<'py>(
+    py: Python<'py>,
+    rebuild: &str,
+    args: impl IntoIterator<Item = Bound<'py, PyAny>, IntoIter: ExactSizeIterator>,
+) -> PyResult<Reduced<'py>> {
+    let f = py.import("bipolar._bipolar")?.getattr(rebuild)?;
+    Ok((f, pyo3::types::PyTuple::new(py, args)?))
 }

@@ -5,47 +5,13 @@ use crate::descriptor::PyDescriptor;
 use crate::errors;
 use crate::geodesic::PyGeodesicSolver;
 use crate::mesh::mesh_arg;
-use bipolar::{DescriptorOptions, LevelSpec, Source, TangentMethod};
+use bipolar::{DescriptorOptions, LevelSpec, Source};
 use geodesic::Method;
 use glam::DVec3;
 use meshcore::{FaceLocator, TriMesh};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyString};
+use pyo3::types::{PyDict, PyString, PyTuple};
 use std::time::{Duration, Instant};
-
-/// Descriptor options from the arguments of `bipolar describe` (same defaults and rules).
-#[allow(clippy::too_many_arguments)]
-fn options(
-    levels: Option<u32>,
-    step: Option<f64>,
-    max_level: Option<u32>,
-    angles: u32,
-    alpha: f64,
-    rule: &str,
-    tolerance: Option<f64>,
-    tangent: &str,
-) -> PyResult<DescriptorOptions> {
-    let levels = match (levels, step) {
-        (Some(_), Some(_)) => return Err(errors::input("give levels or step, not both")),
-        (_, Some(s)) => LevelSpec::Step(s),
-        (Some(n), None) => LevelSpec::Count(n),
-        (None, None) => LevelSpec::Count(10),
-    };
-    let rule = rule
-        .parse::<bipolar::SelectionKind>()
-        .map_err(errors::descriptor)?
-        .rule(tolerance.unwrap_or(alpha / (4.0 * angles.max(1) as f64)));
-    let tangent: TangentMethod = tangent.parse().map_err(errors::descriptor)?;
-    Ok(DescriptorOptions {
-        levels,
-        max_level,
-        angles,
-        alpha,
-        rule,
-        tangent,
-        ..DescriptorOptions::default()
-    })
-}
 
 /// Labelled landmark positions given by the caller: a path (lm3 / JSON, read by
 /// `mesh_io::read_landmark_file`) or a dict `{label: (x, y, z)}`.
@@ -160,9 +126,23 @@ pub(crate) fn references(
     Ok(out)
 }
 
-/// `describe` and the seconds spent in library calls (for the overhead benchmark).
+/// The bipolar descriptor of a mesh (the options of ``bipolar describe``).
+///
+/// ``mesh``: a ``Mesh`` or a path. References ``ref_a``, ``ref_b`` and further ``refs``: a
+/// vertex index, an ``(x, y, z)`` point (snapped to the nearest surface point) or a landmark
+/// name (``"outer-eye-right"``, ...), looked up in ``landmarks`` (a ``.lm3`` / JSON path or a
+/// ``{label: (x, y, z)}`` dict; positions are snapped) or, without it, detected automatically.
+/// ``levels`` (default 10) or ``step``; ``max_level`` limits the region (fields cut off);
+/// ``angles`` K, ``alpha``; ``rule`` ``"isoangle"`` | ``"filter"`` (``tolerance``, default
+/// ``alpha / (4 K)``) | ``"all"``; ``tangent`` ``"gradient"`` | ``"strip"`` | ``"spline"``;
+/// geodesic ``method`` ``"exact"`` | ``"fmm"`` | ``"heat"`` | ``"dijkstra"``, or a prepared
+/// ``solver`` for this mesh (then ``method`` is ignored). The GIL is released while it runs.
+#[pyfunction]
+#[pyo3(signature = (mesh, ref_a, ref_b, *, refs=None, levels=None, step=None, max_level=None,
+                    angles=8, alpha=0.95, rule="isoangle", tolerance=None, tangent="gradient",
+                    method="exact", landmarks=None, solver=None))]
 #[allow(clippy::too_many_arguments)]
-fn describe_impl(
+pub fn describe(
     py: Python<'_>,
     mesh: &Bound<'_, PyAny>,
     ref_a: &Bound<'_, PyAny>,
@@ -179,10 +159,27 @@ fn describe_impl(
     method: &str,
     landmarks: Option<&Bound<'_, PyAny>>,
     solver: Option<&Bound<'_, PyGeodesicSolver>>,
-) -> PyResult<(PyDescriptor, f64)> {
-    let opts = options(
-        levels, step, max_level, angles, alpha, rule, tolerance, tangent,
-    )?;
+) -> PyResult<PyDescriptor> {
+    // The options of `bipolar describe` (same defaults and rules).
+    let levels = match (levels, step) {
+        (Some(_), Some(_)) => return Err(errors::input("give levels or step, not both")),
+        (_, Some(s)) => LevelSpec::Step(s),
+        (Some(n), None) => LevelSpec::Count(n),
+        (None, None) => LevelSpec::Count(10),
+    };
+    let rule = rule
+        .parse::<bipolar::SelectionKind>()
+        .map_err(errors::descriptor)?
+        .rule(tolerance.unwrap_or(alpha / (4.0 * angles.max(1) as f64)));
+    let opts = DescriptorOptions {
+        levels,
+        max_level,
+        angles,
+        alpha,
+        rule,
+        tangent: tangent.parse().map_err(errors::descriptor)?,
+        ..DescriptorOptions::default()
+    };
     let m = mesh_arg(mesh)?;
     let mesh = m.mesh();
     let given = landmarks.map(given_landmarks).transpose()?;
@@ -231,89 +228,27 @@ fn describe_impl(
         }
     };
     in_library += t;
-    let d = d.map_err(errors::descriptor)?;
-    Ok((PyDescriptor { d }, in_library.as_secs_f64()))
+    LIBRARY_SECONDS.set(in_library.as_secs_f64());
+    Ok(PyDescriptor {
+        d: d.map_err(errors::descriptor)?,
+    })
 }
 
-/// The bipolar descriptor of a mesh (the options of ``bipolar describe``).
-///
-/// ``mesh``: a ``Mesh`` or a path. References ``ref_a``, ``ref_b`` and further ``refs``: a
-/// vertex index, an ``(x, y, z)`` point (snapped to the nearest surface point) or a landmark
-/// name (``"outer-eye-right"``, ...), looked up in ``landmarks`` (a ``.lm3`` / JSON path or a
-/// ``{label: (x, y, z)}`` dict; positions are snapped) or, without it, detected automatically.
-/// ``levels`` (default 10) or ``step``; ``max_level`` limits the region (fields cut off);
-/// ``angles`` K, ``alpha``; ``rule`` ``"isoangle"`` | ``"filter"`` (``tolerance``, default
-/// ``alpha / (4 K)``) | ``"all"``; ``tangent`` ``"gradient"`` | ``"strip"`` | ``"spline"``;
-/// geodesic ``method`` ``"exact"`` | ``"fmm"`` | ``"heat"`` | ``"dijkstra"``, or a prepared
-/// ``solver`` for this mesh (then ``method`` is ignored). The GIL is released while it runs.
-#[pyfunction]
-#[pyo3(signature = (mesh, ref_a, ref_b, *, refs=None, levels=None, step=None, max_level=None,
-                    angles=8, alpha=0.95, rule="isoangle", tolerance=None, tangent="gradient",
-                    method="exact", landmarks=None, solver=None))]
-#[allow(clippy::too_many_arguments)]
-pub fn describe(
-    py: Python<'_>,
-    mesh: &Bound<'_, PyAny>,
-    ref_a: &Bound<'_, PyAny>,
-    ref_b: &Bound<'_, PyAny>,
-    refs: Option<&Bound<'_, PyAny>>,
-    levels: Option<u32>,
-    step: Option<f64>,
-    max_level: Option<u32>,
-    angles: u32,
-    alpha: f64,
-    rule: &str,
-    tolerance: Option<f64>,
-    tangent: &str,
-    method: &str,
-    landmarks: Option<&Bound<'_, PyAny>>,
-    solver: Option<&Bound<'_, PyGeodesicSolver>>,
-) -> PyResult<PyDescriptor> {
-    describe_impl(
-        py, mesh, ref_a, ref_b, refs, levels, step, max_level, angles, alpha, rule, tolerance,
-        tangent, method, landmarks, solver,
-    )
-    .map(|(d, _)| d)
+thread_local! {
+    /// Seconds the last `describe` on this thread spent inside library calls.
+    static LIBRARY_SECONDS: std::cell::Cell<f64> = const { std::cell::Cell::new(0.0) };
 }
 
-/// ``describe`` returning ``(descriptor, seconds spent inside the library calls)``: the time
-/// the Rust crates took (references, solver preparation, descriptor), for measuring the
-/// binding's own overhead (python/benchmarks).
-///
-/// ``mesh``: a ``Mesh`` or a path. References ``ref_a``, ``ref_b`` and further ``refs``: a
-/// vertex index, an ``(x, y, z)`` point (snapped to the nearest surface point) or a landmark
-/// name (``"outer-eye-right"``, ...), looked up in ``landmarks`` (a ``.lm3`` / JSON path or a
-/// ``{label: (x, y, z)}`` dict; positions are snapped) or, without it, detected automatically.
-/// ``levels`` (default 10) or ``step``; ``max_level`` limits the region (fields cut off);
-/// ``angles`` K, ``alpha``; ``rule`` ``"isoangle"`` | ``"filter"`` (``tolerance``, default
-/// ``alpha / (4 K)``) | ``"all"``; ``tangent`` ``"gradient"`` | ``"strip"`` | ``"spline"``;
-/// geodesic ``method`` ``"exact"`` | ``"fmm"`` | ``"heat"`` | ``"dijkstra"``, or a prepared
-/// ``solver`` for this mesh (then ``method`` is ignored). The GIL is released while it runs.
+/// ``describe`` (same arguments) returning ``(descriptor, seconds spent inside the library
+/// calls)``: the time the Rust crates took (references, solver preparation, descriptor), for
+/// measuring the binding's own overhead (python/benchmarks).
 #[pyfunction]
-#[pyo3(signature = (mesh, ref_a, ref_b, *, refs=None, levels=None, step=None, max_level=None,
-                    angles=8, alpha=0.95, rule="isoangle", tolerance=None, tangent="gradient",
-                    method="exact", landmarks=None, solver=None))]
-#[allow(clippy::too_many_arguments)]
-pub fn _describe_profiled(
-    py: Python<'_>,
-    mesh: &Bound<'_, PyAny>,
-    ref_a: &Bound<'_, PyAny>,
-    ref_b: &Bound<'_, PyAny>,
-    refs: Option<&Bound<'_, PyAny>>,
-    levels: Option<u32>,
-    step: Option<f64>,
-    max_level: Option<u32>,
-    angles: u32,
-    alpha: f64,
-    rule: &str,
-    tolerance: Option<f64>,
-    tangent: &str,
-    method: &str,
-    landmarks: Option<&Bound<'_, PyAny>>,
-    solver: Option<&Bound<'_, PyGeodesicSolver>>,
-) -> PyResult<(PyDescriptor, f64)> {
-    describe_impl(
-        py, mesh, ref_a, ref_b, refs, levels, step, max_level, angles, alpha, rule, tolerance,
-        tangent, method, landmarks, solver,
-    )
+#[pyo3(signature = (*args, **kwargs))]
+pub fn _describe_profiled<'py>(
+    py: Python<'py>,
+    args: &Bound<'py, PyTuple>,
+    kwargs: Option<&Bound<'py, PyDict>>,
+) -> PyResult<(Bound<'py, PyAny>, f64)> {
+    let d = wrap_pyfunction!(describe, py)?.call(args, kwargs)?;
+    Ok((d, LIBRARY_SECONDS.get()))
 }

@@ -5,7 +5,7 @@ use crate::errors;
 use bipolar::{Descriptor, DescriptorPoint, Key};
 use glam::DVec3;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyTuple};
+use pyo3::types::PyDict;
 
 /// A bipolar descriptor: keyed points on a surface, sorted by key then position.
 ///
@@ -237,17 +237,12 @@ impl PyDescriptor {
         )
     }
 
-    fn __reduce__<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
-        let f = py
-            .import("bipolar._bipolar")?
-            .getattr("_descriptor_from_state")?;
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<convert::Reduced<'py>> {
         let mut meta = self.d.clone();
         meta.points.clear();
-        let args = PyTuple::new(
+        convert::reduced(
             py,
+            "_descriptor_from_state",
             [
                 self.points(py).into_any(),
                 self.keys(py).into_any(),
@@ -259,8 +254,7 @@ impl PyDescriptor {
                     .into_pyobject(py)?
                     .into_any(),
             ],
-        )?;
-        Ok((f, args))
+        )
     }
 }
 

@@ -5,27 +5,14 @@
 use crate::convert::{self, rows_out};
 use crate::descriptor::PyDescriptor;
 use crate::errors;
-use glam::{DMat3, DVec3};
+use meshcore::Choice;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyTuple};
+use pyo3::types::PyDict;
 use rayon::prelude::*;
-use serde_json::json;
 use shapedist::{
-    GlobalOptions, IcpOptions, IcpVariant, KeyedOptions, PrepareOptions, PreparedSet, RobustLoss,
-    RotationMethod, ShapeDistError, Which,
+    CompareOptions, ComparedSet, IcpVariant, Mode, RobustWeights, RotationMethod, ShapeDistError,
+    Which,
 };
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Mode {
-    Keys,
-    Icp,
-    Hausdorff,
-}
-meshcore::choice!(Mode, "mode", meshcore::UnknownChoice {
-    Keys = "keys",
-    Icp = "icp",
-    Hausdorff = "hausdorff",
-});
 
 /// How two descriptors are compared (the flags of ``bipolar distance``).
 ///
@@ -40,17 +27,11 @@ meshcore::choice!(Mode, "mode", meshcore::UnknownChoice {
 #[pyclass(module = "bipolar._bipolar", name = "DistanceOptions", frozen)]
 #[derive(Debug, Clone)]
 pub struct PyDistanceOptions {
-    mode: Mode,
     solver: String,
     robust: Option<String>,
-    gate: Option<f64>,
     keep_ambiguous: bool,
     variant: String,
-    trim: f64,
-    iterations: usize,
-    global_search: bool,
-    keyed: KeyedOptions,
-    global: GlobalOptions,
+    o: CompareOptions,
 }
 
 #[pymethods]
@@ -71,58 +52,43 @@ impl PyDistanceOptions {
         iterations: usize,
         global_search: bool,
     ) -> PyResult<Self> {
-        let m: Mode = mode.parse().map_err(|e| errors::input(format!("{e}")))?;
-        let method: RotationMethod = solver.parse().map_err(errors::shapedist)?;
-        let robust_loss = match robust {
-            None => None,
-            Some("huber") => Some(RobustLoss::Huber(1.345)),
-            Some("tukey") => Some(RobustLoss::Tukey(4.685)),
-            Some(o) => {
-                return Err(errors::input(format!(
-                    "unknown robust weights {o:?} (expected huber, tukey or None)"
-                )))
-            }
-        };
-        let icp_variant: IcpVariant = variant.parse().map_err(errors::shapedist)?;
-        let keyed = KeyedOptions {
-            method,
-            robust: robust_loss,
-            irls_iterations: 5,
+        let mode = Mode::from_name(mode).map_err(|e| {
+            errors::input(meshcore::UnknownChoice { what: "mode", ..e }.to_string())
+        })?;
+        let robust_weights = robust
+            .map(|r| {
+                RobustWeights::from_name(r).map_err(|_| {
+                    errors::input(format!(
+                        "unknown robust weights {r:?} (expected huber, tukey or None)"
+                    ))
+                })
+            })
+            .transpose()?;
+        let o = CompareOptions {
+            mode,
+            solver: solver
+                .parse::<RotationMethod>()
+                .map_err(errors::shapedist)?,
+            robust: robust_weights,
             gate,
-        };
-        let global = GlobalOptions {
-            grid: global_search,
-            refine: IcpOptions {
-                variant: icp_variant,
-                max_iterations: iterations.max(1),
-                trim,
-                ..IcpOptions::default()
-            },
-            ..GlobalOptions::default()
-        };
-        Ok(Self {
-            mode: m,
-            solver: solver.into(),
-            robust: robust.map(Into::into),
-            gate,
-            keep_ambiguous,
-            variant: variant.into(),
+            variant: variant.parse::<IcpVariant>().map_err(errors::shapedist)?,
             trim,
             iterations,
             global_search,
-            keyed,
-            global,
+        };
+        Ok(Self {
+            solver: solver.into(),
+            robust: robust.map(Into::into),
+            keep_ambiguous,
+            variant: variant.into(),
+            o,
         })
     }
 
     /// ``"keys"``, ``"icp"`` or ``"hausdorff"``.
     #[getter]
     fn mode(&self) -> &'static str {
-        match self.mode {
-            Mode::Keys => "keys",
-            Mode::Icp => "icp",
-            Mode::Hausdorff => "hausdorff",
-        }
+        self.o.mode.name()
     }
 
     /// The options as keyword arguments of the constructor.
@@ -131,12 +97,12 @@ impl PyDistanceOptions {
         d.set_item("mode", self.mode())?;
         d.set_item("solver", &self.solver)?;
         d.set_item("robust", &self.robust)?;
-        d.set_item("gate", self.gate)?;
+        d.set_item("gate", self.o.gate)?;
         d.set_item("keep_ambiguous", self.keep_ambiguous)?;
         d.set_item("variant", &self.variant)?;
-        d.set_item("trim", self.trim)?;
-        d.set_item("iterations", self.iterations)?;
-        d.set_item("global_search", self.global_search)?;
+        d.set_item("trim", self.o.trim)?;
+        d.set_item("iterations", self.o.iterations)?;
+        d.set_item("global_search", self.o.global_search)?;
         Ok(d)
     }
 
@@ -144,14 +110,12 @@ impl PyDistanceOptions {
         Ok(format!("DistanceOptions(**{})", self.as_dict(py)?.repr()?))
     }
 
-    fn __reduce__<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
-        let f = py
-            .import("bipolar._bipolar")?
-            .getattr("_distance_options_from_dict")?;
-        Ok((f, PyTuple::new(py, [self.as_dict(py)?])?))
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<convert::Reduced<'py>> {
+        convert::reduced(
+            py,
+            "_distance_options_from_dict",
+            [self.as_dict(py)?.into_any()],
+        )
     }
 }
 
@@ -189,144 +153,18 @@ pub fn options_arg(
 }
 
 /// A descriptor reduced to what the distances need (as `bipolar distance` loads a file).
-struct Loaded {
-    keys: Vec<u64>,
-    key_points: Vec<DVec3>,
-    points: Vec<DVec3>,
+fn load(d: &bipolar::Descriptor, keep_ambiguous: bool) -> ComparedSet {
+    let (keys, key_points) = d.keyed_points(keep_ambiguous);
+    ComparedSet::new(keys, key_points, d.positions())
 }
 
-fn load(d: &bipolar::Descriptor, keep_ambiguous: bool) -> Loaded {
-    let kept: Vec<_> = d
-        .points
-        .iter()
-        .filter(|p| keep_ambiguous || !p.ambiguous)
-        .collect();
-    Loaded {
-        keys: kept.iter().map(|p| p.key.pack()).collect(),
-        key_points: kept.iter().map(|p| p.position).collect(),
-        points: d.positions(),
-    }
-}
-
-/// The sets of a list of descriptors, prepared once for the ICP modes.
-struct Sets {
-    loaded: Vec<Loaded>,
-    prepared: Option<Vec<PreparedSet>>,
-}
-
-fn prepare_sets(
-    ds: &[&bipolar::Descriptor],
+/// The distance of one pair.
+fn distance_of(
+    a: &ComparedSet,
+    b: &ComparedSet,
     o: &PyDistanceOptions,
-    which: Which,
-) -> Result<Sets, (usize, ShapeDistError)> {
-    let loaded: Vec<Loaded> = ds.iter().map(|d| load(d, o.keep_ambiguous)).collect();
-    let prepared = if o.mode == Mode::Keys {
-        None
-    } else {
-        let po = PrepareOptions::default();
-        Some(
-            loaded
-                .par_iter()
-                .enumerate()
-                .map(|(i, l)| PreparedSet::new(&l.points, &po, which).map_err(|e| (i, e)))
-                .collect::<Result<Vec<_>, _>>()?,
-        )
-    };
-    Ok(Sets { loaded, prepared })
-}
-
-fn rows(r: DMat3) -> [[f64; 3]; 3] {
-    let t = r.transpose();
-    [
-        t.x_axis.to_array(),
-        t.y_axis.to_array(),
-        t.z_axis.to_array(),
-    ]
-}
-
-/// The distance of one pair and, when `details`, the fields `bipolar distance --json` prints.
-fn compare(
-    a: &Loaded,
-    b: &Loaded,
-    pa: Option<&PreparedSet>,
-    pb: Option<&PreparedSet>,
-    o: &PyDistanceOptions,
-    details: bool,
-) -> Result<(f64, Option<serde_json::Value>), ShapeDistError> {
-    match o.mode {
-        Mode::Keys => {
-            let r = shapedist::keyed_distance(
-                &a.keys,
-                &a.key_points,
-                &b.keys,
-                &b.key_points,
-                &o.keyed,
-            )?;
-            let v = details.then(|| {
-                json!({
-                    "mode": "keys",
-                    "distance": r.distance,
-                    "rotation": rows(r.motion.matrix3),
-                    "translation": r.motion.translation.to_array(),
-                    "shared_keys": r.shared_keys,
-                    "pairs_used": r.pairs_used,
-                    "share_a": r.share_a,
-                    "share_b": r.share_b,
-                    "points_a": a.points.len(),
-                    "points_b": b.points.len(),
-                    "keyed_points_a": a.keys.len(),
-                    "keyed_points_b": b.keys.len(),
-                    "repeated_keys_a": r.ambiguous_a,
-                    "repeated_keys_b": r.ambiguous_b,
-                    "gated": r.gated,
-                    "rmse": r.rmse,
-                    "max_residual": r.max_residual,
-                })
-            });
-            Ok((r.distance, v))
-        }
-        Mode::Icp | Mode::Hausdorff => {
-            let owned;
-            let (pa, pb) = match (pa, pb) {
-                (Some(x), Some(y)) => (x, y),
-                _ => {
-                    let po = PrepareOptions::default();
-                    owned = (
-                        PreparedSet::new(&a.points, &po, Which::A)?,
-                        PreparedSet::new(&b.points, &po, Which::B)?,
-                    );
-                    (&owned.0, &owned.1)
-                }
-            };
-            let r = shapedist::icp_distance(pa, pb, &o.global)?;
-            let d = if o.mode == Mode::Icp {
-                r.stats.mean_normalised
-            } else {
-                r.stats.hausdorff_normalised
-            };
-            let v = details.then(|| {
-                json!({
-                    "mode": if o.mode == Mode::Icp { "icp" } else { "hausdorff" },
-                    "distance": d,
-                    "mean_normalised": r.stats.mean_normalised,
-                    "hausdorff_normalised": r.stats.hausdorff_normalised,
-                    "rms_normalised": r.stats.rms_normalised,
-                    "mean": r.stats.mean,
-                    "hausdorff": r.stats.hausdorff,
-                    "rms": r.stats.rms,
-                    "rotation": rows(r.motion.matrix3),
-                    "translation": r.motion.translation.to_array(),
-                    "iterations": r.iterations,
-                    "converged": r.converged,
-                    "starts": r.starts,
-                    "rmse": r.rmse,
-                    "points_a": a.points.len(),
-                    "points_b": b.points.len(),
-                })
-            });
-            Ok((d, v))
-        }
-    }
+) -> Result<f64, ShapeDistError> {
+    shapedist::compare(a, b, &o.o).map(|r| r.distance())
 }
 
 /// A failure inside a detached computation, turned into an exception once the GIL is held.
@@ -344,6 +182,44 @@ impl Fail {
             Fail::Threads(m) => errors::input(m),
         }
     }
+}
+
+/// The descriptors of each of `lists` (a Python sequence of Descriptor and its name) reduced to
+/// their sets and prepared once for the ICP modes, in parallel with the GIL released on
+/// `threads` rayon threads (default one per core); then `f` on them, in the same pool.
+fn on_sets<const N: usize, T: Send>(
+    py: Python<'_>,
+    lists: [(&Bound<'_, PyAny>, &'static str); N],
+    o: &PyDistanceOptions,
+    threads: Option<usize>,
+    f: impl FnOnce(&[Vec<ComparedSet>; N]) -> Result<T, Fail> + Send,
+) -> PyResult<T> {
+    let mut bound = Vec::with_capacity(N);
+    for (obj, what) in lists {
+        bound.push((descriptor_list(obj, what)?, what));
+    }
+    let ds: Vec<(Vec<&bipolar::Descriptor>, &'static str)> = bound
+        .iter()
+        .map(|(l, what)| (l.iter().map(|d| &d.get().d).collect(), *what))
+        .collect();
+    py.detach(|| {
+        convert::with_threads(threads, || {
+            let mut sets = Vec::with_capacity(N);
+            for (list, what) in &ds {
+                let mut s: Vec<ComparedSet> =
+                    list.iter().map(|d| load(d, o.keep_ambiguous)).collect();
+                s.par_iter_mut().enumerate().try_for_each(|(i, x)| {
+                    x.prepare(o.o.mode, Which::A)
+                        .map_err(|e| Fail::Set(what, i, e))
+                })?;
+                sets.push(s);
+            }
+            let mut sets = sets.into_iter();
+            f(&std::array::from_fn(|_| sets.next().unwrap_or_default()))
+        })
+        .map_err(Fail::Threads)?
+    })
+    .map_err(Fail::into_py)
 }
 
 fn descriptor_list<'py>(
@@ -377,11 +253,8 @@ pub fn distance(
 ) -> PyResult<f64> {
     let o = options_arg(py, options, kwargs)?;
     let (da, db) = (&a.get().d, &b.get().d);
-    py.detach(|| {
-        let (la, lb) = (load(da, o.keep_ambiguous), load(db, o.keep_ambiguous));
-        compare(&la, &lb, None, None, &o, false).map(|(d, _)| d)
-    })
-    .map_err(errors::shapedist)
+    py.detach(|| distance_of(&load(da, o.keep_ambiguous), &load(db, o.keep_ambiguous), &o))
+        .map_err(errors::shapedist)
 }
 
 /// ``distance`` with the details ``bipolar distance --json`` prints (rotation, shared keys and
@@ -400,11 +273,9 @@ pub fn distance_details<'py>(
     let v = py
         .detach(|| {
             let (la, lb) = (load(da, o.keep_ambiguous), load(db, o.keep_ambiguous));
-            compare(&la, &lb, None, None, &o, true)
+            shapedist::compare(&la, &lb, &o.o).map(|r| r.details(&la, &lb))
         })
-        .map_err(errors::shapedist)?
-        .1
-        .unwrap_or_default();
+        .map_err(errors::shapedist)?;
     py.import("json")?.call_method1("loads", (v.to_string(),))
 }
 
@@ -420,27 +291,12 @@ pub fn distance_matrix<'py>(
     kwargs: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
     let o = options_arg(py, options, kwargs)?;
-    let ds = descriptor_list(descriptors, "descriptors")?;
-    let refs: Vec<&bipolar::Descriptor> = ds.iter().map(|d| &d.get().d).collect();
-    let n = refs.len();
-    let m = py
-        .detach(|| {
-            convert::with_threads(threads, || {
-                let sets = prepare_sets(&refs, &o, Which::A)
-                    .map_err(|(i, e)| Fail::Set("descriptors", i, e))?;
-                let idx: Vec<usize> = (0..n).collect();
-                shapedist::pairwise_matrix(&idx, |&i, &j| {
-                    let (pa, pb) = match &sets.prepared {
-                        Some(p) => (Some(&p[i]), Some(&p[j])),
-                        None => (None, None),
-                    };
-                    compare(&sets.loaded[i], &sets.loaded[j], pa, pb, &o, false).map(|(d, _)| d)
-                })
-                .map_err(|e| Fail::Pair(e.i, e.j, e.error))
-            })
-            .map_err(Fail::Threads)?
-        })
-        .map_err(Fail::into_py)?;
+    let m = on_sets(py, [(descriptors, "descriptors")], &o, threads, |[sets]| {
+        let idx: Vec<usize> = (0..sets.len()).collect();
+        shapedist::pairwise_matrix(&idx, |&i, &j| distance_of(&sets[i], &sets[j], &o))
+            .map_err(|e| Fail::Pair(e.i, e.j, e.error))
+    })?;
+    let n = m.len();
     Ok(rows_out(py, m.into_iter().flatten().collect(), n))
 }
 
@@ -458,35 +314,21 @@ pub fn cross_distances<'py>(
     kwargs: Option<&Bound<'py, PyDict>>,
 ) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
     let o = options_arg(py, options, kwargs)?;
-    let r = descriptor_list(rows, "rows")?;
-    let c = descriptor_list(cols, "cols")?;
-    let rr: Vec<&bipolar::Descriptor> = r.iter().map(|d| &d.get().d).collect();
-    let cc: Vec<&bipolar::Descriptor> = c.iter().map(|d| &d.get().d).collect();
-    let (nr, nc) = (rr.len(), cc.len());
-    let flat = py
-        .detach(|| {
-            convert::with_threads(threads, || {
-                let sr =
-                    prepare_sets(&rr, &o, Which::A).map_err(|(i, e)| Fail::Set("rows", i, e))?;
-                let sc =
-                    prepare_sets(&cc, &o, Which::A).map_err(|(j, e)| Fail::Set("cols", j, e))?;
-                let pairs: Vec<(usize, usize)> =
-                    (0..nr).flat_map(|i| (0..nc).map(move |j| (i, j))).collect();
-                pairs
-                    .par_iter()
-                    .map(|&(i, j)| {
-                        let (pa, pb) = match (&sr.prepared, &sc.prepared) {
-                            (Some(p), Some(q)) => (Some(&p[i]), Some(&q[j])),
-                            _ => (None, None),
-                        };
-                        compare(&sr.loaded[i], &sc.loaded[j], pa, pb, &o, false)
-                            .map(|(d, _)| d)
-                            .map_err(|e| Fail::Pair(i, j, e))
-                    })
-                    .collect::<Result<Vec<f64>, Fail>>()
-            })
-            .map_err(Fail::Threads)?
-        })
-        .map_err(Fail::into_py)?;
+    let (flat, nc) = on_sets(
+        py,
+        [(rows, "rows"), (cols, "cols")],
+        &o,
+        threads,
+        |[r, c]| {
+            let pairs: Vec<(usize, usize)> = (0..r.len())
+                .flat_map(|i| (0..c.len()).map(move |j| (i, j)))
+                .collect();
+            let flat = pairs
+                .par_iter()
+                .map(|&(i, j)| distance_of(&r[i], &c[j], &o).map_err(|e| Fail::Pair(i, j, e)))
+                .collect::<Result<Vec<f64>, Fail>>()?;
+            Ok((flat, c.len()))
+        },
+    )?;
     Ok(rows_out(py, flat, nc))
 }

@@ -131,20 +131,9 @@ impl PyGeodesicSolver {
         threads: Option<usize>,
     ) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
         let sets = source_sets(sources)?;
-        let opts = cutoff(max_distance);
         let n = self.solver.n_vertices();
-        let fields = py
-            .detach(|| {
-                convert::with_threads(threads, || {
-                    geodesic::distances_many(self.solver.as_ref(), &sets, &opts)
-                })
-            })
-            .map_err(errors::input)?
-            .map_err(errors::geodesic)?;
-        let mut flat = Vec::with_capacity(fields.len() * n);
-        for f in fields {
-            flat.extend(f);
-        }
+        let mut flat = Vec::with_capacity(sets.len() * n);
+        self.for_each_field(py, &sets, max_distance, threads, |f| flat.extend(f))?;
         Ok(rows_out(py, flat, n))
     }
 
@@ -159,34 +148,23 @@ impl PyGeodesicSolver {
         max_distance: Option<f64>,
         threads: Option<usize>,
     ) -> PyResult<Bound<'py, PyTuple>> {
-        let src = convert::u32_vec(sources, "sources")?;
-        let opts = cutoff(max_distance);
-        let limit = opts.max_distance.unwrap_or(f64::INFINITY);
-        let result = py
-            .detach(|| {
-                convert::with_threads(threads, || {
-                    let mut indptr = vec![0i64];
-                    let mut indices: Vec<i64> = Vec::new();
-                    let mut data: Vec<f64> = Vec::new();
-                    for chunk in src.chunks(256) {
-                        let sets: Vec<Vec<Source>> =
-                            chunk.iter().map(|&v| vec![Source::Vertex(v)]).collect();
-                        let fields = geodesic::distances_many(self.solver.as_ref(), &sets, &opts)?;
-                        for f in fields {
-                            for (j, d) in f.into_iter().enumerate() {
-                                if d.is_finite() && d > 0.0 && d <= limit {
-                                    indices.push(j as i64);
-                                    data.push(d);
-                                }
-                            }
-                            indptr.push(indices.len() as i64);
-                        }
-                    }
-                    Ok::<_, geodesic::GeodesicError>((indptr, indices, data))
-                })
-            })
-            .map_err(errors::input)?;
-        let (indptr, indices, data) = result.map_err(errors::geodesic)?;
+        let sets: Vec<Vec<Source>> = convert::u32_vec(sources, "sources")?
+            .into_iter()
+            .map(|v| vec![Source::Vertex(v)])
+            .collect();
+        let limit = cutoff(max_distance).max_distance.unwrap_or(f64::INFINITY);
+        let mut indptr = vec![0i64];
+        let mut indices: Vec<i64> = Vec::new();
+        let mut data: Vec<f64> = Vec::new();
+        self.for_each_field(py, &sets, max_distance, threads, |f| {
+            for (j, d) in f.into_iter().enumerate() {
+                if d.is_finite() && d > 0.0 && d <= limit {
+                    indices.push(j as i64);
+                    data.push(d);
+                }
+            }
+            indptr.push(indices.len() as i64);
+        })?;
         PyTuple::new(
             py,
             [
@@ -203,6 +181,33 @@ impl PyGeodesicSolver {
             self.method.name(),
             self.solver.n_vertices()
         )
+    }
+}
+
+impl PyGeodesicSolver {
+    /// Calls `f` on the field of each of `sets`, in order; the fields are computed in parallel
+    /// (`threads` rayon threads, default one per core, GIL released), 256 at a time.
+    fn for_each_field(
+        &self,
+        py: Python<'_>,
+        sets: &[Vec<Source>],
+        max_distance: Option<f64>,
+        threads: Option<usize>,
+        mut f: impl FnMut(Vec<f64>) + Send,
+    ) -> PyResult<()> {
+        let opts = cutoff(max_distance);
+        py.detach(|| {
+            convert::with_threads(threads, || {
+                for chunk in sets.chunks(256) {
+                    for field in geodesic::distances_many(self.solver.as_ref(), chunk, &opts)? {
+                        f(field);
+                    }
+                }
+                Ok::<_, geodesic::GeodesicError>(())
+            })
+        })
+        .map_err(errors::input)?
+        .map_err(errors::geodesic)
     }
 }
 

@@ -37,6 +37,26 @@ fn summary_dict<'py>(py: Python<'py>, s: RepairReport) -> PyResult<Bound<'py, Py
     Ok(d)
 }
 
+impl PyMesh {
+    /// A copy repaired by `repair` with the tolerance `tol` (finite and >= 0, named `name` in
+    /// the message), GIL released, and the repair's summary as a dict.
+    fn repaired<'py>(
+        &self,
+        py: Python<'py>,
+        (name, tol): (&str, f64),
+        repair: fn(&mut LoadedMesh, f64) -> RepairReport,
+    ) -> PyResult<(Self, Bound<'py, PyDict>)> {
+        if !(tol.is_finite() && tol >= 0.0) {
+            return Err(errors::input(format!(
+                "{name} must be finite and >= 0, got {tol}"
+            )));
+        }
+        let mut out = self.clone();
+        let s = py.detach(|| repair(&mut out.loaded, tol));
+        Ok((out, summary_dict(py, s)?))
+    }
+}
+
 /// Builds a mesh from arrays (the one place a `TriMesh` is made from Python data).
 pub fn mesh_from_arrays(
     vertices: &Bound<'_, PyAny>,
@@ -284,14 +304,7 @@ impl PyMesh {
     /// collapsed faces and unused vertices. Returns ``(new_mesh, summary)``.
     #[pyo3(signature = (tol=0.0))]
     fn weld<'py>(&self, py: Python<'py>, tol: f64) -> PyResult<(Self, Bound<'py, PyDict>)> {
-        if !(tol.is_finite() && tol >= 0.0) {
-            return Err(errors::input(format!(
-                "tol must be finite and >= 0, got {tol}"
-            )));
-        }
-        let mut out = self.clone();
-        let s = py.detach(|| out.loaded.weld(tol));
-        Ok((out, summary_dict(py, s)?))
+        self.repaired(py, ("tol", tol), LoadedMesh::weld)
     }
 
     /// Removes faces with a repeated vertex or an area <= ``rel_tol * diagonal^2``, then
@@ -302,14 +315,7 @@ impl PyMesh {
         py: Python<'py>,
         rel_tol: f64,
     ) -> PyResult<(Self, Bound<'py, PyDict>)> {
-        if !(rel_tol.is_finite() && rel_tol >= 0.0) {
-            return Err(errors::input(format!(
-                "rel_tol must be finite and >= 0, got {rel_tol}"
-            )));
-        }
-        let mut out = self.clone();
-        let s = py.detach(|| out.loaded.drop_degenerate(rel_tol));
-        Ok((out, summary_dict(py, s)?))
+        self.repaired(py, ("rel_tol", rel_tol), LoadedMesh::drop_degenerate)
     }
 
     /// The bytes of a file of the given format (``"obj"``, ``"ply"`` (binary little endian),
@@ -334,11 +340,7 @@ impl PyMesh {
         )
     }
 
-    fn __reduce__<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
-        let f = py.import("bipolar._bipolar")?.getattr("_mesh_from_state")?;
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<convert::Reduced<'py>> {
         let scalars = PyDict::new(py);
         for s in &self.loaded.scalars {
             let ty = match s.ty {
@@ -347,8 +349,9 @@ impl PyMesh {
             };
             scalars.set_item(&s.name, (vec_out(py, s.values.clone()), ty))?;
         }
-        let args = PyTuple::new(
+        convert::reduced(
             py,
+            "_mesh_from_state",
             [
                 self.vertices(py).into_any(),
                 self.triangles(py).into_any(),
@@ -356,8 +359,7 @@ impl PyMesh {
                     .map_or_else(|| py.None().into_bound(py), |c| c.into_any()),
                 scalars.into_any(),
             ],
-        )?;
-        Ok((f, args))
+        )
     }
 }
 

@@ -126,24 +126,15 @@ pub fn describe_polar(
     let mesh = m.mesh();
     let given = landmarks.map(given_landmarks).transpose()?;
     let mut in_library = Duration::ZERO;
-    let pole = references(
-        py,
-        mesh,
-        &[("pole".to_string(), pole.clone())],
-        given.as_deref(),
-        &mut in_library,
-    )?[0];
+    let mut resolve = |what: &str, spec: &Bound<'_, PyAny>| {
+        let one = [(what.to_string(), spec.clone())];
+        references(py, mesh, &one, given.as_deref(), &mut in_library).map(|s| s[0])
+    };
+    let pole = resolve("pole", pole)?;
     // The angular origin is only a direction: a point is used as given (the eye-corner midpoint
     // of a face lies off the surface); a vertex or a landmark name gives its position.
     let towards = if towards.is_instance_of::<PyString>() || towards.extract::<i64>().is_ok() {
-        let r = references(
-            py,
-            mesh,
-            &[("towards".to_string(), towards.clone())],
-            given.as_deref(),
-            &mut in_library,
-        )?[0];
-        match r {
+        match resolve("towards", towards)? {
             Source::Vertex(v) => mesh.try_position(v).map_err(errors::mesh)?,
             Source::Point(sp) => mesh.point_position(&sp).map_err(errors::mesh)?,
         }

@@ -21,11 +21,15 @@
 //!   with point-to-point or point-to-plane steps, distance and normal gates, trimming,
 //!   damping and the stopping rule as options ([`IcpLoopOptions`]); [`icp()`] and
 //!   [`global_icp`] run it. Rigid motions are [`glam::DAffine3`].
+//! * [`compare()`]: one comparison in a chosen [`Mode`] (keyed, ICP mean or Hausdorff) from flat
+//!   settings ([`CompareOptions`]), with its details as JSON: what the command line and the
+//!   Python bindings call.
 //! * [`pairwise_matrix`] and [`write_matrix_csv`]: parallel symmetric distance matrices.
 //!
 //! The normalisations and their proofs of lying in [0, 1] are in `docs/shape-distance.md`.
 //! Nothing panics on user input: errors are [`ShapeDistError`].
 
+pub mod compare;
 mod error;
 pub mod icp;
 pub mod keyed;
@@ -37,6 +41,7 @@ pub mod target;
 use glam::{DAffine3, DVec3};
 use serde::Serialize;
 
+pub use compare::{compare, CompareOptions, ComparedSet, Comparison, Mode, RobustWeights};
 pub use error::{ShapeDistError, Which};
 pub use glam;
 pub use icp::{

@@ -13,6 +13,7 @@
 //! * **Analytic distance fields** and the differences between two fields: [`fields`].
 //! * **End-to-end runs** of the command-line tools: [`cli`]; the check of a crate's option
 //!   names: [`check_choice_error`].
+//! * **Temporary folders**: [`fresh_temp_dir`].
 //! * **The independent descriptor and distance** the crates are checked against: [`oracle`].
 
 pub mod cli;
@@ -173,6 +174,17 @@ where
         Err(e) => assert!(unknown(&e), "{bad:?}: unexpected error {e:?}"),
         Ok(v) => panic!("{bad:?} parses to {v:?}"),
     }
+}
+
+/// An empty folder `<temp>/<prefix>-<process id>-<name>` for a test's files (emptied first
+/// when a previous run left it).
+pub fn fresh_temp_dir(prefix: &str, name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("{prefix}-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    if let Err(e) = std::fs::create_dir_all(&d) {
+        panic!("creating {}: {e}", d.display());
+    }
+    d
 }
 
 /// Reads a mesh file with `mesh-io`; panics with the reader's message (test code).

@@ -1,9 +1,8 @@
 //! Shared pieces of `cargo xtask robustness` and `cargo xtask recognition`: the single-pole
-//! point set, the pipeline glue around `bipolar` and `shapedist`, and report writing. Straightest geodesics are
+//! descriptor, the pipeline glue around `bipolar` and `shapedist`, and report writing. Straightest geodesics are
 //! `geodesic::straightest`, the single-pole descriptor is `bipolar::polar`; face-set loading,
 //! the face frame and the static-area mask are in the `facemodel` crate.
 
-pub mod keyed;
 pub mod pipeline;
 pub mod report;
 
@@ -22,11 +21,10 @@ pub mod walk {
     }
 }
 
-/// The single-pole descriptor of `bipolar::polar`, as the experiments' keyed point sets.
+/// The single-pole descriptor of `bipolar::polar`.
 pub mod polar {
-    use super::keyed::KeyedPoints;
     use anyhow::Result;
-    use bipolar::{BipolarError, PolarKey};
+    use bipolar::{BipolarError, PolarDescriptor};
     use geodesic::Walker;
     use meshcore::DVec3;
 
@@ -34,31 +32,27 @@ pub mod polar {
     /// Where the pole is (a vertex or a surface point).
     pub use bipolar::Source as Pole;
 
-    /// `(level, sector)` of a packed polar key.
-    pub fn polar_key_parts(k: u64) -> (u32, u32) {
-        let k = PolarKey::unpack(k);
-        (k.level, k.sector)
-    }
-
-    /// [`bipolar::describe_polar`] as keyed points; a descriptor with no point (no ray reaches
-    /// level 1) is the empty set, as the experiments count it.
+    /// [`bipolar::describe_polar`]; a descriptor with no point (no ray reaches level 1) is the
+    /// empty set, as the experiments count it.
     pub fn polar_descriptor(
         walker: &Walker<'_>,
         u: &[f64],
         pole: Pole,
         towards: DVec3,
         opts: &PolarOptions,
-    ) -> Result<KeyedPoints> {
+    ) -> Result<PolarDescriptor> {
         match bipolar::describe_polar(walker, u, pole, towards, opts) {
-            Ok(d) => Ok(KeyedPoints::from_pairs(
-                d.points
-                    .iter()
-                    .map(|p| (p.key.pack(), p.position))
-                    .collect(),
-                0.0,
-            )),
-            Err(BipolarError::NoIntersections(_)) => Ok(KeyedPoints::default()),
+            Ok(d) => Ok(d),
+            Err(BipolarError::NoIntersections(_)) => Ok(empty(opts)),
             Err(e) => Err(e.into()),
+        }
+    }
+
+    /// The descriptor without points (counted as the empty set).
+    pub fn empty(opts: &PolarOptions) -> PolarDescriptor {
+        PolarDescriptor {
+            points: Vec::new(),
+            options: *opts,
         }
     }
 }

@@ -2,7 +2,6 @@
 //! per region (built by the `bipolar` crate), keyed distances (`shapedist`), reference-point
 //! perturbation, geodesic method resolution and progress bars.
 
-use super::keyed::KeyedPoints;
 use super::walk::Walker;
 use anyhow::{bail, Context, Result};
 use facemodel::{static_mask, FaceFrame};
@@ -116,17 +115,14 @@ pub trait Keyed {
 
 impl Keyed for bipolar::Descriptor {
     fn unambiguous(&self) -> (Vec<u64>, Vec<DVec3>) {
-        self.points
-            .iter()
-            .filter(|p| !p.ambiguous)
-            .map(|p| (p.key.pack(), p.position))
-            .unzip()
+        self.keyed_points(false)
     }
 }
 
-impl Keyed for KeyedPoints {
+/// The single-pole descriptor has one point per key: none is ambiguous.
+impl Keyed for bipolar::PolarDescriptor {
     fn unambiguous(&self) -> (Vec<u64>, Vec<DVec3>) {
-        KeyedPoints::unambiguous(self)
+        (self.keys(), self.positions())
     }
 }
 

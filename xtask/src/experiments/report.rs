@@ -116,6 +116,22 @@ pub fn f4(x: f64) -> String {
 
 pub use viz::Series;
 
+/// Markers of one colour and radius at `points`.
+pub fn markers(
+    points: impl IntoIterator<Item = meshcore::DVec3>,
+    color: [u8; 3],
+    radius: f64,
+) -> Vec<viz::Marker> {
+    points
+        .into_iter()
+        .map(|position| viz::Marker {
+            position,
+            color,
+            radius,
+        })
+        .collect()
+}
+
 /// A line plot drawn by `viz` (SVG or PNG by the extension of `path`).
 pub fn line_plot(
     path: &Path,
@@ -135,16 +151,9 @@ pub fn line_plot(
 mod tests {
     use super::*;
 
-    fn tmp(name: &str) -> PathBuf {
-        let d =
-            std::env::temp_dir().join(format!("xtask-report-test-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&d);
-        d
-    }
-
     #[test]
     fn report_writes_markdown_csv_and_figures() {
-        let d = tmp("a");
+        let d = testsupport::fresh_temp_dir("xtask-report-test", "a");
         let mut r = Report::new(&d, "T").unwrap();
         r.heading(2, "Sec");
         r.table(&["a", "b"], &[vec!["1".into(), "2".into()]]);

@@ -3,15 +3,16 @@
 //! the single-pole matrix).
 
 use super::{eye_mid, n_keys, Ctx, Desc, MethodResults, Prepared, RESOLUTIONS};
-use crate::experiments::keyed::KeyedPoints;
 use crate::experiments::pipeline::{bar, Region};
 use crate::experiments::polar::{polar_descriptor, Pole};
+use crate::experiments::report::markers;
 use anyhow::{Context, Result};
+use bipolar::PolarDescriptor;
 use facemodel::static_mask;
 use meshcore::{DVec3, Topology, TriMesh};
 use rayon::prelude::*;
 use std::path::Path;
-use viz::{Marker, Polyline, Scene, View};
+use viz::{Polyline, Scene, View};
 
 /// The descriptors the later parts compare against.
 pub(super) struct Base {
@@ -20,7 +21,7 @@ pub(super) struct Base {
     /// Static-area descriptors at the default resolution, per face.
     pub static_: Vec<Desc>,
     /// Single-pole descriptors, per face.
-    pub polar: Vec<KeyedPoints>,
+    pub polar: Vec<PolarDescriptor>,
 }
 
 const RED: [u8; 3] = [0xc0, 0x39, 0x2b];
@@ -32,22 +33,6 @@ const ORANGE: [u8; 3] = [0xe6, 0x7e, 0x22];
 /// Surface colour of the static area in the renders (the rest is viz's default grey).
 const STATIC_TINT: [u8; 3] = [170, 200, 255];
 const SURFACE: [u8; 3] = [225, 215, 205];
-
-/// Markers of one colour and radius.
-pub(super) fn markers(
-    points: impl IntoIterator<Item = DVec3>,
-    color: [u8; 3],
-    radius: f64,
-) -> Vec<Marker> {
-    points
-        .into_iter()
-        .map(|position| Marker {
-            position,
-            color,
-            radius,
-        })
-        .collect()
-}
 
 /// Positions of a descriptor's points (none if refused).
 fn positions(d: &Desc) -> Vec<DVec3> {
@@ -200,7 +185,7 @@ pub(super) fn run(ctx: &Ctx<'_>, prep: &Prepared, res: &mut MethodResults) -> Re
         .collect();
     res.m_static = ctx.matrix(&static_, &format!("static, N = {n}"));
     res.m_whole = ctx.matrix(&whole, &format!("whole, N = {n}"));
-    let polar: Vec<KeyedPoints> = (0..nf)
+    let polar: Vec<PolarDescriptor> = (0..nf)
         .into_par_iter()
         .map(|i| {
             polar_descriptor(

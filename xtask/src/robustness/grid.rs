@@ -5,10 +5,10 @@
 use super::base::Base;
 use super::stats::{max, mean, min};
 use super::{eye_mid, Ctx, MethodResults, Prepared, N_DIRS, RADII_PCT, RESOLUTIONS};
-use crate::experiments::keyed::KeyedPoints;
 use crate::experiments::pipeline::{bar, field, field_at, perturb, Refs, Region};
 use crate::experiments::polar::{polar_descriptor, Pole};
 use anyhow::Result;
+use bipolar::PolarDescriptor;
 use facemodel::face_frame;
 use geodesic::Source;
 use rayon::prelude::*;
@@ -17,7 +17,7 @@ use rayon::prelude::*;
 /// each walk met the boundary.
 struct Cell {
     refs: Refs,
-    polar: KeyedPoints,
+    polar: PolarDescriptor,
     cut_q: bool,
     cut_nose: bool,
 }

@@ -16,7 +16,6 @@ mod random;
 mod report;
 mod stats;
 
-use crate::experiments::keyed::KeyedPoints;
 use crate::experiments::pipeline::{
     bipolar, dist, field, resolve_methods, DescriptorRule, Refs, Region,
 };
@@ -24,6 +23,7 @@ use crate::experiments::polar::PolarOptions;
 use crate::experiments::walk::Walker;
 use crate::paths::{default_out_dir, default_paper_set};
 use anyhow::{bail, Result};
+use bipolar::PolarDescriptor;
 use facemodel::{face_frame, load_face_set, Face};
 use geodesic::{GeodesicSolver, Method, Source};
 use meshcore::{DVec3, TriMesh};
@@ -167,7 +167,12 @@ impl Ctx<'_> {
     }
 
     /// Distance of two single-pole descriptors.
-    fn dist_pole(&self, a: &KeyedPoints, b: &KeyedPoints, what: impl FnOnce() -> String) -> f64 {
+    fn dist_pole(
+        &self,
+        a: &PolarDescriptor,
+        b: &PolarDescriptor,
+        what: impl FnOnce() -> String,
+    ) -> f64 {
         self.score(dist(a, b), what)
     }
 
@@ -190,37 +195,34 @@ impl Ctx<'_> {
         }
     }
 
-    /// The pairwise matrix of face descriptors (`shapedist::pairwise_matrix`; failed cells NaN).
+    /// The pairwise matrix of face descriptors (failed cells NaN).
     fn matrix(&self, descs: &[Desc], label: &str) -> Vec<Vec<f64>> {
-        let items: Vec<(&str, &Desc)> = self
-            .faces
-            .iter()
-            .map(|f| f.name.as_str())
-            .zip(descs)
-            .collect();
-        let m = shapedist::pairwise_matrix(&items, |a, b| {
-            Ok::<f64, std::convert::Infallible>(
-                self.dist(a.1, b.1, || format!("{label}: {} vs {}", a.0, b.0)),
-            )
-        });
-        match m {
-            Ok(m) => m,
-            Err(e) => match e.error {},
-        }
+        self.pairwise(descs, label, |a, b, what| self.dist(a, b, what))
     }
 
     /// The pairwise matrix of single-pole descriptors.
-    fn matrix_pole(&self, descs: &[KeyedPoints], label: &str) -> Vec<Vec<f64>> {
-        let items: Vec<(&str, &KeyedPoints)> = self
+    fn matrix_pole(&self, descs: &[PolarDescriptor], label: &str) -> Vec<Vec<f64>> {
+        self.pairwise(descs, label, |a, b, what| self.dist_pole(a, b, what))
+    }
+
+    /// The matrix of `dist` over the pairs of `descs` (one per face, in face order) by
+    /// `shapedist::pairwise_matrix`; `dist` gets the pair's name for its failure message.
+    fn pairwise<T: Sync>(
+        &self,
+        descs: &[T],
+        label: &str,
+        dist: impl Fn(&T, &T, &dyn Fn() -> String) -> f64 + Sync,
+    ) -> Vec<Vec<f64>> {
+        let items: Vec<(&str, &T)> = self
             .faces
             .iter()
             .map(|f| f.name.as_str())
             .zip(descs)
             .collect();
         let m = shapedist::pairwise_matrix(&items, |a, b| {
-            Ok::<f64, std::convert::Infallible>(
-                self.dist_pole(a.1, b.1, || format!("{label}: {} vs {}", a.0, b.0)),
-            )
+            Ok::<f64, std::convert::Infallible>(dist(a.1, b.1, &|| {
+                format!("{label}: {} vs {}", a.0, b.0)
+            }))
         });
         match m {
             Ok(m) => m,

@@ -1,13 +1,14 @@
 //! Figure 15: rotating some polar rings of the test face individually keeps every per-ring
 //! distance ~0 while the global distance becomes large.
 
-use super::base::{markers, render};
+use super::base::render;
 use super::Args;
-use crate::experiments::keyed::KeyedPoints;
 use crate::experiments::pipeline::{dist, field};
-use crate::experiments::polar::{polar_descriptor, polar_key_parts, PolarOptions, Pole};
+use crate::experiments::polar::{polar_descriptor, PolarOptions, Pole};
+use crate::experiments::report::markers;
 use crate::experiments::walk::Walker;
 use anyhow::Result;
+use bipolar::PolarDescriptor;
 use facemodel::{face_frame, Face, FaceFrame};
 use geodesic::{Method, Source};
 use meshcore::{DMat3, DQuat, DVec3};
@@ -38,7 +39,7 @@ fn describe(
     method: Method,
     levels: u32,
     sectors: u32,
-) -> Result<(KeyedPoints, FaceFrame)> {
+) -> Result<(PolarDescriptor, FaceFrame)> {
     let lm = f.landmarks;
     let s = geodesic::new_solver(&f.mesh, method)?;
     let un = field(s.as_ref(), Source::Vertex(lm.nose_tip))?;
@@ -62,17 +63,17 @@ fn describe(
 }
 
 /// `s` with rings [`ROTATED`] each rotated about its centroid by a seeded random rotation.
-fn rotate_rings(s: &KeyedPoints, seed: u64) -> KeyedPoints {
+fn rotate_rings(s: &PolarDescriptor, seed: u64) -> PolarDescriptor {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut s1 = s.clone();
     for &lvl in &ROTATED {
-        let idx: Vec<usize> = (0..s.len())
-            .filter(|&k| polar_key_parts(s.keys[k]).0 == lvl)
+        let idx: Vec<usize> = (0..s.points.len())
+            .filter(|&k| s.points[k].key.level == lvl)
             .collect();
         if idx.is_empty() {
             continue;
         }
-        let c = idx.iter().map(|&k| s.points[k]).sum::<DVec3>() / idx.len() as f64;
+        let c = idx.iter().map(|&k| s.points[k].position).sum::<DVec3>() / idx.len() as f64;
         let axis = DVec3::new(
             rng.random_range(-1.0..1.0),
             rng.random_range(-1.0..1.0),
@@ -85,7 +86,7 @@ fn rotate_rings(s: &KeyedPoints, seed: u64) -> KeyedPoints {
             angle,
         ));
         for &k in &idx {
-            s1.points[k] = c + rot * (s.points[k] - c);
+            s1.points[k].position = c + rot * (s.points[k].position - c);
         }
     }
     s1
@@ -104,7 +105,7 @@ pub(super) fn figure15(
         .iter()
         .position(|f| f.person != faces[test].person)
         .unwrap_or(test);
-    let descs: Vec<(KeyedPoints, FaceFrame)> = [test, other]
+    let descs: Vec<(PolarDescriptor, FaceFrame)> = [test, other]
         .par_iter()
         .map(|&i| describe(&faces[i], method, args.levels, args.sectors))
         .collect::<Result<_>>()?;
@@ -112,24 +113,26 @@ pub(super) fn figure15(
     let s1 = rotate_rings(s, args.seed);
     let mut per_ring = Vec::new();
     for lvl in 1..=args.levels {
-        let idx: Vec<usize> = (0..s.len())
-            .filter(|&k| polar_key_parts(s.keys[k]).0 == lvl && !s.ambiguous[k])
+        let idx: Vec<usize> = (0..s.points.len())
+            .filter(|&k| s.points[k].key.level == lvl)
             .collect();
-        let keys: Vec<u64> = idx.iter().map(|&k| s.keys[k]).collect();
-        let a: Vec<DVec3> = idx.iter().map(|&k| s.points[k]).collect();
-        let b: Vec<DVec3> = idx.iter().map(|&k| s1.points[k]).collect();
+        let keys: Vec<u64> = idx.iter().map(|&k| s.points[k].key.pack()).collect();
+        let a: Vec<DVec3> = idx.iter().map(|&k| s.points[k].position).collect();
+        let b: Vec<DVec3> = idx.iter().map(|&k| s1.points[k].position).collect();
         let d =
             shapedist::keyed_distance(&keys, &a, &keys, &b, &shapedist::KeyedOptions::default());
         per_ring.push((lvl, d.map_or(f64::NAN, |d| d.distance)));
     }
     let global = dist(s, &s1)?;
     let reference = dist(s, &descs[1].0)?;
-    let moved: Vec<DVec3> = (0..s.len())
-        .filter(|&k| ROTATED.contains(&polar_key_parts(s.keys[k]).0))
-        .map(|k| s1.points[k])
+    let moved: Vec<DVec3> = s1
+        .points
+        .iter()
+        .filter(|p| ROTATED.contains(&p.key.level))
+        .map(|p| p.position)
         .collect();
     let mut scene = Scene::new(&faces[test].mesh);
-    scene.points = markers(s.points.iter().copied(), [0x24, 0x71, 0xa3], 2.2);
+    scene.points = markers(s.positions(), [0x24, 0x71, 0xa3], 2.2);
     scene.points.extend(markers(moved, [0xc0, 0x39, 0x2b], 2.6));
     render(&out.join("figure15.svg"), &scene, frame.up, frame.forward)?;
     Ok(Figure15 {

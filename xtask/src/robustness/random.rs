@@ -3,11 +3,11 @@
 //! between the perturbed descriptors.
 
 use super::{eye_mid, Ctx, Desc, MethodResults, Prepared};
-use crate::experiments::keyed::KeyedPoints;
 use crate::experiments::pipeline::{bar, field, field_at, perturb, Refs, Region};
 use crate::experiments::polar::{polar_descriptor, Pole};
 use crate::experiments::walk::Walker;
 use anyhow::Result;
+use bipolar::PolarDescriptor;
 use facemodel::face_frame;
 use geodesic::Source;
 use meshcore::{DVec3, SurfacePoint};
@@ -19,7 +19,7 @@ use rayon::prelude::*;
 struct Run {
     one: Desc,
     both: Desc,
-    nose: KeyedPoints,
+    nose: PolarDescriptor,
     one_pct: f64,
 }
 

@@ -1,7 +1,7 @@
 //! report.md and the CSV tables of `cargo xtask robustness`; every figure is drawn by `viz`.
 
 use super::pole::Figure15;
-use super::stats::{matrix_rows, max, mean, min, Sep};
+use super::stats::{matrix_rows, max, mean, min, Sep, SepColumn};
 use super::{Args, Failures, MethodResults, N_DIRS, RADII_PCT};
 use crate::experiments::pipeline::{DescriptorRule, MethodUse};
 use crate::experiments::report::{f4, line_plot, Report, Series};
@@ -44,6 +44,69 @@ fn radius_series(
             .collect(),
         dashed,
     }
+}
+
+/// A distance matrix of the report: the heatmap `{stem}_{method}.svg` titled `title`, its table
+/// `{stem}_{method}.csv` (rows and columns labelled by face) and the figure with `caption`.
+fn matrix_figure(
+    rep: &mut Report,
+    inp: &Input<'_>,
+    m: &[Vec<f64>],
+    (stem, method): (&str, &str),
+    title: &str,
+    caption: &str,
+) -> Result<()> {
+    let fname = format!("{stem}_{method}.svg");
+    heatmap(rep.path(&fname), title, &inp.labels, m, "distance")?;
+    let mut h = vec!["face".to_string()];
+    h.extend(inp.labels.iter().cloned());
+    let hh: Vec<&str> = h.iter().map(String::as_str).collect();
+    rep.csv(
+        &format!("{stem}_{method}.csv"),
+        &hh,
+        &matrix_rows(inp.faces, m),
+    )?;
+    rep.figure(&fname, caption);
+    Ok(())
+}
+
+/// A separation table (Markdown and the CSV `file`): the two `lead` columns of each row, then
+/// the `cols` of its [`Sep`].
+fn sep_table(
+    rep: &mut Report,
+    file: &str,
+    lead: [&str; 2],
+    rows: &[(String, String, Sep)],
+    cols: &[SepColumn],
+) -> Result<()> {
+    let hdr: Vec<&str> = lead
+        .into_iter()
+        .chain(cols.iter().map(|c| c.header()))
+        .collect();
+    let cells: Vec<Vec<String>> = rows
+        .iter()
+        .map(|(a, b, s)| {
+            [a.clone(), b.clone()]
+                .into_iter()
+                .chain(cols.iter().map(|c| c.cell(s)))
+                .collect()
+        })
+        .collect();
+    rep.table(&hdr, &cells);
+    rep.csv(file, &hdr, &cells)
+}
+
+/// A line plot of the report drawn into `file` and added as a figure with `caption`.
+fn plot_figure(
+    rep: &mut Report,
+    file: &str,
+    (title, x_label, y_label): (&str, &str, &str),
+    series: &[Series],
+    caption: &str,
+) -> Result<()> {
+    line_plot(&rep.path(file), title, x_label, y_label, series)?;
+    rep.figure(file, caption);
+    Ok(())
 }
 
 /// Writes `report.md`, the CSV tables and the figures into `out`.
@@ -205,7 +268,6 @@ fn resolution(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
     let faces = inp.faces;
     let test = inp.test;
     let results = inp.results;
-    let labels = &inp.labels;
     let n = inp.n;
     // 2. Resolution sweep and matrix.
     rep.heading(
@@ -228,18 +290,20 @@ fn resolution(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
                 dashed: faces[j].person != faces[test].person,
             });
         }
-        let file = format!("fig6_distance_vs_resolution_{}.svg", res.name);
-        line_plot(
-            &rep.path(&file),
-            &format!(
-                "{} vs every other face, static area ({})",
-                faces[test].name, res.name
+        plot_figure(
+            rep,
+            &format!("fig6_distance_vs_resolution_{}.svg", res.name),
+            (
+                &format!(
+                    "{} vs every other face, static area ({})",
+                    faces[test].name, res.name
+                ),
+                "levels N between the corners",
+                "normalised shape distance",
             ),
-            "levels N between the corners",
-            "normalised shape distance",
             &series,
+            &format!("distance from the test face against resolution; solid: same person, dashed: other persons ({})", res.name),
         )?;
-        rep.figure(&file, &format!("distance from the test face against resolution; solid: same person, dashed: other persons ({})", res.name));
         let mut hdr = vec!["N".to_string()];
         hdr.extend(faces.iter().map(|f| f.name.clone()));
         let rows: Vec<Vec<String>> = res
@@ -260,54 +324,25 @@ fn resolution(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
             ("static area", &res.m_static, "static"),
             ("whole face (levels up to 2N)", &res.m_whole, "whole"),
         ] {
-            let fname = format!("fig7_matrix_{file}_{}.svg", res.name);
-            heatmap(
-                rep.path(&fname),
-                &format!("pairwise distances, {label}, N = {n} ({})", res.name),
-                labels,
+            matrix_figure(
+                rep,
+                inp,
                 m,
-                "distance",
+                (&format!("fig7_matrix_{file}"), &res.name),
+                &format!("pairwise distances, {label}, N = {n} ({})", res.name),
+                &format!("12 x 12 matrix, {label} ({})", res.name),
             )?;
-            let mut h = vec!["face".to_string()];
-            h.extend(labels.iter().cloned());
-            let hh: Vec<&str> = h.iter().map(String::as_str).collect();
-            rep.csv(
-                &format!("fig7_matrix_{file}_{}.csv", res.name),
-                &hh,
-                &matrix_rows(faces, m),
-            )?;
-            rep.figure(&fname, &format!("12 x 12 matrix, {label} ({})", res.name));
-            let s = Sep::of(m, faces, test);
-            sep_rows.push(vec![
-                res.name.clone(),
-                label.to_string(),
-                f4(s.max_same),
-                f4(s.min_diff),
-                format!("{:.3}", s.ratio()),
-                s.verdict().into(),
-                f4(s.row_max_same),
-                f4(s.row_min_diff),
-                format!("{:.3}", s.row_ratio()),
-                s.row_verdict().into(),
-            ]);
+            sep_rows.push((res.name.clone(), label.to_string(), Sep::of(m, faces, test)));
         }
     }
     rep.para("Separation: the largest distance between two faces of the same person, the smallest between faces of different persons, and their ratio (> 1 means every same-person pair is closer than every different-person pair). 'Test row' restricts this to the pairs involving the neutral test face, which is what the paper's figure 6 shows.");
-    let sep_hdr = [
-        "method",
-        "descriptor",
-        "max same",
-        "min different",
-        "ratio",
-        "whole matrix",
-        "test row: max same",
-        "test row: min different",
-        "test-row ratio",
-        "test row",
-    ];
-    rep.table(&sep_hdr, &sep_rows);
-    rep.csv("separation.csv", &sep_hdr, &sep_rows)?;
-    Ok(())
+    sep_table(
+        rep,
+        "separation.csv",
+        ["method", "descriptor"],
+        &sep_rows,
+        &SepColumn::ALL,
+    )
 }
 
 /// Section 3: the perturbation grid (figures 9, 10).
@@ -334,34 +369,40 @@ fn robustness(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
                 dashed: false,
             })
             .collect();
-        let f10 = format!("fig10_grid_{}.svg", res.name);
-        line_plot(
-            &rep.path(&f10),
-            &format!("perturbed vs original, by direction ({})", res.name),
-            "direction theta (degrees from r)",
-            "normalised shape distance",
-            &series,
-        )?;
         let by_r = vec![
             radius_series("mean over directions", &res.grid_bip, mean, false),
             radius_series("max over directions", &res.grid_bip, max, true),
         ];
-        let f9 = format!("fig9_radius_{}.svg", res.name);
-        line_plot(
-            &rep.path(&f9),
-            &format!("perturbed vs original, by radius ({})", res.name),
-            "radius (% of D)",
-            "normalised shape distance",
-            &by_r,
-        )?;
-        rep.figure(
-            &f9,
-            &format!("distance against the error radius ({})", res.name),
-        );
-        rep.figure(
-            &f10,
-            &format!("distance over the radius x direction grid ({})", res.name),
-        );
+        let plots = [
+            (
+                "fig9_radius",
+                "radius",
+                "radius (% of D)",
+                by_r,
+                "distance against the error radius",
+            ),
+            (
+                "fig10_grid",
+                "direction",
+                "direction theta (degrees from r)",
+                series,
+                "distance over the radius x direction grid",
+            ),
+        ];
+        for (stem, by, x_label, s, caption) in plots {
+            let name = &res.name;
+            plot_figure(
+                rep,
+                &format!("{stem}_{name}.svg"),
+                (
+                    &format!("perturbed vs original, by {by} ({name})"),
+                    x_label,
+                    "normalised shape distance",
+                ),
+                &s,
+                &format!("{caption} ({name})"),
+            )?;
+        }
         let rows: Vec<Vec<String>> = res
             .grid_bip
             .iter()
@@ -389,6 +430,16 @@ fn robustness(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
     Ok(())
 }
 
+/// The six curves of figure 11, in the order of their values: plot label, table header, dashed.
+const FIG11_CASES: [(&str, &str, bool); 6] = [
+    ("(a) perturbed, mean", "a mean", false),
+    ("(a) perturbed, max", "a max", true),
+    ("(b) expressions, mean", "b mean", false),
+    ("(b) expressions, min", "b min", true),
+    ("(c) other persons, mean", "c mean", false),
+    ("(c) other persons, min", "c min", true),
+];
+
 /// Figure 11: the three cases against resolution.
 fn figure11(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
     let results = inp.results;
@@ -396,103 +447,44 @@ fn figure11(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
     rep.para("Figure 11, the paper's three cases against resolution: (a) perturbed vs original (the 40 grid perturbations), (b) the test face vs the same person's other expressions, (c) vs other persons. The ordering a < b < c is checked on the means and, more strictly, as max(a) < min(b) and min(b)... (strict: max a < min b, and mean b < min c).");
     let mut rows = Vec::new();
     for res in results {
-        let s = vec![
-            Series {
-                name: "(a) perturbed, mean".into(),
+        let s: Vec<Series> = FIG11_CASES
+            .iter()
+            .enumerate()
+            .map(|(k, &(name, _, dashed))| Series {
+                name: name.into(),
                 points: res
                     .fig11
                     .iter()
-                    .map(|(nl, v)| (f64::from(*nl), v[0]))
+                    .map(|(nl, v)| (f64::from(*nl), v[k]))
                     .collect(),
-                dashed: false,
-            },
-            Series {
-                name: "(a) perturbed, max".into(),
-                points: res
-                    .fig11
-                    .iter()
-                    .map(|(nl, v)| (f64::from(*nl), v[1]))
-                    .collect(),
-                dashed: true,
-            },
-            Series {
-                name: "(b) expressions, mean".into(),
-                points: res
-                    .fig11
-                    .iter()
-                    .map(|(nl, v)| (f64::from(*nl), v[2]))
-                    .collect(),
-                dashed: false,
-            },
-            Series {
-                name: "(b) expressions, min".into(),
-                points: res
-                    .fig11
-                    .iter()
-                    .map(|(nl, v)| (f64::from(*nl), v[3]))
-                    .collect(),
-                dashed: true,
-            },
-            Series {
-                name: "(c) other persons, mean".into(),
-                points: res
-                    .fig11
-                    .iter()
-                    .map(|(nl, v)| (f64::from(*nl), v[4]))
-                    .collect(),
-                dashed: false,
-            },
-            Series {
-                name: "(c) other persons, min".into(),
-                points: res
-                    .fig11
-                    .iter()
-                    .map(|(nl, v)| (f64::from(*nl), v[5]))
-                    .collect(),
-                dashed: true,
-            },
-        ];
-        let f11 = format!("fig11_three_cases_{}.svg", res.name);
-        line_plot(
-            &rep.path(&f11),
-            &format!("three cases against resolution ({})", res.name),
-            "levels N between the corners",
-            "normalised shape distance",
+                dashed,
+            })
+            .collect();
+        plot_figure(
+            rep,
+            &format!("fig11_three_cases_{}.svg", res.name),
+            (
+                &format!("three cases against resolution ({})", res.name),
+                "levels N between the corners",
+                "normalised shape distance",
+            ),
             &s,
-        )?;
-        rep.figure(
-            &f11,
             &format!("the three cases of figure 11 ({})", res.name),
-        );
+        )?;
         for (nl, v) in &res.fig11 {
             let mean_order = v[0] < v[2] && v[2] < v[4];
             let strict = v[1] < v[3] && v[2] < v[5];
-            rows.push(vec![
-                res.name.clone(),
-                nl.to_string(),
-                f4(v[0]),
-                f4(v[1]),
-                f4(v[2]),
-                f4(v[3]),
-                f4(v[4]),
-                f4(v[5]),
-                if mean_order { "yes" } else { "NO" }.into(),
-                if strict { "yes" } else { "NO" }.into(),
-            ]);
+            let mut row = vec![res.name.clone(), nl.to_string()];
+            row.extend(v.iter().map(|&x| f4(x)));
+            row.extend([mean_order, strict].map(|ok| if ok { "yes" } else { "NO" }.to_string()));
+            rows.push(row);
         }
     }
-    let h11 = [
-        "method",
-        "N",
-        "a mean",
-        "a max",
-        "b mean",
-        "b min",
-        "c mean",
-        "c min",
-        "a < b < c (means)",
-        "max a < min b and mean b < min c",
-    ];
+    let h11: Vec<&str> = ["method", "N"]
+        .into_iter()
+        .chain(FIG11_CASES.iter().map(|c| c.1))
+        .chain(["a < b < c (means)", "max a < min b and mean b < min c"])
+        .collect();
     rep.table(&h11, &rows);
     rep.csv("fig11_three_cases.csv", &h11, &rows)?;
     Ok(())
@@ -503,7 +495,6 @@ fn random_errors(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
     let faces = inp.faces;
     let test = inp.test;
     let results = inp.results;
-    let labels = &inp.labels;
     let n = inp.n;
     // Figures 12-13.
     rep.para(&format!("Figures 12 and 13: every face gets its own random error (seeded), radius uniform in [0, 5%] of D and a uniform direction: on q only, then on both r and q (independent draws); the 12 x 12 matrices are computed between the perturbed descriptors (N = {n}, static area)."));
@@ -513,49 +504,25 @@ fn random_errors(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
             ("error on q", &res.m_rand_one, "fig12_random_one"),
             ("errors on r and q", &res.m_rand_both, "fig13_random_both"),
         ] {
-            let fname = format!("{file}_{}.svg", res.name);
-            heatmap(
-                rep.path(&fname),
-                &format!("{label}, static area, N = {n} ({})", res.name),
-                labels,
+            matrix_figure(
+                rep,
+                inp,
                 m,
-                "distance",
+                (file, &res.name),
+                &format!("{label}, static area, N = {n} ({})", res.name),
+                &format!("{label} ({})", res.name),
             )?;
-            let mut h = vec!["face".to_string()];
-            h.extend(labels.iter().cloned());
-            let hh: Vec<&str> = h.iter().map(String::as_str).collect();
-            rep.csv(
-                &format!("{file}_{}.csv", res.name),
-                &hh,
-                &matrix_rows(faces, m),
-            )?;
-            rep.figure(&fname, &format!("{label} ({})", res.name));
-            let s = Sep::of(m, faces, test);
-            rows.push(vec![
-                res.name.clone(),
-                label.into(),
-                f4(s.max_same),
-                f4(s.min_diff),
-                format!("{:.3}", s.ratio()),
-                s.verdict().into(),
-                format!("{:.3}", s.row_ratio()),
-                s.row_verdict().into(),
-            ]);
+            rows.push((res.name.clone(), label.to_string(), Sep::of(m, faces, test)));
         }
     }
-    let h12 = [
-        "method",
-        "errors",
-        "max same",
-        "min different",
-        "ratio",
-        "whole matrix",
-        "test-row ratio",
-        "test row",
-    ];
-    rep.table(&h12, &rows);
-    rep.csv("fig12_13_separation.csv", &h12, &rows)?;
-    Ok(())
+    use SepColumn::*;
+    sep_table(
+        rep,
+        "fig12_13_separation.csv",
+        ["method", "errors"],
+        &rows,
+        &[MaxSame, MinDiff, Ratio, Verdict, RowRatio, RowVerdict],
+    )
 }
 
 /// Section 4: the single pole under the same errors (figure 17).
@@ -564,7 +531,6 @@ fn single_pole(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
     let faces = inp.faces;
     let test = inp.test;
     let results = inp.results;
-    let labels = &inp.labels;
     let n = inp.n;
     // 4. Single pole.
     rep.heading(
@@ -580,24 +546,23 @@ fn single_pole(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
             radius_series("bipolar, max", &res.grid_bip, max, true),
             radius_series("single pole, max", &res.grid_pol, max, true),
         ];
-        let f = format!("fig17_pole_vs_bipolar_{}.svg", res.name);
-        line_plot(
-            &rep.path(&f),
-            &format!(
-                "reference-point error: bipolar vs single pole ({})",
-                res.name
+        plot_figure(
+            rep,
+            &format!("fig17_pole_vs_bipolar_{}.svg", res.name),
+            (
+                &format!(
+                    "reference-point error: bipolar vs single pole ({})",
+                    res.name
+                ),
+                "error radius (% of D)",
+                "distance to the unperturbed descriptor",
             ),
-            "error radius (% of D)",
-            "distance to the unperturbed descriptor",
             &series,
-        )?;
-        rep.figure(
-            &f,
             &format!(
                 "bipolar vs single pole under the same errors ({})",
                 res.name
             ),
-        );
+        )?;
         for (label, m, file) in [
             ("single pole, no error", &res.m_polar, "matrix_pole"),
             (
@@ -608,49 +573,23 @@ fn single_pole(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
             ("bipolar, random error on q (fig. 17b)", &res.m_rand_one, ""),
         ] {
             if !file.is_empty() {
-                let fname = format!("{file}_{}.svg", res.name);
-                heatmap(
-                    rep.path(&fname),
-                    &format!("{label} ({})", res.name),
-                    labels,
-                    m,
-                    "distance",
-                )?;
-                let mut h = vec!["face".to_string()];
-                h.extend(labels.iter().cloned());
-                let hh: Vec<&str> = h.iter().map(String::as_str).collect();
-                rep.csv(
-                    &format!("{file}_{}.csv", res.name),
-                    &hh,
-                    &matrix_rows(faces, m),
-                )?;
-                rep.figure(&fname, &format!("{label} ({})", res.name));
+                let title = format!("{label} ({})", res.name);
+                matrix_figure(rep, inp, m, (file, &res.name), &title, &title)?;
             }
-            let s = Sep::of(m, faces, test);
-            rows.push(vec![
-                res.name.clone(),
-                label.into(),
-                f4(s.max_same),
-                f4(s.min_diff),
-                format!("{:.3}", s.ratio()),
-                format!("{:.3}", s.row_ratio()),
-            ]);
+            rows.push((res.name.clone(), label.to_string(), Sep::of(m, faces, test)));
         }
         let gb: Vec<f64> = res.grid_bip.iter().map(|g| g.2).collect();
         let gp: Vec<f64> = res.grid_pol.iter().map(|g| g.2).collect();
         rep.para(&format!("{}: over the 40 grid perturbations, bipolar mean {} (max {}), single pole mean {} (max {}); the bipolar representation is {} robust here.", res.name, f4(mean(&gb)), f4(max(&gb)), f4(mean(&gp)), f4(max(&gp)), if mean(&gb) < mean(&gp) { "more" } else { "NOT more" }));
     }
-    let h17 = [
-        "method",
-        "matrix",
-        "max same",
-        "min different",
-        "ratio",
-        "test-row ratio",
-    ];
-    rep.table(&h17, &rows);
-    rep.csv("fig17_separation.csv", &h17, &rows)?;
-    Ok(())
+    use SepColumn::*;
+    sep_table(
+        rep,
+        "fig17_separation.csv",
+        ["method", "matrix"],
+        &rows,
+        &[MaxSame, MinDiff, Ratio, RowRatio],
+    )
 }
 
 /// The figure-15 argument.

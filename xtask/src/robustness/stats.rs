@@ -1,5 +1,6 @@
 //! Separation figures and finite-value reductions of distance matrices and rows.
 
+use crate::experiments::report::f4;
 use facemodel::Face;
 
 /// Separation figures of a distance matrix.
@@ -55,6 +56,61 @@ impl Sep {
             "separated"
         } else {
             "NOT separated"
+        }
+    }
+}
+
+/// A column of the separation tables: its header and its cell for a [`Sep`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum SepColumn {
+    MaxSame,
+    MinDiff,
+    Ratio,
+    Verdict,
+    RowMaxSame,
+    RowMinDiff,
+    RowRatio,
+    RowVerdict,
+}
+
+impl SepColumn {
+    /// Every column, in table order.
+    pub(super) const ALL: [SepColumn; 8] = [
+        SepColumn::MaxSame,
+        SepColumn::MinDiff,
+        SepColumn::Ratio,
+        SepColumn::Verdict,
+        SepColumn::RowMaxSame,
+        SepColumn::RowMinDiff,
+        SepColumn::RowRatio,
+        SepColumn::RowVerdict,
+    ];
+
+    /// The column header.
+    pub(super) fn header(self) -> &'static str {
+        match self {
+            SepColumn::MaxSame => "max same",
+            SepColumn::MinDiff => "min different",
+            SepColumn::Ratio => "ratio",
+            SepColumn::Verdict => "whole matrix",
+            SepColumn::RowMaxSame => "test row: max same",
+            SepColumn::RowMinDiff => "test row: min different",
+            SepColumn::RowRatio => "test-row ratio",
+            SepColumn::RowVerdict => "test row",
+        }
+    }
+
+    /// The cell of `s` (distances with 4 decimals, ratios with 3).
+    pub(super) fn cell(self, s: &Sep) -> String {
+        match self {
+            SepColumn::MaxSame => f4(s.max_same),
+            SepColumn::MinDiff => f4(s.min_diff),
+            SepColumn::Ratio => format!("{:.3}", s.ratio()),
+            SepColumn::Verdict => s.verdict().into(),
+            SepColumn::RowMaxSame => f4(s.row_max_same),
+            SepColumn::RowMinDiff => f4(s.row_min_diff),
+            SepColumn::RowRatio => format!("{:.3}", s.row_ratio()),
+            SepColumn::RowVerdict => s.row_verdict().into(),
         }
     }
 }
