@@ -5,7 +5,6 @@
 
 use geodesic::{FastMarching, FmmUpdate, GeodesicSolver, SolveOptions, Source, TriMesh};
 use glam::DVec3;
-use std::f64::consts::PI;
 use testsupport::fields::{max_abs_diff, mean_abs_diff, prism_geodesic, sphere_geodesic};
 use testsupport::shapes::{self, icosphere, uv_sphere, Diagonals};
 

@@ -209,7 +209,7 @@ proptest! {
         n in 1usize..300,
         kind in 0u8..3,
     ) {
-        let (mut r, pts, tree) = tree_case(seed, n, kind);
+        let (_, pts, tree) = tree_case(seed, n, kind);
         let graph = NeighbourGraph::new(&tree);
         prop_assert_eq!(graph.len(), n);
         for (i, &p) in pts.iter().enumerate() {
