@@ -134,66 +134,48 @@ impl Artifacts {
 
     /// Checks every part's sizes.
     pub fn validate(&self) -> Result<(), ScanError> {
-        // `what` must lie in `[lo, hi]` (and be finite); the error names the expected `range`.
-        let check = |what: &str, v: f64, (lo, hi): (f64, f64), range: &str| {
-            if v.is_finite() && v >= lo && v <= hi {
-                Ok(())
-            } else {
-                Err(ScanError::InvalidOption(format!(
-                    "{what} = {v} (expected {range})"
-                )))
-            }
-        };
+        // (what, value, lo, hi, the range as the error says it): the value must be finite and
+        // in [lo, hi]; in the order they are checked.
+        let mut checks: Vec<(&str, f64, f64, f64, &str)> = Vec::new();
         if let Some(n) = self.noise {
-            check("noise sigma_mm", n.sigma_mm, (0.0, 50.0), "0 to 50")?;
+            checks.push(("noise sigma_mm", n.sigma_mm, 0.0, 50.0, "0 to 50"));
         }
         if let Some(q) = self.quantisation {
             // From the smallest positive f64: greater than 0.
-            let range = (f64::from_bits(1), 100.0);
-            check(
+            let (v, lo) = (q.step_mm, f64::from_bits(1));
+            checks.push((
                 "quantisation step_mm",
-                q.step_mm,
-                range,
+                v,
+                lo,
+                100.0,
                 "greater than 0, at most 100",
-            )?;
+            ));
         }
         if let Some(s) = self.spikes {
-            check("spikes fraction", s.fraction, (0.0, 1.0), "0 to 1")?;
-            check("spikes min_mm", s.min_mm, (0.0, 1e4), "0 to 10000")?;
-            check(
-                "spikes max_mm",
-                s.max_mm,
-                (s.min_mm, 1e4),
-                "min_mm to 10000",
-            )?;
+            let (lo, hi) = (s.min_mm, s.max_mm);
+            checks.extend([
+                ("spikes fraction", s.fraction, 0.0, 1.0, "0 to 1"),
+                ("spikes min_mm", lo, 0.0, 1e4, "0 to 10000"),
+                ("spikes max_mm", hi, lo, 1e4, "min_mm to 10000"),
+            ]);
         }
         if let Some(o) = self.outliers {
-            check("outliers count", o.count as f64, (0.0, 1e7), "at most 10^7")?;
+            checks.push(("outliers count", o.count as f64, 0.0, 1e7, "at most 10^7"));
         }
         if let Some(g) = self.grazing {
-            check("grazing start_deg", g.start_deg, (0.0, 90.0), "0 to 90")?;
-            check(
-                "grazing full_deg",
-                g.full_deg,
-                (g.start_deg, 90.0),
-                "start_deg to 90",
-            )?;
+            let (lo, hi) = (g.start_deg, g.full_deg);
+            checks.extend([
+                ("grazing start_deg", lo, 0.0, 90.0, "0 to 90"),
+                ("grazing full_deg", hi, lo, 90.0, "start_deg to 90"),
+            ]);
         }
         if let Some(h) = self.holes {
-            check("holes count", h.count as f64, (0.0, 1e4), "at most 10000")?;
-            check(
-                "holes min_radius_mm",
-                h.min_radius_mm,
-                (0.0, 1e4),
-                "0 to 10000",
-            )?;
-            let range = (h.min_radius_mm, 1e4);
-            check(
-                "holes max_radius_mm",
-                h.max_radius_mm,
-                range,
-                "min_radius_mm to 10000",
-            )?;
+            let (lo, hi) = (h.min_radius_mm, h.max_radius_mm);
+            checks.extend([
+                ("holes count", h.count as f64, 0.0, 1e4, "at most 10000"),
+                ("holes min_radius_mm", lo, 0.0, 1e4, "0 to 10000"),
+                ("holes max_radius_mm", hi, lo, 1e4, "min_radius_mm to 10000"),
+            ]);
         }
         if let Some(b) = self.border {
             for (what, v) in [
@@ -202,7 +184,14 @@ impl Artifacts {
                 ("border left_mm", b.left_mm),
                 ("border right_mm", b.right_mm),
             ] {
-                check(what, v, (0.0, 1e5), "0 to 100000")?;
+                checks.push((what, v, 0.0, 1e5, "0 to 100000"));
+            }
+        }
+        for (what, v, lo, hi, range) in checks {
+            if !(v.is_finite() && v >= lo && v <= hi) {
+                return Err(ScanError::InvalidOption(format!(
+                    "{what} = {v} (expected {range})"
+                )));
             }
         }
         Ok(())
