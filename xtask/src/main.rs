@@ -7,6 +7,7 @@ mod landmarks_eval;
 mod paths;
 mod recognition;
 mod robustness;
+mod scan_study;
 mod sphere_validate;
 
 /// Experiments and evaluations of the bipolar workspace.
@@ -21,6 +22,8 @@ enum Task {
     Recognition(recognition::Args),
     /// Landmark detection accuracy on sampled faces.
     LandmarksEval(landmarks_eval::Args),
+    /// The descriptor's stability on range scans: rescans, expressions, other persons.
+    ScanStudy(scan_study::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -29,5 +32,6 @@ fn main() -> anyhow::Result<()> {
         Task::Robustness(args) => robustness::run(args),
         Task::Recognition(args) => recognition::run(args),
         Task::LandmarksEval(args) => landmarks_eval::run(args),
+        Task::ScanStudy(args) => scan_study::run(args),
     }
 }

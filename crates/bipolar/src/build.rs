@@ -420,6 +420,12 @@ fn check_options(opts: &DescriptorOptions, n: usize) -> Result<(), BipolarError>
             return bad(format!("filter tolerance {tolerance} (must be >= 0)"));
         }
     }
+    let sm = opts.isoangle.smoothing;
+    if !(sm.is_finite() && sm >= 0.0) {
+        return bad(format!(
+            "iso-angle smoothing {sm} (must be finite and >= 0 mean edge lengths)"
+        ));
+    }
     if !(opts.min_sin >= 0.0 && opts.min_sin < 1.0) {
         return bad(format!("min_sin = {} (must be in [0, 1))", opts.min_sin));
     }

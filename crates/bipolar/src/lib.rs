@@ -40,6 +40,6 @@ pub use key::Key;
 pub use meshcore::Surface;
 pub use polar::{describe_polar, PolarDescriptor, PolarKey, PolarOptions, PolarPoint};
 pub use types::{
-    Descriptor, DescriptorOptions, DescriptorPoint, DescriptorStats, LevelSpec, SelectionKind,
-    SelectionRule, SplineOptions, StripOptions, TangentMethod,
+    Descriptor, DescriptorOptions, DescriptorPoint, DescriptorStats, IsoAngleOptions, IsoCrossings,
+    LevelSpec, SelectionKind, SelectionRule, SplineOptions, StripOptions, TangentMethod,
 };

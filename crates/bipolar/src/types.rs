@@ -87,6 +87,49 @@ impl SelectionRule {
     }
 }
 
+/// How the iso-angle rule ([`SelectionRule::IsoAngle`]) turns the opening along a level curve
+/// into points.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum IsoCrossings {
+    /// One point per angle level and curve run: along each run of a level curve (a piece, cut
+    /// where a tangent is undefined), the signed opening angle `psi = atan2(sin, cos)` between
+    /// the two tangents (unwrapped, `sin` signed by the side) is replaced by its best monotone
+    /// least-squares fit (isotonic regression, weighted by arc length; increasing or decreasing,
+    /// whichever fits better), and each angle level is taken where the fit crosses it. On a
+    /// smooth surface the opening is monotone along the curve and this equals
+    /// [`IsoCrossings::Every`]; on noisy or faceted meshes the raw opening wiggles around a
+    /// level and crosses it several times, which this rule turns into one point. The default.
+    #[default]
+    Monotone,
+    /// Every crossing of an angle level by the piecewise-linear opening along the curve (several
+    /// per key where the opening wiggles; those keys are then ambiguous).
+    Every,
+}
+
+meshcore::choice!(IsoCrossings, "iso-angle crossings", crate::BipolarError {
+    Monotone = "monotone",
+    Every = "every",
+});
+
+/// Settings of the iso-angle rule.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct IsoAngleOptions {
+    /// Which crossings become points.
+    pub crossings: IsoCrossings,
+    /// Gaussian smoothing of the opening angle along the curve before the crossings are taken:
+    /// standard deviation in units of the mean edge length (0: none).
+    pub smoothing: f64,
+}
+
+impl Default for IsoAngleOptions {
+    fn default() -> Self {
+        Self {
+            crossings: IsoCrossings::Monotone,
+            smoothing: 0.0,
+        }
+    }
+}
+
 /// Settings of the strip tangent method (M1).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct StripOptions {
@@ -155,6 +198,9 @@ pub struct DescriptorOptions {
     pub strip: StripOptions,
     /// Spline method settings.
     pub spline: SplineOptions,
+    /// Iso-angle rule settings.
+    #[serde(default)]
+    pub isoangle: IsoAngleOptions,
     /// Intersections with `|sin| < min_sin` between the level curves are dropped (their
     /// position is ill-conditioned, §2.3).
     pub min_sin: f64,
@@ -172,6 +218,7 @@ impl Default for DescriptorOptions {
             tangent: TangentMethod::Gradient,
             strip: StripOptions::default(),
             spline: SplineOptions::default(),
+            isoangle: IsoAngleOptions::default(),
             min_sin: 1e-3,
         }
     }
