@@ -7,6 +7,7 @@ mod landmarks_eval;
 mod paths;
 mod recognition;
 mod robustness;
+mod scan_path;
 mod sphere_validate;
 
 /// Experiments and evaluations of the bipolar workspace.
@@ -27,6 +28,8 @@ enum Task {
     Recognition(recognition::Args),
     /// Landmark detection accuracy on sampled faces.
     LandmarksEval(landmarks_eval::Args),
+    /// Wall time of each step of the path of one range scan (read, clean, detect, describe).
+    ScanPath(scan_path::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -36,5 +39,6 @@ fn main() -> anyhow::Result<()> {
         Task::Robustness(args) => robustness::run(args),
         Task::Recognition(args) => recognition::run(args),
         Task::LandmarksEval(args) => landmarks_eval::run(args),
+        Task::ScanPath(args) => scan_path::run(args),
     }
 }

@@ -6,6 +6,7 @@
 pub mod keyed;
 pub mod pipeline;
 pub mod report;
+pub mod scans;
 
 /// Straightest geodesics: the library's walker (`geodesic::straightest`).
 pub mod walk {
