@@ -35,7 +35,7 @@ use std::time::Instant;
 /// Arguments of `cargo xtask recognition`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
-    /// Number of sampled identities (default 50; with `--scans` 16).
+    /// Number of sampled identities (default 50; with `--scans` 12).
     #[arg(long)]
     pub identities: Option<usize>,
     /// Faces per identity, the first neutral for the gallery (default 6; with `--scans` 3).
@@ -71,7 +71,7 @@ pub struct Args {
     #[command(flatten)]
     pub scan: ScanArgs,
     /// Identities whose probes are rescanned at every sweep setting (`--scans`).
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = 6)]
     pub sweep_identities: usize,
     /// Skip the sweeps (`--scans`).
     #[arg(long)]

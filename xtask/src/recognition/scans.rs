@@ -48,19 +48,19 @@ fn sweeps() -> Vec<Sweep> {
         Sweep {
             name: "noise",
             unit: "mm",
-            values: vec![0.0, 0.1, 0.2, 0.5, 1.0],
+            values: vec![0.0, 0.1, 0.3, 1.0],
             apply: |s, v| ScanSettings { noise_mm: v, ..s },
         },
         Sweep {
             name: "pitch",
             unit: "mm",
-            values: vec![0.3, 0.5, 0.75, 1.0],
+            values: vec![0.3, 0.5, 1.0],
             apply: |s, v| ScanSettings { pitch_mm: v, ..s },
         },
         Sweep {
             name: "yaw",
             unit: "degrees",
-            values: vec![0.0, 15.0, 30.0, 45.0, 60.0],
+            values: vec![0.0, 20.0, 40.0, 60.0],
             apply: |s, v| ScanSettings { yaw_deg: v, ..s },
         },
     ]
@@ -241,7 +241,7 @@ fn p95(mut v: Vec<f64>) -> f64 {
 
 /// Runs the scan benchmark; prints the output folder on the last line.
 pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
-    let identities = args.identities.unwrap_or(16);
+    let identities = args.identities.unwrap_or(12);
     let expressions = args.expressions.unwrap_or(3);
     if identities < 2 || expressions < 2 {
         bail!("need at least 2 identities and 2 expressions (one neutral gallery face + probes)");
