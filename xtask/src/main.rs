@@ -8,6 +8,7 @@ mod paths;
 mod recognition;
 mod robustness;
 mod scan_study;
+mod scan_path;
 mod sphere_validate;
 
 /// Experiments and evaluations of the bipolar workspace.
@@ -24,6 +25,8 @@ enum Task {
     LandmarksEval(landmarks_eval::Args),
     /// The descriptor's stability on range scans: rescans, expressions, other persons.
     ScanStudy(scan_study::Args),
+    /// Wall time of each step of the path of one range scan (read, clean, detect, describe).
+    ScanPath(scan_path::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -33,5 +36,6 @@ fn main() -> anyhow::Result<()> {
         Task::Recognition(args) => recognition::run(args),
         Task::LandmarksEval(args) => landmarks_eval::run(args),
         Task::ScanStudy(args) => scan_study::run(args),
+        Task::ScanPath(args) => scan_path::run(args),
     }
 }

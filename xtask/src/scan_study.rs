@@ -15,7 +15,6 @@
 //! Only composes the libraries; deterministic (the scanner's seeds, rayon results collected in
 //! input order).
 
-use crate::experiments::keyed::KeyedPoints;
 use crate::experiments::pipeline::{bar, dist};
 use crate::experiments::polar::{polar_descriptor, PolarOptions, Pole};
 use crate::paths::{default_out_dir, default_paper_set};
@@ -142,7 +141,7 @@ struct Described {
     landmark_offsets_mm: [f64; 3],
     /// One descriptor per entry of [`VARIANTS`] (`None`: refused, the reason in `notes`).
     bip: Vec<Option<bipolar::Descriptor>>,
-    polar: KeyedPoints,
+    polar: bipolar::PolarDescriptor,
     notes: Vec<String>,
     icp_probe: Vec<DVec3>,
     landmarks: [DVec3; 3],

@@ -208,20 +208,36 @@ pub fn vertex_curvatures_with(
     adj: &VertexAdjacency,
     options: &CurvatureOptions,
 ) -> Vec<Curvature> {
+    let all: Vec<u32> = (0..mesh.n_vertices() as u32).collect();
+    curvatures_at(mesh, normals, adj, options, &all)
+}
+
+/// [`vertex_curvatures_with`] at the given vertices only, in their order (each value is the
+/// one the whole-mesh computation gives at that vertex: the fit still uses every neighbour).
+/// Vertex ids out of range get zero curvatures.
+pub fn curvatures_at(
+    mesh: &TriMesh,
+    normals: &[DVec3],
+    adj: &VertexAdjacency,
+    options: &CurvatureOptions,
+    vertices: &[u32],
+) -> Vec<Curvature> {
     let pos = mesh.positions();
     let n = pos.len();
     let radius = options.radius.max(0.0);
     let min_count = options.min_neighbours.max(5) + 1;
     // Vertices are independent: in parallel, each result computed exactly as on one thread
     // (the ball collector's state only marks visited vertices), collected in vertex order.
-    (0..n as u32)
-        .into_par_iter()
+    vertices
+        .par_iter()
+        .copied()
         .with_min_len(256)
         .map_init(
             || (BallCollector::new(n), Vec::new()),
             |(ball, nb), v| {
-                let p = pos[v as usize];
-                let nrm = normals[v as usize];
+                let (Some(&p), Some(&nrm)) = (pos.get(v as usize), normals.get(v as usize)) else {
+                    return flat(DVec3::Z);
+                };
                 if nrm == DVec3::ZERO {
                     return flat(DVec3::Z);
                 }

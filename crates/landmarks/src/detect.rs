@@ -4,7 +4,7 @@
 
 #![allow(clippy::needless_range_loop)] // Dense small linear algebra reads best with indices.
 
-use crate::curvature::{vertex_curvatures_with, CurvatureOptions, VertexAdjacency};
+use crate::curvature::{curvatures_at, CurvatureOptions, VertexAdjacency};
 use crate::geom::{icp, score, FitScore, SurfaceIndex};
 use crate::model::GenericModel;
 use crate::{Landmark, LandmarkError, LandmarkName, Landmarks};
@@ -33,6 +33,11 @@ pub struct DetectOptions {
     /// Place the landmarks with the model's learned regression (when it has one, see
     /// [`crate::LandmarkRegressor`]) instead of the local template search alone.
     pub use_regressor: bool,
+    /// Least share of a landmark's local template (the mean surface around it, turned by the
+    /// fitted pose and placed at the reported point) that must find the input surface within
+    /// the inlier distance; below it the landmark is not on the input (occluded, in a hole or outside the
+    /// scan) and the fitted pose is rejected naming the landmark. `0` disables the check.
+    pub min_landmark_coverage: f64,
 }
 
 impl Default for DetectOptions {
@@ -45,6 +50,7 @@ impl Default for DetectOptions {
             min_symmetry: 0.5,
             min_local_agreement: 0.85,
             use_regressor: true,
+            min_landmark_coverage: 0.5,
         }
     }
 }
@@ -71,6 +77,25 @@ pub(crate) fn surface_index(mesh: &TriMesh) -> SurfaceIndex {
         .map(|(s, &c)| if c > 0 { 0.5 * s / c as f64 } else { 0.0 })
         .collect();
     SurfaceIndex::new(pos, nrm, reach)
+}
+
+/// The vertices at which candidates are looked for, in increasing order: every vertex when the
+/// mesh's mean edge is at least half of `spacing`, else the first vertex (lowest id) in each
+/// occupied cube of side `spacing`.
+fn spaced_vertices(mesh: &TriMesh, spacing: f64) -> Vec<u32> {
+    let n = mesh.n_vertices() as u32;
+    if !(spacing > 0.0 && spacing.is_finite()) || mesh.mean_edge_length() >= 0.5 * spacing {
+        return (0..n).collect();
+    }
+    let mut seen = std::collections::HashSet::new();
+    let mut out = Vec::new();
+    for (v, p) in mesh.positions().iter().enumerate() {
+        let c = (*p / spacing).floor();
+        if seen.insert((c.x as i64, c.y as i64, c.z as i64)) {
+            out.push(v as u32);
+        }
+    }
+    out
 }
 
 /// Greedy non-maximum suppression: vertices sorted by decreasing score (ties by index), kept
@@ -232,11 +257,16 @@ pub fn detect_with(
     let clock = std::time::Instant::now();
     let idx = surface_index(mesh_m);
     let adj = VertexAdjacency::new(mesh_m);
-    let curv = vertex_curvatures_with(
+    // Candidates come from the curvature at vertices about a sixth of the curvature radius
+    // apart: every vertex of a mesh as coarse as the training faces, a subsample of a dense scan
+    // (its fits still use every neighbour).
+    let at = spaced_vertices(mesh_m, p.curvature_radius / 6.0);
+    let curv = curvatures_at(
         mesh_m,
         &idx.nrm,
         &adj,
         &CurvatureOptions::with_radius(p.curvature_radius),
+        &at,
     );
     use LandmarkName as L;
     let mut n_noses = 0;
@@ -263,16 +293,16 @@ pub fn detect_with(
         // Candidates.
         let mut nose_c = Vec::new();
         let mut eye_c = Vec::new();
-        for (v, c) in curv.iter().enumerate() {
+        for (&v, c) in at.iter().zip(&curv) {
             let (si, cv) = (c.shape_index(), c.curvedness());
             // Candidates resemble the learned curvature signatures (within 3 sd on each axis).
             let dn = p.nose.distance2(si, cv);
             if dn < gate && si > 0.0 {
-                nose_c.push((-dn, v as u32));
+                nose_c.push((-dn, v));
             }
             let de = p.eye.distance2(si, cv);
             if de < gate && si < 0.0 {
-                eye_c.push((-de, v as u32));
+                eye_c.push((-de, v));
             }
         }
         let noses = nms(&idx, nose_c, p.candidate_radius, max_noses);
@@ -298,7 +328,9 @@ pub fn detect_with(
         let mut hyps: Vec<DAffine3> = Vec::new();
         for &n in &noses {
             let pn = idx.pos[n as usize];
-            let nn = curv[n as usize].normal;
+            let nn = at
+                .binary_search(&n)
+                .map_or(idx.nrm[n as usize], |k| curv[k].normal);
             let src_base = [m_nose, m_nose + m_nn * d];
             let dst_base = [pn, pn + nn * d];
             for (i, &ei) in eyes.iter().enumerate() {
@@ -474,6 +506,27 @@ pub fn detect_with(
             }
             _ => out,
         };
+        // Every landmark must sit on the input: one the fitted face puts where the input has
+        // no surface (occluded, in a hole, cropped) lands on the nearest rim vertex, a silent
+        // wrong point; the template around a reported point then finds little surface.
+        if options.min_landmark_coverage > 0.0 {
+            let bare = L::ALL.into_iter().find_map(|name| {
+                let k = name as usize;
+                let c = coverage(&idx, &model.patches[k], &best.t, out[k].position, tau);
+                (c < options.min_landmark_coverage).then_some((name, c))
+            });
+            if let Some((name, c)) = bare {
+                rejected.get_or_insert((
+                    format!(
+                        "{name} is not on the surface: only {:.0} % of the surface expected around it was found (at least {:.0} % needed); it is occluded, in a hole or outside the scan",
+                        100.0 * c,
+                        100.0 * options.min_landmark_coverage
+                    ),
+                    f.conf * c,
+                ));
+                continue;
+            }
+        }
         let out = out.map(|l| Landmark {
             position: mesh.position(l.vertex),
             ..l
@@ -582,6 +635,22 @@ fn regressed(
         out[k].position = idx.pos[v as usize];
     }
     out
+}
+
+/// Share of the points of a landmark template (offsets from the landmark, turned by the pose
+/// `t`), placed at `at`, whose nearest input vertex is within `tau`.
+fn coverage(idx: &SurfaceIndex, tpl: &crate::Template, t: &DAffine3, at: DVec3, tau: f64) -> f64 {
+    let tau2 = tau * tau;
+    let n = tpl.points.len();
+    let hit = tpl
+        .points
+        .iter()
+        .filter(|p| {
+            let q = at + t.transform_vector3(DVec3::new(p[0], p[1], p[2]));
+            idx.query(q).d2 < tau2
+        })
+        .count();
+    hit as f64 / n.max(1) as f64
 }
 
 /// Confidence in `[0, 1]` of a face fit from its inlier share and inlier RMS, relative to the

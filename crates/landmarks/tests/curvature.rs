@@ -178,3 +178,21 @@ fn curvature_does_not_depend_on_the_thread_count() {
     // And the field is not trivial (the comparison is not between two flat results).
     assert!(one.iter().any(|c| c.k1.abs() > 0.1));
 }
+
+#[test]
+fn curvature_at_chosen_vertices_equals_the_whole_mesh_computation() {
+    let mesh = height_field(30, |x, y| 0.3 * x * x - 0.2 * x * y + 0.1 * y * y * y);
+    let normals = mesh.vertex_normals();
+    let adj = landmarks::curvature::VertexAdjacency::new(&mesh);
+    let opts = CurvatureOptions::with_radius(0.25);
+    let all = landmarks::curvature::vertex_curvatures_with(&mesh, &normals, &adj, &opts);
+    let at = [517u32, 3, 250, 899, 3];
+    let some = landmarks::curvature::curvatures_at(&mesh, &normals, &adj, &opts, &at);
+    assert_eq!(some.len(), at.len());
+    for (v, c) in at.iter().zip(&some) {
+        assert_eq!(*c, all[*v as usize], "vertex {v}");
+    }
+    // An id out of range gets zero curvatures instead of a panic.
+    let out = landmarks::curvature::curvatures_at(&mesh, &normals, &adj, &opts, &[u32::MAX]);
+    assert_eq!((out[0].k1, out[0].k2), (0.0, 0.0));
+}

@@ -367,3 +367,23 @@ fn ict_truth(dir: &std::path::Path) -> std::collections::BTreeMap<String, [meshc
         .map(|(k, v)| (k.clone(), io::select_five(v, k).unwrap()))
         .collect()
 }
+
+#[test]
+fn a_landmark_without_surface_is_not_found_with_its_name() {
+    let Some(dir) = paper_set() else { return };
+    let truth = ict_truth(&dir);
+    let model = GenericModel::default_model().unwrap();
+    let mesh = read_obj(&dir.join("id2_neutral.obj"));
+    let corner = truth["id2_neutral"][LandmarkName::OuterEyeRight as usize];
+    // The whole face is found.
+    detect(&mesh, &model).unwrap();
+    // No surface within 1.2 cm of the right outer eye corner (a landmark the scanner did not
+    // see): not found, never a point on the rim of the hole, under any rigid motion.
+    let holed = part(&mesh, |p| (p - corner).length() > 1.2);
+    for t in motions() {
+        match detect(&holed.transformed(&t), &model) {
+            Err(LandmarkError::NotFound { reason, .. }) => assert!(!reason.is_empty()),
+            other => panic!("expected NotFound, got {other:?}"),
+        }
+    }
+}

@@ -5,6 +5,7 @@
 
 pub mod pipeline;
 pub mod report;
+pub mod scans;
 
 /// Straightest geodesics: the library's walker (`geodesic::straightest`).
 pub mod walk {

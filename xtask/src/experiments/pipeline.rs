@@ -134,6 +134,15 @@ impl<T: Keyed> Keyed for Option<T> {
     }
 }
 
+/// A descriptor that could not be built (its error kept for the report) counts as a set without
+/// points.
+impl<T: Keyed, E> Keyed for Result<T, E> {
+    fn unambiguous(&self) -> (Vec<u64>, Vec<DVec3>) {
+        self.as_ref()
+            .map_or_else(|_| (Vec::new(), Vec::new()), Keyed::unambiguous)
+    }
+}
+
 /// Keyed distance of the unambiguous points: `shapedist::keyed_distance` (Kabsch closed form,
 /// no gate). Fewer than 3 shared keys is `ShapeDistError::TooFewPairs`.
 pub fn dist<A: Keyed + ?Sized, B: Keyed + ?Sized>(a: &A, b: &B) -> Result<f64, ShapeDistError> {

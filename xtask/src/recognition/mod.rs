@@ -9,11 +9,14 @@
 //! probe x gallery pairs, and the ROC curve. Results: `report.md`, `summary.json`, `roc.svg` (and `roc.png`),
 //! CSV tables, in the output folder printed on the last line.
 
+mod scans;
+
 use crate::experiments::pipeline::{
     bar, bipolar, dist, resolve_methods, DescriptorRule, Refs, Region,
 };
 use crate::experiments::polar::{self, polar_descriptor, PolarOptions, Pole};
 use crate::experiments::report::{f4, line_plot, Report, Series};
+use crate::experiments::scans::ScanArgs;
 use crate::experiments::walk::Walker;
 use crate::paths::{default_model_dir, default_out_dir};
 use anyhow::{bail, Context, Result};
@@ -32,12 +35,12 @@ use std::time::Instant;
 /// Arguments of `cargo xtask recognition`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
-    /// Number of sampled identities.
-    #[arg(long, default_value_t = 50)]
-    pub identities: usize,
-    /// Faces per identity (the first is neutral and goes to the gallery).
-    #[arg(long, default_value_t = 6)]
-    pub expressions: usize,
+    /// Number of sampled identities (default 50; with `--scans` 12).
+    #[arg(long)]
+    pub identities: Option<usize>,
+    /// Faces per identity, the first neutral for the gallery (default 6; with `--scans` 3).
+    #[arg(long)]
+    pub expressions: Option<usize>,
     /// Seed of the sampling.
     #[arg(long, default_value_t = 7)]
     pub seed: u64,
@@ -56,9 +59,23 @@ pub struct Args {
     /// ICT model folder (default `$BIPOLAR_SHARED/faces/ict-facekit/model`).
     #[arg(long)]
     pub model: Option<PathBuf>,
-    /// Output folder (default `target/recognition`).
+    /// Output folder (default `target/recognition`; with `--scans` `target/recognition-scans`).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Recognition on range scans (`rangescan`, cleaned by `scanprep`): neutral frontal scans
+    /// (the `--scan-*` settings) as the gallery, expressions under yaw and noise as probes, and
+    /// sweeps of noise, pitch and yaw.
+    #[arg(long)]
+    pub scans: bool,
+    /// Scanner settings of the gallery (and the reference of the sweeps) with `--scans`.
+    #[command(flatten)]
+    pub scan: ScanArgs,
+    /// Identities whose probes are rescanned at every sweep setting (`--scans`).
+    #[arg(long, default_value_t = 6)]
+    pub sweep_identities: usize,
+    /// Skip the sweeps (`--scans`).
+    #[arg(long)]
+    pub no_sweeps: bool,
 }
 
 /// One sampled face.
@@ -80,9 +97,88 @@ struct Lm {
 /// Per face and landmark set: descriptors and landmark positions.
 #[derive(Debug, Clone)]
 struct Described {
-    bip: Option<bipolar::Descriptor>,
+    bip: Result<bipolar::Descriptor, String>,
     pol: PolarDescriptor,
     lm_pos: [DVec3; 3],
+}
+
+/// Descriptor settings of the benchmark.
+#[derive(Debug, Clone, Copy)]
+struct DescribeOptions {
+    /// Levels N between the outer eye corners.
+    levels: u32,
+    /// Sectors of the single-pole descriptor.
+    sectors: u32,
+}
+
+/// The bipolar (static area, grid reading) and single-pole descriptors of one face for one
+/// landmark set. Only the static lens (within D of both corners, D ~ 1.1 |q - r|) and polar
+/// radii up to D are used: the fields are cut off at 1.4 |q - r|. Errors name what failed
+/// (a bipolar descriptor the crate refuses is kept as its error; an empty single-pole one is
+/// the empty set).
+fn describe_face(
+    mesh: &TriMesh,
+    solver: &dyn geodesic::GeodesicSolver,
+    walker: &Walker<'_>,
+    lm: Lm,
+    o: &DescribeOptions,
+) -> Result<Described, String> {
+    if lm.r == lm.q {
+        return Err(format!(
+            "the two outer eye corners are the same vertex {}",
+            lm.r
+        ));
+    }
+    let (r, q, nose) = (
+        mesh.position(lm.r),
+        mesh.position(lm.q),
+        mesh.position(lm.nose),
+    );
+    let cut = SolveOptions {
+        max_distance: Some(1.4 * (q - r).length()),
+    };
+    let field = |v: u32| {
+        solver
+            .distances(&[Source::Vertex(v)], &cut)
+            .map_err(|e| format!("geodesic field: {e}"))
+    };
+    let (ur, uq, un) = (field(lm.r)?, field(lm.q)?, field(lm.nose)?);
+    let d = 0.5 * (ur[lm.q as usize] + uq[lm.r as usize]);
+    if !d.is_finite() || d <= 0.0 {
+        return Err(format!(
+            "the geodesic distance between the outer eye corners is {d} (not reachable within 1.4 times their distance)"
+        ));
+    }
+    let frame = face_frame(mesh, r, q, nose);
+    let refs = Refs {
+        ur,
+        uq,
+        d,
+        r,
+        q,
+        nose,
+        frame,
+    };
+    let bip = bipolar(
+        mesh,
+        &refs,
+        o.levels,
+        Region::Static,
+        DescriptorRule::CrateAll,
+    )
+    .map_err(|e| format!("bipolar descriptor: {e}"));
+    let opts = PolarOptions {
+        step: d / f64::from(o.levels),
+        levels: o.levels,
+        sectors: o.sectors,
+    };
+    let pol = polar_descriptor(walker, &un, Pole::Vertex(lm.nose), 0.5 * (r + q), &opts)
+        .unwrap_or_else(|_| polar::empty(&opts));
+    Ok(Described {
+        bip,
+        pol,
+        lm_pos: [r, q, nose],
+    })
 }
 
 /// Identification/verification figures of one score matrix.
@@ -212,15 +308,131 @@ fn icp_score(
     (ss / probe.len().max(1) as f64).sqrt()
 }
 
+/// About `n` vertices of a probe for ICP, evenly strided.
+fn icp_points(mesh: &TriMesh, n: usize) -> Vec<DVec3> {
+    let stride = (mesh.n_vertices() / n.max(3)).max(1);
+    mesh.positions().iter().step_by(stride).copied().collect()
+}
+
+/// Scores of one probe (its description and ICP points) against every gallery face:
+/// bipolar, single pole and ICP; NaN where either side has no description or the score fails.
+fn score_row(
+    probe: Option<&Described>,
+    pts: &[DVec3],
+    gallery: &[Option<(&Described, &FaceLocator<'_>)>],
+) -> [Vec<f64>; 3] {
+    let mut out = [Vec::new(), Vec::new(), Vec::new()];
+    for g in gallery {
+        let [b, s, c] = match (probe, g) {
+            (Some(x), Some((y, loc))) => [
+                dist(&x.bip, &y.bip).unwrap_or(f64::NAN),
+                dist(&x.pol, &y.pol).unwrap_or(f64::NAN),
+                icp_score(pts, &x.lm_pos, loc, &y.lm_pos),
+            ],
+            _ => [f64::NAN; 3],
+        };
+        out[0].push(b);
+        out[1].push(s);
+        out[2].push(c);
+    }
+    out
+}
+
+/// Names of the three scores of [`score_row`].
+const SCORES: [&str; 3] = ["bipolar", "single_pole", "icp_raw_mesh"];
+
+/// The figures of the three score matrices of one landmark set (rows from [`score_row`]).
+fn summarize(
+    rows: &[[Vec<f64>; 3]],
+    probe_id: &[usize],
+    gallery_id: &[usize],
+    landmarks: &str,
+) -> Vec<Metrics> {
+    SCORES
+        .iter()
+        .enumerate()
+        .map(|(j, dname)| {
+            let m: Vec<Vec<f64>> = rows.iter().map(|r| r[j].clone()).collect();
+            let (rank1, eer, roc, gm, im, failures) = metrics(&m, probe_id, gallery_id);
+            Metrics {
+                descriptor: dname.to_string(),
+                landmarks: landmarks.to_string(),
+                rank1,
+                eer,
+                genuine_mean: gm,
+                impostor_mean: im,
+                failures,
+                roc,
+            }
+        })
+        .collect()
+}
+
+/// Appends the table of `all` (rank-1, EER, mean scores, failed pairs) to the report and
+/// writes it as the CSV file `csv`.
+fn results_table(rep: &mut Report, all: &[Metrics], csv: &str) -> Result<()> {
+    let rows: Vec<Vec<String>> = all
+        .iter()
+        .map(|m| {
+            vec![
+                m.descriptor.clone(),
+                m.landmarks.clone(),
+                format!("{:.3}", m.rank1),
+                format!("{:.3}", m.eer),
+                f4(m.genuine_mean),
+                f4(m.impostor_mean),
+                m.failures.to_string(),
+            ]
+        })
+        .collect();
+    let hdr = [
+        "descriptor",
+        "landmarks",
+        "rank-1",
+        "EER",
+        "mean genuine score",
+        "mean impostor score",
+        "failed pairs",
+    ];
+    rep.table(&hdr, &rows);
+    rep.csv(csv, &hdr, &rows)
+}
+
+/// Draws the ROC curves of `all` into `file` and appends the figure to the report.
+fn roc_figure(rep: &mut Report, all: &[Metrics], file: &str, title: &str) -> Result<()> {
+    let series: Vec<Series> = all
+        .iter()
+        .map(|m| Series {
+            name: format!("{} ({})", m.descriptor, m.landmarks),
+            points: m.roc.clone(),
+            dashed: m.landmarks == "detected",
+        })
+        .collect();
+    line_plot(
+        &rep.path(file),
+        title,
+        "false accept rate",
+        "true accept rate",
+        &series,
+    )?;
+    rep.figure(file, &format!("{title}; dashed: detected landmarks"));
+    Ok(())
+}
+
 /// Runs the benchmark; prints the output folder on the last line.
 pub fn run(args: Args) -> Result<()> {
     let t0 = Instant::now();
-    if args.identities < 2 || args.expressions < 2 {
-        bail!("need at least 2 identities and 2 expressions (one neutral gallery face + probes)");
-    }
     let model_dir = args.model.clone().unwrap_or_else(default_model_dir);
     let model = FaceModel::load(&model_dir)
         .with_context(|| format!("loading the ICT model from {}", model_dir.display()))?;
+    if args.scans {
+        return scans::run(&args, &model, t0);
+    }
+    let identities = args.identities.unwrap_or(50);
+    let expressions = args.expressions.unwrap_or(6);
+    if identities < 2 || expressions < 2 {
+        bail!("need at least 2 identities and 2 expressions (one neutral gallery face + probes)");
+    }
     let out = args
         .out
         .clone()
@@ -233,9 +445,9 @@ pub fn run(args: Args) -> Result<()> {
     // Sampling (sequential: deterministic).
     let mut rng = ChaCha8Rng::seed_from_u64(args.seed);
     let mut samples = Vec::new();
-    for id in 0..args.identities {
+    for id in 0..identities {
         let w = model.random_identity(&mut rng);
-        for e in 0..args.expressions {
+        for e in 0..expressions {
             let ew = if e == 0 {
                 vec![0.0; model.n_expressions()]
             } else {
@@ -261,10 +473,14 @@ pub fn run(args: Args) -> Result<()> {
     eprintln!(
         "{} faces sampled ({} identities x {}); geodesics: {}",
         samples.len(),
-        args.identities,
-        args.expressions,
+        identities,
+        expressions,
         method.name()
     );
+    let desc_opts = DescribeOptions {
+        levels: args.levels,
+        sectors: args.sectors,
+    };
     // Landmark detection.
     let generic = landmarks::GenericModel::default_model()
         .map_err(|e| anyhow::anyhow!("landmark model: {e}"))?;
@@ -300,61 +516,11 @@ pub fn run(args: Args) -> Result<()> {
         .map(|(s, det)| -> Result<_> {
             let solver = geodesic::new_solver(&s.mesh, method)?;
             let walker = Walker::new(&s.mesh);
-            let mut out: [Option<Described>; 2] = [None, None];
-            for (k, lm) in [Some(gt), *det].into_iter().enumerate() {
-                let Some(lm) = lm else { continue };
-                if lm.r == lm.q {
-                    continue;
-                }
-                let (r, q, nose) = (
-                    s.mesh.position(lm.r),
-                    s.mesh.position(lm.q),
-                    s.mesh.position(lm.nose),
-                );
-                // Only the static lens (within D of both corners, D ~ 1.1 |q - r|) and polar
-                // radii up to D are used: the fields are cut off at 1.4 |q - r|.
-                let cut = SolveOptions {
-                    max_distance: Some(1.4 * (q - r).length()),
-                };
-                let ur = solver.distances(&[Source::Vertex(lm.r)], &cut)?;
-                let uq = solver.distances(&[Source::Vertex(lm.q)], &cut)?;
-                let un = solver.distances(&[Source::Vertex(lm.nose)], &cut)?;
-                let d = 0.5 * (ur[lm.q as usize] + uq[lm.r as usize]);
-                if !d.is_finite() || d <= 0.0 {
-                    continue;
-                }
-                let frame = face_frame(&s.mesh, r, q, nose);
-                let refs = Refs {
-                    ur,
-                    uq,
-                    d,
-                    r,
-                    q,
-                    nose,
-                    frame,
-                };
-                let bip = bipolar(
-                    &s.mesh,
-                    &refs,
-                    args.levels,
-                    Region::Static,
-                    DescriptorRule::CrateAll,
-                )
-                .ok();
-                let opts = PolarOptions {
-                    step: d / f64::from(args.levels),
-                    levels: args.levels,
-                    sectors: args.sectors,
-                };
-                let pol =
-                    polar_descriptor(&walker, &un, Pole::Vertex(lm.nose), 0.5 * (r + q), &opts)
-                        .unwrap_or_else(|_| polar::empty(&opts));
-                out[k] = Some(Described {
-                    bip,
-                    pol,
-                    lm_pos: [r, q, nose],
-                });
-            }
+            let out = [Some(gt), *det].map(|lm| {
+                lm.and_then(|lm| {
+                    describe_face(&s.mesh, solver.as_ref(), &walker, lm, &desc_opts).ok()
+                })
+            });
             pb.inc(1);
             Ok(out)
         })
@@ -372,60 +538,24 @@ pub fn run(args: Args) -> Result<()> {
         .iter()
         .map(|&g| FaceLocator::new(&samples[g].mesh))
         .collect();
-    let stride = (samples[0].mesh.n_vertices() / args.icp_points.max(3)).max(1);
     let mut all = Vec::new();
     let pb = bar(2 * probes.len(), "scoring (ICP dominates)");
     for (k, lname) in ["ground_truth", "detected"].iter().enumerate() {
+        let gal: Vec<Option<(&Described, &FaceLocator<'_>)>> = gallery
+            .iter()
+            .zip(&locators)
+            .map(|(&g, l)| described[g][k].as_ref().map(|d| (d, l)))
+            .collect();
         let rows: Vec<[Vec<f64>; 3]> = probes
             .par_iter()
             .map(|&p| {
-                let dp = described[p][k].as_ref();
-                let pts: Vec<DVec3> = samples[p]
-                    .mesh
-                    .positions()
-                    .iter()
-                    .step_by(stride)
-                    .copied()
-                    .collect();
-                let mut b = Vec::new();
-                let mut s = Vec::new();
-                let mut c = Vec::new();
-                for (gi, &g) in gallery.iter().enumerate() {
-                    let dg = described[g][k].as_ref();
-                    match (dp, dg) {
-                        (Some(x), Some(y)) => {
-                            b.push(dist(&x.bip, &y.bip).unwrap_or(f64::NAN));
-                            s.push(dist(&x.pol, &y.pol).unwrap_or(f64::NAN));
-                            c.push(icp_score(&pts, &x.lm_pos, &locators[gi], &y.lm_pos));
-                        }
-                        _ => {
-                            b.push(f64::NAN);
-                            s.push(f64::NAN);
-                            c.push(f64::NAN);
-                        }
-                    }
-                }
+                let pts = icp_points(&samples[p].mesh, args.icp_points);
+                let r = score_row(described[p][k].as_ref(), &pts, &gal);
                 pb.inc(1);
-                [b, s, c]
+                r
             })
             .collect();
-        for (j, dname) in ["bipolar", "single_pole", "icp_raw_mesh"]
-            .iter()
-            .enumerate()
-        {
-            let m: Vec<Vec<f64>> = rows.iter().map(|r| r[j].clone()).collect();
-            let (rank1, eer, roc, gm, im, failures) = metrics(&m, &pid, &gid);
-            all.push(Metrics {
-                descriptor: dname.to_string(),
-                landmarks: lname.to_string(),
-                rank1,
-                eer,
-                genuine_mean: gm,
-                impostor_mean: im,
-                failures,
-                roc,
-            });
-        }
+        all.extend(summarize(&rows, &pid, &gid, lname));
     }
     pb.finish();
 
@@ -433,62 +563,23 @@ pub fn run(args: Args) -> Result<()> {
     let mut rep = Report::new(&out, "Recognition benchmark on sampled ICT faces")?;
     rep.para(&format!(
         "{} identities x {} faces (seed {}): {} gallery faces (neutral), {} probes (random expressions: with probability 1/2 a recipe at strength 0.3-1, plus random blendshapes), every face under a random rigid motion. Geodesics: {}{}. Bipolar descriptor: static area, N = {} levels between the outer eye corners (grid reading, keyed distance); single pole: {} sectors x {} radius levels around the nose tip; ICP: {} probe vertices onto the gallery surface, started from the 3-landmark alignment, 10 % trimmed, score = RMS closest-point distance (cm).",
-        args.identities, args.expressions, args.seed, gallery.len(), probes.len(), method.name(),
+        identities, expressions, args.seed, gallery.len(), probes.len(), method.name(),
         method_note.as_ref().map(|n| format!(" (exact requested: {n})")).unwrap_or_default(),
-        args.levels, args.sectors, args.levels, samples[0].mesh.positions().iter().step_by(stride).count()
+        args.levels, args.sectors, args.levels, icp_points(&samples[0].mesh, args.icp_points).len()
     ));
     let n_det = detected.iter().filter(|d| d.is_some()).count();
     let mean_err =
         |k: usize| det_err.iter().map(|e| e[k]).sum::<f64>() / det_err.len().max(1) as f64;
     rep.para(&format!("Landmark detection: {n_det} of {} faces detected; mean error right corner {:.3} cm, left corner {:.3} cm, nose tip {:.3} cm.", samples.len(), mean_err(0), mean_err(1), mean_err(2)));
-    let rows: Vec<Vec<String>> = all
-        .iter()
-        .map(|m| {
-            vec![
-                m.descriptor.clone(),
-                m.landmarks.clone(),
-                format!("{:.3}", m.rank1),
-                format!("{:.3}", m.eer),
-                f4(m.genuine_mean),
-                f4(m.impostor_mean),
-                m.failures.to_string(),
-            ]
-        })
-        .collect();
-    let hdr = [
-        "descriptor",
-        "landmarks",
-        "rank-1",
-        "EER",
-        "mean genuine score",
-        "mean impostor score",
-        "failed pairs",
-    ];
-    rep.table(&hdr, &rows);
-    rep.csv("results.csv", &hdr, &rows)?;
-    let series: Vec<Series> = all
-        .iter()
-        .map(|m| Series {
-            name: format!("{} ({})", m.descriptor, m.landmarks),
-            points: m.roc.clone(),
-            dashed: m.landmarks == "detected",
-        })
-        .collect();
-    line_plot(
-        &rep.path("roc.svg"),
-        "ROC (verification)",
-        "false accept rate",
-        "true accept rate",
-        &series,
-    )?;
-    rep.figure("roc.svg", "ROC curves; dashed: detected landmarks");
+    results_table(&mut rep, &all, "results.csv")?;
+    roc_figure(&mut rep, &all, "roc.svg", "ROC (verification)")?;
     rep.png_twins()?;
     let secs = t0.elapsed().as_secs_f64();
     rep.para(&format!("Run time: {secs:.1} s."));
     rep.finish()?;
     let summary = serde_json::json!({
-        "identities": args.identities,
-        "faces_per_identity": args.expressions,
+        "identities": identities,
+        "faces_per_identity": expressions,
         "seed": args.seed,
         "gallery": gallery.len(),
         "probes": probes.len(),

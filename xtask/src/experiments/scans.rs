@@ -1,0 +1,477 @@
+//! Scan sets for the experiments: faces sampled from the ICT model (`facemodel`), scanned by
+//! the virtual range scanner (`rangescan`) under given settings, cleaned by `scanprep` (crop
+//! around the nose tip), with the ground-truth landmarks the scanner projected (unseen ones
+//! marked with the reason) and the landmarks `landmarks::detect` finds on the cleaned scan.
+//!
+//! Deterministic: the faces' weights come from one seeded stream drawn in order, every scan
+//! has its own seed derived from the set's seed and the face's index, and faces are processed
+//! in parallel (rayon) but collected in input order.
+
+use anyhow::Result;
+use facemodel::FaceModel;
+use indicatif::ProgressBar;
+use landmarks::{DetectOptions, GenericModel, LandmarkName, Landmarks};
+use meshcore::{DVec3, TriMesh};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rangescan::{
+    Artifacts, DepthNoise, GrazingDropout, HeadPose, Holes, Outliers, Quantisation, ScanOptions,
+    Spikes, Visibility,
+};
+use rayon::prelude::*;
+use scanprep::{CleanOptions, Crop, Input};
+use std::time::{Duration, Instant};
+
+/// The scanner settings of one scan.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScanSettings {
+    /// Sample pitch, mm.
+    pub pitch_mm: f64,
+    /// Standard deviation of the Gaussian depth noise, mm (0: none).
+    pub noise_mm: f64,
+    /// Depth quantisation step, mm (0: none).
+    pub quantisation_mm: f64,
+    /// Spikes (0.1 % of the samples, 2-10 mm) and 50 background outliers.
+    pub spikes: bool,
+    /// Holes: 4 random holes of 1-4 mm radius and dropouts at grazing angles (70-80 degrees).
+    pub holes: bool,
+    /// Head rotation about the vertical axis, degrees (positive turns the face to the
+    /// scanner's right).
+    pub yaw_deg: f64,
+    /// Head rotation about the horizontal axis, degrees (positive lifts the chin).
+    pub pitch_deg: f64,
+}
+
+impl ScanSettings {
+    /// The scanner's artifact model for these settings (the parts of
+    /// `Artifacts::structured_light` that are switched on, with the noise and quantisation
+    /// given here).
+    pub fn artifacts(&self) -> Artifacts {
+        let sl = Artifacts::structured_light();
+        Artifacts {
+            noise: (self.noise_mm > 0.0).then_some(DepthNoise {
+                sigma_mm: self.noise_mm,
+            }),
+            quantisation: (self.quantisation_mm > 0.0).then_some(Quantisation {
+                step_mm: self.quantisation_mm,
+            }),
+            spikes: if self.spikes {
+                sl.spikes.or(Some(Spikes {
+                    fraction: 0.001,
+                    min_mm: 2.0,
+                    max_mm: 10.0,
+                }))
+            } else {
+                None
+            },
+            outliers: if self.spikes {
+                sl.outliers.or(Some(Outliers { count: 50 }))
+            } else {
+                None
+            },
+            grazing: if self.holes {
+                sl.grazing.or(Some(GrazingDropout {
+                    start_deg: 70.0,
+                    full_deg: 80.0,
+                }))
+            } else {
+                None
+            },
+            holes: if self.holes {
+                sl.holes.or(Some(Holes {
+                    count: 4,
+                    min_radius_mm: 1.0,
+                    max_radius_mm: 4.0,
+                }))
+            } else {
+                None
+            },
+            border: None,
+        }
+    }
+
+    /// A short label (`pitch 0.5 mm, noise 0.1 mm, holes, spikes, yaw 30`).
+    pub fn label(&self) -> String {
+        let mut s = format!("pitch {} mm, noise {} mm", self.pitch_mm, self.noise_mm);
+        if self.quantisation_mm > 0.0 {
+            s += &format!(", quantisation {} mm", self.quantisation_mm);
+        }
+        if self.holes {
+            s += ", holes";
+        }
+        if self.spikes {
+            s += ", spikes";
+        }
+        if self.yaw_deg != 0.0 {
+            s += &format!(", yaw {}", self.yaw_deg);
+        }
+        if self.pitch_deg != 0.0 {
+            s += &format!(", pitch {}", self.pitch_deg);
+        }
+        s
+    }
+}
+
+/// One face to scan: its weights in the ICT model, the scanner settings and the scan's seed.
+#[derive(Debug, Clone)]
+pub struct FaceSpec {
+    /// Name used in reports (`id03-e1-yaw30`, ...).
+    pub name: String,
+    /// Identity index in the set.
+    pub identity: usize,
+    /// Identity weights.
+    pub identity_weights: Vec<f64>,
+    /// Expression weights (empty: neutral).
+    pub expression_weights: Vec<f64>,
+    /// Scanner settings.
+    pub settings: ScanSettings,
+    /// Seed of the scanner's artifacts.
+    pub seed: u64,
+}
+
+/// Weights of `identities` x `expressions` faces drawn from one stream of `seed`, identity by
+/// identity (expression 0 of each is neutral), as `(identity weights, expression weights per
+/// face)`.
+pub fn sample_weights(
+    model: &FaceModel,
+    identities: usize,
+    expressions: usize,
+    seed: u64,
+) -> Vec<(Vec<f64>, Vec<Vec<f64>>)> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    (0..identities)
+        .map(|_| {
+            let w = model.random_identity(&mut rng);
+            let ex = (0..expressions)
+                .map(|e| {
+                    if e == 0 {
+                        Vec::new()
+                    } else {
+                        model.random_expression(&mut rng)
+                    }
+                })
+                .collect();
+            (w, ex)
+        })
+        .collect()
+}
+
+/// The scan seed of face `index` of a set with seed `seed` (SplitMix64 of both).
+pub fn scan_seed(seed: u64, index: u64) -> u64 {
+    let mut z = seed
+        .wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        .wrapping_add(index.wrapping_add(1).wrapping_mul(0xBF58_476D_1CE4_E5B9));
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// A ground-truth landmark on the cleaned scan.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Truth {
+    /// The true point in the scan frame (mm).
+    pub position: DVec3,
+    /// What the scanner saw at the point.
+    pub scanner: Visibility,
+    /// The nearest vertex of the cleaned scan and its distance (mm) when it is within
+    /// [`MAX_SNAP_MM`] (the point is on the cleaned scan, whatever the scanner saw at its exact
+    /// position: a corner tucked under the eyelid counts, a filled hole too); otherwise why not.
+    pub vertex: Result<(u32, f64), String>,
+}
+
+/// A ground-truth landmark farther than this (mm) from every vertex of the cleaned scan
+/// (occluded, outside the grid, removed by the cleaning or the crop) is not on the scan.
+pub const MAX_SNAP_MM: f64 = 3.0;
+
+/// Wall time of each step of one face.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct StepTimes {
+    /// Sampling the face and scanning it.
+    pub scan: Duration,
+    /// `scanprep::clean`.
+    pub clean: Duration,
+    /// `landmarks::detect`.
+    pub detect: Duration,
+}
+
+/// One scanned, cleaned face.
+#[derive(Debug, Clone)]
+pub struct ScannedFace {
+    /// Valid samples of the raw scan.
+    pub valid_samples: usize,
+    /// The cleaned scan (mm, scan frame).
+    pub mesh: TriMesh,
+    /// Ground truth, in [`LandmarkName::ALL`] order.
+    pub truth: [Truth; 5],
+    /// Landmarks detected on the cleaned scan, or the detector's error message.
+    pub detected: Result<Landmarks, String>,
+    /// Step times.
+    pub times: StepTimes,
+}
+
+impl ScannedFace {
+    /// Ground-truth vertices of the outer eye corners and the nose tip, or why one is missing.
+    pub fn truth_vertices(&self) -> Result<[u32; 3], String> {
+        let v = |n: LandmarkName| {
+            self.truth[n as usize]
+                .vertex
+                .as_ref()
+                .map(|x| x.0)
+                .map_err(|e| format!("ground-truth {n}: {e}"))
+        };
+        Ok([
+            v(LandmarkName::OuterEyeRight)?,
+            v(LandmarkName::OuterEyeLeft)?,
+            v(LandmarkName::NoseTip)?,
+        ])
+    }
+
+    /// Detected vertices of the outer eye corners and the nose tip, or the detector's error.
+    pub fn detected_vertices(&self) -> Result<[u32; 3], String> {
+        let d = self
+            .detected
+            .as_ref()
+            .map_err(|e| format!("detection: {e}"))?;
+        Ok([
+            d.outer_eye_right.vertex,
+            d.outer_eye_left.vertex,
+            d.nose_tip.vertex,
+        ])
+    }
+}
+
+/// Options of [`scan_faces`].
+#[derive(Debug, Clone)]
+pub struct ScanSetOptions {
+    /// Crop radius around the nose tip, mm.
+    pub crop_radius_mm: f64,
+    /// Detection options for every cleaned scan (their `mesh_units_per_model_unit` is replaced
+    /// by the one recognised from the scan, `landmarks::mesh_units_per_model_unit`); `None`:
+    /// no detection.
+    pub detect: Option<DetectOptions>,
+}
+
+impl Default for ScanSetOptions {
+    fn default() -> Self {
+        Self {
+            crop_radius_mm: scanprep::DEFAULT_CROP_RADIUS_MM,
+            detect: Some(DetectOptions::default()),
+        }
+    }
+}
+
+/// The scanner settings and the crop as command-line options (shared by the tasks that scan).
+#[derive(Debug, Clone, clap::Args)]
+pub struct ScanArgs {
+    /// Sample pitch of the scans, mm.
+    #[arg(long, default_value_t = 0.5)]
+    pub scan_pitch: f64,
+    /// Depth noise of the scans (standard deviation), mm; 0 switches it off.
+    #[arg(long, default_value_t = 0.1)]
+    pub scan_noise: f64,
+    /// Depth quantisation step of the scans, mm; 0 switches it off.
+    #[arg(long, default_value_t = 0.0)]
+    pub scan_quantisation: f64,
+    /// Scans without holes and grazing dropouts.
+    #[arg(long)]
+    pub no_holes: bool,
+    /// Scans without spikes and outliers.
+    #[arg(long)]
+    pub no_spikes: bool,
+    /// Head yaw of the scans, degrees.
+    #[arg(long, default_value_t = 0.0)]
+    pub scan_yaw: f64,
+    /// Crop radius around the nose tip, mm.
+    #[arg(long, default_value_t = scanprep::DEFAULT_CROP_RADIUS_MM)]
+    pub crop_radius: f64,
+}
+
+impl ScanArgs {
+    /// The settings these options give.
+    pub fn settings(&self) -> ScanSettings {
+        ScanSettings {
+            pitch_mm: self.scan_pitch,
+            noise_mm: self.scan_noise,
+            quantisation_mm: self.scan_quantisation,
+            spikes: !self.no_spikes,
+            holes: !self.no_holes,
+            yaw_deg: self.scan_yaw,
+            pitch_deg: 0.0,
+        }
+    }
+}
+
+/// Samples, scans, cleans and (optionally) detects every face, in parallel, in input order.
+/// A face whose sampling, scan or cleaning fails is `Err` with the face's name and the error.
+pub fn scan_faces(
+    model: &FaceModel,
+    generic: &GenericModel,
+    specs: &[FaceSpec],
+    options: &ScanSetOptions,
+    progress: &ProgressBar,
+) -> Vec<Result<ScannedFace, String>> {
+    specs
+        .par_iter()
+        .map(|s| {
+            let r = scan_face(model, generic, s, options).map_err(|e| format!("{}: {e:#}", s.name));
+            progress.inc(1);
+            r
+        })
+        .collect()
+}
+
+/// [`scan_faces`] for one face.
+pub fn scan_face(
+    model: &FaceModel,
+    generic: &GenericModel,
+    spec: &FaceSpec,
+    options: &ScanSetOptions,
+) -> Result<ScannedFace> {
+    let t0 = Instant::now();
+    let face = model.sample(&spec.identity_weights, &spec.expression_weights)?;
+    let truth_cm = model.landmark_positions(&face)?;
+    let marks: Vec<(String, DVec3)> = LandmarkName::ALL
+        .iter()
+        .zip(truth_cm)
+        .map(|(n, p)| (n.lm3_label().to_string(), p))
+        .collect();
+    let mm_per_unit = match model.units() {
+        "mm" => 1.0,
+        "m" => 1000.0,
+        _ => 10.0,
+    };
+    let st = &spec.settings;
+    let scan = rangescan::scan_with_landmarks(
+        &face,
+        &marks,
+        &ScanOptions {
+            input_mm_per_unit: mm_per_unit,
+            pitch_mm: st.pitch_mm,
+            pose: HeadPose {
+                yaw_deg: st.yaw_deg,
+                pitch_deg: st.pitch_deg,
+            },
+            artifacts: st.artifacts(),
+            seed: spec.seed,
+            ..ScanOptions::default()
+        },
+    )?;
+    let t1 = Instant::now();
+    let nose = scan.landmarks[LandmarkName::NoseTip as usize].position;
+    let cleaned = scanprep::clean(
+        Input::Grid(&scan.grid),
+        &CleanOptions {
+            crop: Some(Crop {
+                centre: nose,
+                radius_mm: options.crop_radius_mm,
+            }),
+            ..CleanOptions::default()
+        },
+    )?;
+    let t2 = Instant::now();
+    let mesh = cleaned.mesh;
+    let truth: Vec<Truth> = scan
+        .landmarks
+        .iter()
+        .map(|l| Truth {
+            position: l.position,
+            scanner: l.visibility,
+            vertex: match nearest_vertex(&mesh, l.position) {
+                Some((v, d)) if d <= MAX_SNAP_MM => Ok((v, d)),
+                Some((_, d)) => Err(format!(
+                    "{} and {d:.1} mm from the cleaned surface",
+                    l.visibility
+                )),
+                None => Err("the cleaned scan is empty".into()),
+            },
+        })
+        .collect();
+    let truth: [Truth; 5] = truth
+        .try_into()
+        .map_err(|_| anyhow::anyhow!("the scanner returned another number of landmarks"))?;
+    let detected = match &options.detect {
+        Some(o) => landmarks::mesh_units_per_model_unit(&mesh, generic)
+            .and_then(|s| {
+                landmarks::detect_with(
+                    &mesh,
+                    generic,
+                    &DetectOptions {
+                        mesh_units_per_model_unit: s,
+                        ..*o
+                    },
+                )
+            })
+            .map_err(|e| e.to_string()),
+        None => Err("not run".into()),
+    };
+    let t3 = Instant::now();
+    Ok(ScannedFace {
+        valid_samples: scan.n_valid(),
+        mesh,
+        truth,
+        detected,
+        times: StepTimes {
+            scan: t1 - t0,
+            clean: t2 - t1,
+            detect: t3 - t2,
+        },
+    })
+}
+
+/// The vertex of `mesh` nearest to `p` and its distance (lowest index on ties).
+pub fn nearest_vertex(mesh: &TriMesh, p: DVec3) -> Option<(u32, f64)> {
+    mesh.positions()
+        .iter()
+        .enumerate()
+        .map(|(i, q)| (i as u32, (*q - p).length_squared()))
+        .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
+        .map(|(i, d2)| (i, d2.sqrt()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn settings_switch_the_artifacts() {
+        let mut s = ScanArgs {
+            scan_pitch: 0.5,
+            scan_noise: 0.1,
+            scan_quantisation: 0.0,
+            no_holes: false,
+            no_spikes: false,
+            scan_yaw: 0.0,
+            crop_radius: 100.0,
+        }
+        .settings();
+        let a = s.artifacts();
+        assert!(a.noise.is_some() && a.spikes.is_some() && a.holes.is_some());
+        assert!(a.quantisation.is_none());
+        s.spikes = false;
+        s.holes = false;
+        s.noise_mm = 0.0;
+        s.quantisation_mm = 2.0;
+        let a = s.artifacts();
+        assert!(a.noise.is_none() && a.spikes.is_none() && a.outliers.is_none());
+        assert!(a.holes.is_none() && a.grazing.is_none());
+        assert_eq!(a.quantisation.map(|q| q.step_mm), Some(2.0));
+        assert!(a.validate().is_ok());
+    }
+
+    #[test]
+    fn scan_seeds_differ_and_repeat() {
+        assert_eq!(scan_seed(7, 3), scan_seed(7, 3));
+        let mut v: Vec<u64> = (0..1000).map(|i| scan_seed(7, i)).collect();
+        v.extend((0..1000).map(|i| scan_seed(8, i)));
+        v.sort_unstable();
+        v.dedup();
+        assert_eq!(v.len(), 2000);
+    }
+
+    #[test]
+    fn nearest_vertex_is_exact() {
+        let m = meshcore::shapes::icosphere(2);
+        let p = m.position(17) * 1.01;
+        assert_eq!(nearest_vertex(&m, p).map(|x| x.0), Some(17));
+    }
+}

@@ -1,0 +1,136 @@
+//! `cargo xtask scan-path`: wall time of each step of the whole path for one range scan: read
+//! the `.bnt`, clean it (`scanprep::clean`, defaults), detect the landmarks
+//! (`landmarks::detect`), describe it (`bipolar::describe` with the exact solver from the two
+//! detected outer eye corners, as `bipolar describe scan.bnt --ref-a outer-eye-right --ref-b
+//! outer-eye-left` does). Without `--bnt` it scans the ICT neutral face (structured-light
+//! artifacts) at `--pitch` and writes the scan into the output folder first.
+
+use crate::paths::{default_model_dir, default_out_dir};
+use anyhow::{Context, Result};
+use facemodel::FaceModel;
+use landmarks::GenericModel;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+/// Arguments of `cargo xtask scan-path`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct Args {
+    /// A range scan to time (default: a scan of the ICT neutral face made here).
+    #[arg(long)]
+    pub bnt: Option<PathBuf>,
+    /// Sample pitch of the scan made without `--bnt`, mm (0.75 mm gives about 36k valid
+    /// samples).
+    #[arg(long, default_value_t = 0.75)]
+    pub pitch: f64,
+    /// Runs of the whole path; the median of each step is reported.
+    #[arg(long, default_value_t = 5)]
+    pub repeats: usize,
+    /// Output folder (default `target/scan-path`).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+fn median(mut v: Vec<Duration>) -> Duration {
+    v.sort();
+    v.get(v.len() / 2).copied().unwrap_or_default()
+}
+
+/// Runs the timing; prints the output folder on the last line.
+pub fn run(args: Args) -> Result<()> {
+    let out = args.out.unwrap_or_else(|| default_out_dir("scan-path"));
+    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    let bnt = match args.bnt {
+        Some(p) => p,
+        None => {
+            let model_dir = default_model_dir();
+            let model = FaceModel::load(&model_dir)
+                .with_context(|| format!("loading the ICT model from {}", model_dir.display()))?;
+            let face = model.neutral()?;
+            let scan = rangescan::scan(
+                &face,
+                &rangescan::ScanOptions {
+                    input_mm_per_unit: 10.0,
+                    pitch_mm: args.pitch,
+                    artifacts: rangescan::Artifacts::structured_light(),
+                    seed: 1,
+                    ..rangescan::ScanOptions::default()
+                },
+            )?;
+            let p = out.join("scan.bnt");
+            mesh_io::write_bnt(&p, &scan.grid)?;
+            p
+        }
+    };
+    let generic = GenericModel::default_model()?;
+    let steps = [
+        "read .bnt",
+        "clean",
+        "detect landmarks",
+        "describe (exact, N = 10)",
+    ];
+    let mut times: Vec<Vec<Duration>> = vec![Vec::new(); steps.len() + 1];
+    let mut info = String::new();
+    for run in 0..args.repeats.max(1) {
+        let t0 = Instant::now();
+        let grid = mesh_io::read_bnt_grid(&bnt)?;
+        let t1 = Instant::now();
+        let cleaned = scanprep::clean(
+            scanprep::Input::Grid(&grid),
+            &scanprep::CleanOptions::default(),
+        )?;
+        let t2 = Instant::now();
+        let lm = landmarks::detect(&cleaned.mesh, &generic)?;
+        let t3 = Instant::now();
+        let n_vertices = cleaned.mesh.n_vertices();
+        let solver = geodesic::new_solver(&cleaned.mesh, geodesic::Method::Exact)?;
+        let surface = bipolar::Surface::new(cleaned.mesh);
+        let d = bipolar::describe(
+            &surface,
+            bipolar::Fields::Solve {
+                solver: solver.as_ref(),
+                references: &[
+                    geodesic::Source::Vertex(lm.outer_eye_right.vertex),
+                    geodesic::Source::Vertex(lm.outer_eye_left.vertex),
+                ],
+            },
+            &bipolar::DescriptorOptions::default(),
+        )?;
+        let t4 = Instant::now();
+        for (k, (a, b)) in [(t0, t1), (t1, t2), (t2, t3), (t3, t4), (t0, t4)]
+            .into_iter()
+            .enumerate()
+        {
+            times[k].push(b - a);
+        }
+        if run == 0 {
+            let valid = (0..grid.xyz.len()).filter(|&i| grid.is_valid(i)).count();
+            info = format!(
+                "{}: {} x {} grid, {valid} valid samples; cleaned mesh {} vertices; descriptor {} points",
+                bnt.display(),
+                grid.nrows,
+                grid.ncols,
+                n_vertices,
+                d.points.len()
+            );
+        }
+        eprintln!("run {}: {:.3} s", run + 1, (t4 - t0).as_secs_f64());
+    }
+    println!("{info}");
+    println!(
+        "median of {} runs (wall, release, rayon on every core):",
+        args.repeats.max(1)
+    );
+    let mut md = format!("{info}\n\n| step | median wall time |\n|---|---|\n");
+    for (k, name) in steps
+        .iter()
+        .chain(std::iter::once(&"whole path"))
+        .enumerate()
+    {
+        let m = median(times[k].clone());
+        println!("  {name:<26} {:>8.1} ms", m.as_secs_f64() * 1e3);
+        md += &format!("| {name} | {:.1} ms |\n", m.as_secs_f64() * 1e3);
+    }
+    std::fs::write(out.join("report.md"), md)?;
+    println!("{}", out.display());
+    Ok(())
+}
