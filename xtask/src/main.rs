@@ -7,6 +7,7 @@ mod landmarks_eval;
 mod paths;
 mod recognition;
 mod robustness;
+mod section6;
 mod sphere_validate;
 
 /// Experiments and evaluations of the bipolar workspace.
@@ -27,6 +28,9 @@ enum Task {
     Recognition(recognition::Args),
     /// Landmark detection accuracy on sampled faces.
     LandmarksEval(landmarks_eval::Args),
+    /// The paper's section 6: bipolar, single pole, facial curves and iso-curvature curves
+    /// side by side.
+    Section6(section6::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -36,5 +40,6 @@ fn main() -> anyhow::Result<()> {
         Task::Robustness(args) => robustness::run(args),
         Task::Recognition(args) => recognition::run(args),
         Task::LandmarksEval(args) => landmarks_eval::run(args),
+        Task::Section6(args) => section6::run(args),
     }
 }
