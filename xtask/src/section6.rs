@@ -28,8 +28,8 @@ use crate::robustness::stats::{max, mean, Sep};
 use anyhow::{bail, Context, Result};
 use facecurves::{
     describe_facial_curves, describe_iso_curvature, elastic_distance, facial_curves_distance,
-    iso_curvature_distance, Aggregate, ElasticOptions, FacialCurvesDescriptor,
-    FacialCurvesOptions, IsoCurvatureDescriptor, IsoCurvatureOptions, IsoLevels, PrincipalField,
+    iso_curvature_distance, Aggregate, ElasticOptions, FacialCurvesDescriptor, FacialCurvesOptions,
+    IsoCurvatureDescriptor, IsoCurvatureOptions, IsoLevels, PrincipalField,
 };
 use facemodel::{face_frame, load_face_set, Face};
 use geodesic::{GeodesicSolver, Method, Source};
@@ -64,7 +64,11 @@ pub struct Args {
     #[arg(long = "iso-levels", default_value_t = 6)]
     pub iso_levels: usize,
     /// Standard deviations of the depth noise, mm (comma separated).
-    #[arg(long = "noise-mm", value_delimiter = ',', default_value = "0.05,0.1,0.2")]
+    #[arg(
+        long = "noise-mm",
+        value_delimiter = ',',
+        default_value = "0.05,0.1,0.2"
+    )]
     pub noise_mm: Vec<f64>,
     /// Noisy copies per standard deviation.
     #[arg(long = "noise-draws", default_value_t = 3)]
@@ -127,7 +131,11 @@ struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
-    fn ok<T, E: std::fmt::Display>(&self, r: Result<T, E>, what: impl FnOnce() -> String) -> Option<T> {
+    fn ok<T, E: std::fmt::Display>(
+        &self,
+        r: Result<T, E>,
+        what: impl FnOnce() -> String,
+    ) -> Option<T> {
         match r {
             Ok(x) => Some(x),
             Err(e) => {
@@ -209,7 +217,8 @@ impl Ctx<'_> {
         t[1] = t0.elapsed();
         if let (Some(x), Some(y)) = (&a.facial, &b.facial) {
             let t0 = Instant::now();
-            let r = facial_curves_distance(x, y, Aggregate::RootSumSquare, &ElasticOptions::default());
+            let r =
+                facial_curves_distance(x, y, Aggregate::RootSumSquare, &ElasticOptions::default());
             t[2] = t0.elapsed();
             d[2] = self
                 .ok(r, || format!("facial distance {what}"))
@@ -283,9 +292,17 @@ pub fn run(args: Args) -> Result<()> {
         .iter()
         .position(|f| f.name == "id1_neutral")
         .unwrap_or(0);
-    let out = args.out.clone().unwrap_or_else(|| default_out_dir("section6"));
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| default_out_dir("section6"));
     let mut rep = Report::new(&out, "Section 6: the four representations side by side")?;
-    eprintln!("{} faces from {}; test face {}", faces.len(), dir.display(), faces[test].name);
+    eprintln!(
+        "{} faces from {}; test face {}",
+        faces.len(),
+        dir.display(),
+        faces[test].name
+    );
     let walkers: Vec<Walker<'_>> = faces.par_iter().map(|f| Walker::new(&f.mesh)).collect();
     let pb = bar(faces.len(), "geodesic fields");
     let preps: Vec<Prep> = faces
@@ -329,7 +346,14 @@ pub fn run(args: Args) -> Result<()> {
         .zip(&preps)
         .zip(&walkers)
         .map(|((f, p), w)| {
-            let d = ctx.describe(&f.mesh, w, &p.refs, &p.un, Pole::Vertex(f.landmarks.nose_tip), &f.name);
+            let d = ctx.describe(
+                &f.mesh,
+                w,
+                &p.refs,
+                &p.un,
+                Pole::Vertex(f.landmarks.nose_tip),
+                &f.name,
+            );
             pb.inc(1);
             d
         })
@@ -341,12 +365,18 @@ pub fn run(args: Args) -> Result<()> {
 
     // Between persons: the 12 x 12 matrices.
     let nf = faces.len();
-    let pairs: Vec<(usize, usize)> = (0..nf).flat_map(|i| (i + 1..nf).map(move |j| (i, j))).collect();
+    let pairs: Vec<(usize, usize)> = (0..nf)
+        .flat_map(|i| (i + 1..nf).map(move |j| (i, j)))
+        .collect();
     let pb = bar(pairs.len(), "12 x 12 matrices");
     let cells: Vec<([f64; 4], [Duration; 4])> = pairs
         .par_iter()
         .map(|&(i, j)| {
-            let r = ctx.distances(&base[i], &base[j], &format!("{} vs {}", faces[i].name, faces[j].name));
+            let r = ctx.distances(
+                &base[i],
+                &base[j],
+                &format!("{} vs {}", faces[i].name, faces[j].name),
+            );
             pb.inc(1);
             r
         })
@@ -368,7 +398,9 @@ pub fn run(args: Args) -> Result<()> {
     // Reference-point errors.
     let grid_cells: Vec<(f64, f64)> = RADII_PCT
         .iter()
-        .flat_map(|&p| (0..N_DIRS).map(move |k| (p, std::f64::consts::TAU * k as f64 / N_DIRS as f64)))
+        .flat_map(|&p| {
+            (0..N_DIRS).map(move |k| (p, std::f64::consts::TAU * k as f64 / N_DIRS as f64))
+        })
         .collect();
     let pb = bar(grid_cells.len(), "reference-point grid");
     let w = &walkers[test];
@@ -396,13 +428,19 @@ pub fn run(args: Args) -> Result<()> {
             // Nose tip moved: the other three (same D, the corners are not moved).
             let (sn, cut_n) = perturb(w, lm.nose_tip, eye_mid, radius, theta)?;
             let un = field(tp.solver.as_ref(), Source::Point(sn))?;
-            let moved_q = ctx.describe(&tf.mesh, w, &refs, &tp.un, Pole::Vertex(lm.nose_tip), &name);
+            let moved_q =
+                ctx.describe(&tf.mesh, w, &refs, &tp.un, Pole::Vertex(lm.nose_tip), &name);
             let moved_n = ctx.describe(&tf.mesh, w, &tp.refs, &un, Pole::Point(sn), &name);
             let (dq, _) = ctx.distances(&base[test], &moved_q, &name);
             let (dn, _) = ctx.distances(&base[test], &moved_n, &name);
             pb.inc(1);
             let nan_if = |cut: bool, v: f64| if cut { f64::NAN } else { v };
-            Ok([nan_if(cut_q, dq[0]), nan_if(cut_n, dn[1]), nan_if(cut_n, dn[2]), nan_if(cut_n, dn[3])])
+            Ok([
+                nan_if(cut_q, dq[0]),
+                nan_if(cut_n, dn[1]),
+                nan_if(cut_n, dn[2]),
+                nan_if(cut_n, dn[3]),
+            ])
         })
         .collect::<Result<_>>()?;
     pb.finish();
@@ -420,7 +458,8 @@ pub fn run(args: Args) -> Result<()> {
     let noise: Vec<[f64; 4]> = noise_cells
         .par_iter()
         .map(|&(sigma_mm, k)| -> Result<[f64; 4]> {
-            let seed = args.seed ^ (k as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ sigma_mm.to_bits();
+            let seed =
+                args.seed ^ (k as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ sigma_mm.to_bits();
             let m = noisy(&tf.mesh, sigma_mm / mm, seed)?;
             let noisy_face = Face {
                 mesh: m,
@@ -429,7 +468,14 @@ pub fn run(args: Args) -> Result<()> {
             let p = prepare(&noisy_face)?;
             let wn = Walker::new(&noisy_face.mesh);
             let name = format!("{} with {sigma_mm} mm noise, draw {k}", tf.name);
-            let dsc = ctx.describe(&noisy_face.mesh, &wn, &p.refs, &p.un, Pole::Vertex(lm.nose_tip), &name);
+            let dsc = ctx.describe(
+                &noisy_face.mesh,
+                &wn,
+                &p.refs,
+                &p.un,
+                Pole::Vertex(lm.nose_tip),
+                &name,
+            );
             let (d, _) = ctx.distances(&base[test], &dsc, &name);
             pb.inc(1);
             Ok(d)
@@ -438,12 +484,35 @@ pub fn run(args: Args) -> Result<()> {
     pb.finish();
 
     // Figure 15: polar rings rotated, scored by each distance.
-    let other = (0..nf).filter(|&j| faces[j].person != tf.person).min_by(|&a, &b| {
-        mats[1][test][a].total_cmp(&mats[1][test][b])
-    });
-    let fig15 = figure15(&base[test].polar, other.map(|j| &base[j].polar), args.seed, args.levels)?;
+    let other = (0..nf)
+        .filter(|&j| faces[j].person != tf.person)
+        .min_by(|&a, &b| mats[1][test][a].total_cmp(&mats[1][test][b]));
+    let fig15 = figure15(
+        &base[test].polar,
+        other.map(|j| &base[j].polar),
+        args.seed,
+        args.levels,
+    )?;
 
-    write_report(&mut rep, &args, &faces, test, &mats, &seps, &scale, &times, pairs.len(), &grid_cells, &grid, &noise_cells, &noise, &fig15, mm, &failures.sorted(), t_start)?;
+    write_report(
+        &mut rep,
+        &args,
+        &faces,
+        test,
+        &mats,
+        &seps,
+        &scale,
+        &times,
+        pairs.len(),
+        &grid_cells,
+        &grid,
+        &noise_cells,
+        &noise,
+        &fig15,
+        mm,
+        &failures.sorted(),
+        t_start,
+    )?;
     let n_png = rep.png_twins()?;
     let path = rep.finish()?;
     eprintln!("{n_png} PNG twins; report {}", path.display());
@@ -489,9 +558,21 @@ fn figure15(s: &KeyedPoints, other: Option<&KeyedPoints>, seed: u64, levels: u32
             .map_or(f64::NAN, |d| d.stats.rms_normalised)
     };
     Ok(vec![
-        ("keyed L2 (bipolar, single pole)", dist(s, &s1).unwrap_or(f64::NAN), dist(s, &o).unwrap_or(f64::NAN)),
-        ("elastic, root sum of squares over rings (facial curves)", ring_elastic(s, &s1, levels)?, ring_elastic(s, &o, levels)?),
-        ("ICP closest points (iso-curvature)", icp(s, &s1), icp(s, &o)),
+        (
+            "keyed L2 (bipolar, single pole)",
+            dist(s, &s1).unwrap_or(f64::NAN),
+            dist(s, &o).unwrap_or(f64::NAN),
+        ),
+        (
+            "elastic, root sum of squares over rings (facial curves)",
+            ring_elastic(s, &s1, levels)?,
+            ring_elastic(s, &o, levels)?,
+        ),
+        (
+            "ICP closest points (iso-curvature)",
+            icp(s, &s1),
+            icp(s, &o),
+        ),
     ])
 }
 
@@ -521,7 +602,11 @@ fn renders(out: &Path, face: &Face, d: &Descs) -> Result<()> {
             .map(|c| Polyline {
                 points: c.points.clone(),
                 closed: c.closed,
-                color: if c.field == PrincipalField::K1 { RED } else { BLUE },
+                color: if c.field == PrincipalField::K1 {
+                    RED
+                } else {
+                    BLUE
+                },
                 width: 1.4,
             })
             .collect();
@@ -587,8 +672,14 @@ fn write_report(
         args.seed,
         t_start.elapsed().as_secs_f64()
     ));
-    rep.figure("iso_curvature.svg", "Iso-curvature network of the test face (k1 red, k2 blue), figure 14 style");
-    rep.figure("facial_curves.svg", "Facial curves of the test face (longest piece of each level)");
+    rep.figure(
+        "iso_curvature.svg",
+        "Iso-curvature network of the test face (k1 red, k2 blue), figure 14 style",
+    );
+    rep.figure(
+        "facial_curves.svg",
+        "Facial curves of the test face (longest piece of each level)",
+    );
 
     rep.heading(2, "Between persons (12 x 12 matrices)");
     let mut rows = Vec::new();
@@ -606,14 +697,27 @@ fn write_report(
         ]);
     }
     rep.table(
-        &["representation", "max same person", "min other person", "ratio", "test row: max same", "test row: min other", "ratio", "ms per comparison"],
+        &[
+            "representation",
+            "max same person",
+            "min other person",
+            "ratio",
+            "test row: max same",
+            "test row: min other",
+            "ratio",
+            "ms per comparison",
+        ],
         &rows,
     );
     for (k, m) in mats.iter().enumerate() {
         let name = format!("matrix_{}.csv", REPS[k].replace(' ', "_"));
         let mut header = vec!["face"];
         header.extend(faces.iter().map(|f| f.name.as_str()));
-        rep.csv(&name, &header, &crate::robustness::stats::matrix_rows(faces, m))?;
+        rep.csv(
+            &name,
+            &header,
+            &crate::robustness::stats::matrix_rows(faces, m),
+        )?;
     }
     rep.para("Times are wall-clock per comparison, summed over the pairs computed in parallel on the shared machine (an upper bound of the single-thread cost; compare them as ratios).");
 
@@ -622,7 +726,9 @@ fn write_report(
     let mut rows = Vec::new();
     let mut csv = Vec::new();
     for &pct in &RADII_PCT {
-        let idx: Vec<usize> = (0..grid_cells.len()).filter(|&i| grid_cells[i].0 == pct).collect();
+        let idx: Vec<usize> = (0..grid_cells.len())
+            .filter(|&i| grid_cells[i].0 == pct)
+            .collect();
         let mut row = vec![format!("{pct} %")];
         for k in 0..4 {
             let v: Vec<f64> = idx.iter().map(|&i| grid[i][k]).collect();
@@ -636,13 +742,33 @@ fn write_report(
         all.push(format!("{} ({:.2})", fmt(max(&v)), max(&v) / scale[k]));
     }
     rows.push(all);
-    rep.table(&["radius (% of D)", "bipolar mean (rel.)", "single pole (rel.)", "facial curves (rel.)", "iso-curvature (rel.)"], &rows);
+    rep.table(
+        &[
+            "radius (% of D)",
+            "bipolar mean (rel.)",
+            "single pole (rel.)",
+            "facial curves (rel.)",
+            "iso-curvature (rel.)",
+        ],
+        &rows,
+    );
     for (c, g) in grid_cells.iter().zip(grid) {
         let mut r = vec![format!("{}", c.0), format!("{:.1}", c.1.to_degrees())];
         r.extend(g.iter().map(|v| format!("{v}")));
         csv.push(r);
     }
-    rep.csv("grid.csv", &["radius_pct", "angle_deg", "bipolar", "single_pole", "facial", "iso_curvature"], &csv)?;
+    rep.csv(
+        "grid.csv",
+        &[
+            "radius_pct",
+            "angle_deg",
+            "bipolar",
+            "single_pole",
+            "facial",
+            "iso_curvature",
+        ],
+        &csv,
+    )?;
 
     rep.heading(2, "Depth noise on the test face");
     rep.para(&format!(
@@ -652,7 +778,9 @@ fn write_report(
     let mut rows = Vec::new();
     let mut csv = Vec::new();
     for &s in &args.noise_mm {
-        let idx: Vec<usize> = (0..noise_cells.len()).filter(|&i| noise_cells[i].0 == s).collect();
+        let idx: Vec<usize> = (0..noise_cells.len())
+            .filter(|&i| noise_cells[i].0 == s)
+            .collect();
         let mut row = vec![format!("{s} mm")];
         for k in 0..4 {
             let v: Vec<f64> = idx.iter().map(|&i| noise[i][k]).collect();
@@ -665,8 +793,28 @@ fn write_report(
         r.extend(d.iter().map(|v| format!("{v}")));
         csv.push(r);
     }
-    rep.table(&["sigma", "bipolar mean (rel.)", "single pole (rel.)", "facial curves (rel.)", "iso-curvature (rel.)"], &rows);
-    rep.csv("noise.csv", &["sigma_mm", "draw", "bipolar", "single_pole", "facial", "iso_curvature"], &csv)?;
+    rep.table(
+        &[
+            "sigma",
+            "bipolar mean (rel.)",
+            "single pole (rel.)",
+            "facial curves (rel.)",
+            "iso-curvature (rel.)",
+        ],
+        &rows,
+    );
+    rep.csv(
+        "noise.csv",
+        &[
+            "sigma_mm",
+            "draw",
+            "bipolar",
+            "single_pole",
+            "facial",
+            "iso_curvature",
+        ],
+        &csv,
+    )?;
 
     rep.heading(2, "Figure 15: polar rings rotated one by one");
     rep.para(&format!(
@@ -676,7 +824,10 @@ fn write_report(
         .iter()
         .map(|(n, r, o)| vec![n.to_string(), fmt(*r), fmt(*o), format!("{:.3}", r / o)])
         .collect();
-    rep.table(&["distance", "rotated rings", "other person", "ratio"], &rows);
+    rep.table(
+        &["distance", "rotated rings", "other person", "ratio"],
+        &rows,
+    );
 
     rep.heading(2, "The paper's section-6 claims against these numbers");
     let noise_rel = |k: usize| {
@@ -715,8 +866,17 @@ fn write_report(
     ));
     if !failures.is_empty() {
         rep.heading(2, "Crate errors");
-        rep.para(&format!("{} descriptors or distances refused (their cells are NaN):", failures.len()));
-        rep.para(&failures.iter().map(|f| format!("- {f}")).collect::<Vec<_>>().join("\n"));
+        rep.para(&format!(
+            "{} descriptors or distances refused (their cells are NaN):",
+            failures.len()
+        ));
+        rep.para(
+            &failures
+                .iter()
+                .map(|f| format!("- {f}"))
+                .collect::<Vec<_>>()
+                .join("\n"),
+        );
     }
     Ok(())
 }
