@@ -199,6 +199,77 @@ def describe_polar(
 ) -> PolarDescriptor: ...
 def polar_distance(a: PolarDescriptor, b: PolarDescriptor) -> float: ...
 def unpack_polar_key(key: int) -> Tuple[int, int]: ...
+
+class FacialCurves:
+    """Facial curves: one level curve of the geodesic distance from the nose tip per level
+    (``curves``: dicts with ``level``, ``closed``, ``pieces``, ``points`` (k, 3))."""
+
+    @property
+    def curves(self) -> List[Dict[str, Any]]: ...
+    @property
+    def step(self) -> float: ...
+    @property
+    def n_levels(self) -> int: ...
+    def __len__(self) -> int: ...
+
+class IsoCurvatureCurves:
+    """Iso-curvature network: level curves of the principal curvatures (``curves``: dicts with
+    ``field`` ("k1" or "k2"), ``level``, ``closed``, ``points`` (k, 3))."""
+
+    @property
+    def curves(self) -> List[Dict[str, Any]]: ...
+    @property
+    def levels_k1(self) -> List[float]: ...
+    @property
+    def levels_k2(self) -> List[float]: ...
+    @property
+    def k1(self) -> F64: ...
+    @property
+    def k2(self) -> F64: ...
+    def __len__(self) -> int: ...
+
+def facial_curves(
+    mesh: Union[Mesh, PathLike],
+    nose: Reference,
+    *,
+    radius: float,
+    levels: int = 8,
+    method: MethodName = "exact",
+    landmarks: Optional[Union[PathLike, Dict[str, ArrayLike]]] = None,
+    solver: Optional[GeodesicSolver] = None,
+) -> FacialCurves: ...
+def iso_curvature_curves(
+    mesh: Union[Mesh, PathLike],
+    *,
+    levels: int = 6,
+    k1_levels: Optional[ArrayLike] = None,
+    k2_levels: Optional[ArrayLike] = None,
+    centre: Optional[Reference] = None,
+    radius: Optional[float] = None,
+    curvature_radius: float = 3.0,
+    method: MethodName = "exact",
+    landmarks: Optional[Union[PathLike, Dict[str, ArrayLike]]] = None,
+    solver: Optional[GeodesicSolver] = None,
+) -> IsoCurvatureCurves: ...
+def facial_curves_distance(
+    a: FacialCurves,
+    b: FacialCurves,
+    *,
+    aggregate: Literal["rss", "root-sum-square", "sum"] = "rss",
+    samples: int = 100,
+    scale: bool = False,
+) -> float: ...
+def iso_curvature_distance(a: IsoCurvatureCurves, b: IsoCurvatureCurves) -> float: ...
+def elastic_distance(
+    a: ArrayLike,
+    b: ArrayLike,
+    *,
+    a_closed: bool = False,
+    b_closed: bool = False,
+    samples: int = 100,
+    scale: bool = False,
+    resampling: Literal["arc-length", "arclength", "parameter"] = "arc-length",
+) -> float: ...
 def pack_key(a: int, b: int, i: int, j: int, side: int, sign: int) -> int: ...
 def unpack_key(key: int) -> Tuple[int, int, int, int, int, int]: ...
 

@@ -9,6 +9,7 @@ mod recognition;
 mod robustness;
 mod scan_study;
 mod scan_path;
+mod section6;
 mod sphere_validate;
 
 /// Experiments and evaluations of the bipolar workspace.
@@ -27,6 +28,9 @@ enum Task {
     ScanStudy(scan_study::Args),
     /// Wall time of each step of the path of one range scan (read, clean, detect, describe).
     ScanPath(scan_path::Args),
+    /// The paper's section 6: bipolar, single pole, facial curves and iso-curvature curves
+    /// side by side.
+    Section6(section6::Args),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -37,5 +41,6 @@ fn main() -> anyhow::Result<()> {
         Task::LandmarksEval(args) => landmarks_eval::run(args),
         Task::ScanStudy(args) => scan_study::run(args),
         Task::ScanPath(args) => scan_path::run(args),
+        Task::Section6(args) => section6::run(args),
     }
 }

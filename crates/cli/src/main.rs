@@ -5,6 +5,7 @@ use clap::{Parser, Subcommand};
 mod choice;
 mod cmd_clean;
 mod cmd_convert;
+mod cmd_curves;
 mod cmd_describe;
 mod cmd_distance;
 mod cmd_geodesic;
@@ -46,6 +47,10 @@ enum Command {
     Scan(cmd_scan::Args),
     /// Prepare a scan: spikes, outliers, small holes, crop, smoothing, decimation; units.
     Clean(cmd_clean::Args),
+    /// Curve representations of the paper's section 6: iso-curvature or facial curves (JSON).
+    Curves(cmd_curves::Args),
+    /// Distance between two curve files (elastic for facial curves, ICP for iso-curvature).
+    CurveDistance(cmd_curves::DistanceArgs),
 }
 
 fn main() -> std::process::ExitCode {
@@ -61,6 +66,8 @@ fn main() -> std::process::ExitCode {
         Command::Landmarks(a) => cmd_landmarks::run(a),
         Command::Scan(a) => cmd_scan::run(a),
         Command::Clean(a) => cmd_clean::run(a),
+        Command::Curves(a) => cmd_curves::run(a),
+        Command::CurveDistance(a) => cmd_curves::run_distance(a),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -204,3 +204,18 @@ pub fn scanprep(e: scanprep::ScanPrepError) -> PyErr {
         other => err(Kind::Input, chain(&other)),
     }
 }
+
+/// `facecurves::FaceCurvesError`.
+pub fn facecurves(e: facecurves::FaceCurvesError) -> PyErr {
+    use facecurves::FaceCurvesError as E;
+    let kind = match &e {
+        E::Mesh(m) => return mesh(m.clone()),
+        E::Geodesic(g) => geodesic_kind(g),
+        E::ShapeDist(_) => Kind::Input,
+        E::Io { .. } => Kind::File,
+        E::File { .. } => Kind::Format,
+        E::NoCurves(_) | E::NoSharedCurves { .. } => Kind::NoPoints,
+        _ => Kind::Input,
+    };
+    err(kind, chain(&e))
+}

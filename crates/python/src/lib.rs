@@ -8,6 +8,7 @@
 //! for type, dtype, shape and index range here, values by the libraries.
 
 mod convert;
+mod curves;
 mod describe;
 mod descriptor;
 mod distance;
@@ -29,6 +30,8 @@ fn _bipolar(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<descriptor::PyDescriptor>()?;
     m.add_class::<distance::PyDistanceOptions>()?;
     m.add_class::<polar::PyPolarDescriptor>()?;
+    m.add_class::<curves::PyFacialCurves>()?;
+    m.add_class::<curves::PyIsoCurvatureCurves>()?;
     m.add_function(wrap_pyfunction!(mesh::read_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::read_mesh_bytes, m)?)?;
     m.add_function(wrap_pyfunction!(mesh::write_mesh, m)?)?;
@@ -59,5 +62,10 @@ fn _bipolar(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(landmark::detect_landmarks, m)?)?;
     m.add_function(wrap_pyfunction!(scan::scan, m)?)?;
     m.add_function(wrap_pyfunction!(scan::clean, m)?)?;
+    m.add_function(wrap_pyfunction!(curves::facial_curves, m)?)?;
+    m.add_function(wrap_pyfunction!(curves::iso_curvature_curves, m)?)?;
+    m.add_function(wrap_pyfunction!(curves::facial_curves_distance, m)?)?;
+    m.add_function(wrap_pyfunction!(curves::iso_curvature_distance, m)?)?;
+    m.add_function(wrap_pyfunction!(curves::elastic_distance, m)?)?;
     Ok(())
 }

@@ -11,10 +11,10 @@
 
 mod base;
 mod grid;
-mod pole;
+pub(crate) mod pole;
 mod random;
 mod report;
-mod stats;
+pub(crate) mod stats;
 
 use crate::experiments::pipeline::{
     bipolar, dist, field, resolve_methods, DescriptorRule, Refs, Region,

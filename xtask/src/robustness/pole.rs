@@ -19,7 +19,7 @@ use std::path::Path;
 use viz::Scene;
 
 /// The rings rotated.
-const ROTATED: [u32; 3] = [2, 4, 6];
+pub(crate) const ROTATED: [u32; 3] = [2, 4, 6];
 
 /// Figure-15 numbers.
 pub(super) struct Figure15 {
@@ -63,7 +63,7 @@ fn describe(
 }
 
 /// `s` with rings [`ROTATED`] each rotated about its centroid by a seeded random rotation.
-fn rotate_rings(s: &PolarDescriptor, seed: u64) -> PolarDescriptor {
+pub(crate) fn rotate_rings(s: &PolarDescriptor, seed: u64) -> PolarDescriptor {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut s1 = s.clone();
     for &lvl in &ROTATED {

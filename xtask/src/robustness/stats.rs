@@ -5,7 +5,7 @@ use facemodel::Face;
 
 /// Separation figures of a distance matrix.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Sep {
+pub(crate) struct Sep {
     pub max_same: f64,
     pub min_diff: f64,
     pub row_max_same: f64,
@@ -13,7 +13,7 @@ pub(super) struct Sep {
 }
 
 impl Sep {
-    pub(super) fn of(m: &[Vec<f64>], faces: &[Face], test: usize) -> Self {
+    pub(crate) fn of(m: &[Vec<f64>], faces: &[Face], test: usize) -> Self {
         let mut s = Sep {
             max_same: 0.0,
             min_diff: f64::INFINITY,
@@ -38,20 +38,20 @@ impl Sep {
         }
         s
     }
-    pub(super) fn ratio(&self) -> f64 {
+    pub(crate) fn ratio(&self) -> f64 {
         self.min_diff / self.max_same
     }
-    pub(super) fn row_ratio(&self) -> f64 {
+    pub(crate) fn row_ratio(&self) -> f64 {
         self.row_min_diff / self.row_max_same
     }
-    pub(super) fn verdict(&self) -> &'static str {
+    pub(crate) fn verdict(&self) -> &'static str {
         if self.ratio() > 1.0 {
             "separated"
         } else {
             "NOT separated"
         }
     }
-    pub(super) fn row_verdict(&self) -> &'static str {
+    pub(crate) fn row_verdict(&self) -> &'static str {
         if self.row_ratio() > 1.0 {
             "separated"
         } else {
@@ -116,11 +116,11 @@ impl SepColumn {
 }
 
 /// The finite values of `v`, in order.
-pub(super) fn finite(v: &[f64]) -> Vec<f64> {
+pub(crate) fn finite(v: &[f64]) -> Vec<f64> {
     v.iter().copied().filter(|x| x.is_finite()).collect()
 }
 /// Mean of the finite values (NaN if none).
-pub(super) fn mean(v: &[f64]) -> f64 {
+pub(crate) fn mean(v: &[f64]) -> f64 {
     let f = finite(v);
     if f.is_empty() {
         f64::NAN
@@ -129,15 +129,15 @@ pub(super) fn mean(v: &[f64]) -> f64 {
     }
 }
 /// Max of the finite values (NaN if none).
-pub(super) fn max(v: &[f64]) -> f64 {
+pub(crate) fn max(v: &[f64]) -> f64 {
     finite(v).into_iter().reduce(f64::max).unwrap_or(f64::NAN)
 }
 /// Min of the finite values (NaN if none).
-pub(super) fn min(v: &[f64]) -> f64 {
+pub(crate) fn min(v: &[f64]) -> f64 {
     finite(v).into_iter().reduce(f64::min).unwrap_or(f64::NAN)
 }
 
-pub(super) fn matrix_rows(faces: &[Face], m: &[Vec<f64>]) -> Vec<Vec<String>> {
+pub(crate) fn matrix_rows(faces: &[Face], m: &[Vec<f64>]) -> Vec<Vec<String>> {
     faces
         .iter()
         .zip(m)
