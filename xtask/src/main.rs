@@ -7,8 +7,8 @@ mod landmarks_eval;
 mod paths;
 mod recognition;
 mod robustness;
-mod scan_study;
 mod scan_path;
+mod scan_study;
 mod section6;
 mod sphere_validate;
 

@@ -606,7 +606,7 @@ fn write_outputs(
                 let _ = writeln!(
                     csv,
                     "{},{:.2},\"{}\"",
-                    d.polar.len(),
+                    d.polar.points.len(),
                     d.seconds,
                     d.notes.join("; ").replace('"', "'")
                 );
@@ -827,7 +827,7 @@ fn write_outputs(
             .collect();
         let col = |f: &dyn Fn(&Described) -> f64| -> Vec<f64> { ds.iter().map(|d| f(d)).collect() };
         let (_, edge, _, _) = quantiles(&col(&|d| d.mean_edge_mm));
-        let (_, pp, _, _) = quantiles(&col(&|d| d.polar.len() as f64));
+        let (_, pp, _, _) = quantiles(&col(&|d| d.polar.points.len() as f64));
         let mut cells = Vec::new();
         let _ = write!(csv, "{}", s.name);
         for k in 0..VARIANTS.len() {

@@ -15,7 +15,6 @@
 //! other person), so the four distances, on different scales, can be compared. The report
 //! states for each claim of section 6 whether the numbers support it.
 
-use bipolar::PolarDescriptor;
 use crate::experiments::pipeline::{
     bar, bipolar, dist, field, field_at, perturb, DescriptorRule, Refs, Region,
 };
@@ -26,6 +25,7 @@ use crate::paths::{default_out_dir, default_paper_set};
 use crate::robustness::pole::{rotate_rings, ROTATED};
 use crate::robustness::stats::{max, mean, Sep};
 use anyhow::{bail, Context, Result};
+use bipolar::PolarDescriptor;
 use facecurves::{
     describe_facial_curves, describe_iso_curvature, elastic_distance, facial_curves_distance,
     iso_curvature_distance, Aggregate, ElasticOptions, FacialCurvesDescriptor, FacialCurvesOptions,
@@ -163,22 +163,17 @@ impl Ctx<'_> {
             bipolar(mesh, refs, n, Region::Static, DescriptorRule::CrateAll),
             || format!("bipolar descriptor of {name}"),
         );
+        let popts = PolarOptions {
+            step,
+            levels: n,
+            sectors: self.args.sectors,
+        };
         let polar = self
             .ok(
-                polar_descriptor(
-                    walker,
-                    un,
-                    nose,
-                    0.5 * (refs.r + refs.q),
-                    &PolarOptions {
-                        step,
-                        levels: n,
-                        sectors: self.args.sectors,
-                    },
-                ),
+                polar_descriptor(walker, un, nose, 0.5 * (refs.r + refs.q), &popts),
                 || format!("single pole of {name}"),
             )
-            .unwrap_or_default();
+            .unwrap_or_else(|| polar::empty(&popts));
         let surface = Surface::new(mesh.clone());
         let facial = self.ok(
             describe_facial_curves(&surface, un, &FacialCurvesOptions { step, levels: n }),
@@ -552,7 +547,12 @@ fn ring_elastic(a: &PolarDescriptor, b: &PolarDescriptor, levels: u32) -> Result
     Ok(s2.sqrt())
 }
 
-fn figure15(s: &PolarDescriptor, other: Option<&PolarDescriptor>, seed: u64, levels: u32) -> Result<Fig15> {
+fn figure15(
+    s: &PolarDescriptor,
+    other: Option<&PolarDescriptor>,
+    seed: u64,
+    levels: u32,
+) -> Result<Fig15> {
     let s1 = rotate_rings(s, seed);
     let o = other.cloned().unwrap_or_else(|| polar::empty(&s.options));
     let icp = |a: &PolarDescriptor, b: &PolarDescriptor| -> f64 {

@@ -460,8 +460,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             )?;
         }
     }
-    // Against mesh resolution (icospheres), N = 8.
-    let by_edge: [(&str, &str, &str, &str, fn(&Row) -> (f64, f64)); 2] = [
+    // Against mesh resolution (icospheres), N = 8: file, title, y label, rule, (x, y) of a row.
+    type EdgePlot = (
+        &'static str,
+        &'static str,
+        &'static str,
+        &'static str,
+        fn(&Row) -> (f64, f64),
+    );
+    let by_edge: [EdgePlot; 2] = [
         (
             "distance_vs_edge_isoangle_N8.svg",
             "Shape distance vs mesh resolution (icospheres, N = 8, iso-angle)",

@@ -418,9 +418,9 @@ fn vertex_renumbering_does_not_change_the_descriptor() {
     let m2 = TriMesh::new(pos, tris).unwrap();
     let t2 = Surface::new(m2.clone());
     let mut f2 = vec![vec![0.0; n]; 2];
-    for k in 0..2 {
+    for (f2k, fk) in f2.iter_mut().zip(&plane.fields) {
         for v in 0..n {
-            f2[k][perm[v] as usize] = plane.fields[k][v];
+            f2k[perm[v] as usize] = fk[v];
         }
     }
     let refs2: Vec<Source> = plane

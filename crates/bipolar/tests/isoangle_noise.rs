@@ -213,7 +213,7 @@ fn monotone_equals_every_crossing_where_the_opening_is_monotone() {
     ];
     let fields: Vec<Vec<f64>> = refs
         .iter()
-        .map(|&v| bipolar::synthetic::euclidean_field(&m, m.position(v)))
+        .map(|&v| testsupport::fields::euclidean(&m, m.position(v)))
         .collect();
     let every = describe_with(&m, &fields, refs, &iso(IsoCrossings::Every, 5));
     let mono = describe_with(&m, &fields, refs, &iso(IsoCrossings::Monotone, 5));

@@ -107,7 +107,8 @@ fn landmark_names_from_a_file_work_in_describe_render_and_geodesic() {
     // describe: the file's names give the same descriptor as the coordinates; geodesic: a
     // landmark source equals the same point given as coordinates. (names, coordinates, the
     // common arguments, the two outputs).
-    let pairs: [(&[&str], &[&str], &[&str], [&Path; 2]); 2] = [
+    type Case<'a> = (&'a [&'a str], &'a [&'a str], &'a [&'a str], [&'a Path; 2]);
+    let pairs: [Case; 2] = [
         (
             &[
                 "--landmarks",

@@ -62,7 +62,7 @@ fn detections_follow_rigid_motions_and_match_the_truth() {
     let truth = ict_truth(&dir);
     let model = GenericModel::default_model().unwrap();
     for name in ["id2_neutral", "id1_happiness"] {
-        let mesh = read_mesh(&dir.join(format!("{name}.obj")));
+        let mesh = read_mesh(dir.join(format!("{name}.obj")));
         let gt = truth[name];
         let base = detect(&mesh, &model).unwrap();
         for (k, t) in motions().iter().enumerate() {
@@ -90,7 +90,7 @@ fn small_evaluation_on_the_paper_set() {
     let train: Vec<(TriMesh, [DVec3; 5])> = (2..=6)
         .map(|i| {
             let n = format!("id{i}_neutral");
-            (read_mesh(&dir.join(format!("{n}.obj"))), truth[&n])
+            (read_mesh(dir.join(format!("{n}.obj"))), truth[&n])
         })
         .collect();
     let model = GenericModel::train(&train).unwrap();
@@ -99,7 +99,7 @@ fn small_evaluation_on_the_paper_set() {
         .iter()
         .enumerate()
     {
-        let mesh = read_mesh(&dir.join(format!("{name}.obj")));
+        let mesh = read_mesh(dir.join(format!("{name}.obj")));
         let t = motions()[k];
         let lm = detect(&mesh.transformed(&t), &model).unwrap();
         for n in LandmarkName::ALL {
@@ -123,7 +123,7 @@ fn small_evaluation_on_the_paper_set() {
 fn face_seen_from_behind_is_not_found() {
     let Some(dir) = paper_set() else { return };
     let model = GenericModel::default_model().unwrap();
-    let mesh = flipped(&read_mesh(&dir.join("id3_neutral.obj")));
+    let mesh = flipped(&read_mesh(dir.join("id3_neutral.obj")));
     for t in motions() {
         match detect(&mesh.transformed(&t), &model) {
             Err(LandmarkError::NotFound { best_score, .. }) => assert!(best_score < 0.3),
@@ -171,7 +171,7 @@ fn non_faces_are_not_found() {
 fn units_are_recognised_from_the_face_size() {
     let Some(dir) = paper_set() else { return };
     let model = GenericModel::default_model().unwrap();
-    let mesh = read_mesh(&dir.join("id2_neutral.obj"));
+    let mesh = read_mesh(dir.join("id2_neutral.obj"));
     let cm = detect(&mesh, &model).unwrap();
     for (units, f) in [("mm", 10.0), ("m", 0.01)] {
         let scaled = mesh.transformed(&DAffine3::from_scale(DVec3::splat(f)));
@@ -216,7 +216,7 @@ fn part(m: &TriMesh, keep: impl Fn(DVec3) -> bool) -> TriMesh {
 fn each_verification_rejects_with_its_reason() {
     let Some(dir) = paper_set() else { return };
     let model = GenericModel::default_model().unwrap();
-    let mesh = read_mesh(&dir.join("id2_neutral.obj"));
+    let mesh = read_mesh(dir.join("id2_neutral.obj"));
     let defaults = DetectOptions::default();
     let lm = detect(&mesh, &model).unwrap();
     // A correct detection on a neutral face is mirror-symmetric and agrees with every template.
@@ -265,7 +265,7 @@ fn partial_faces_are_found_right_or_not_at_all() {
     let Some(dir) = paper_set() else { return };
     let truth = ict_truth(&dir);
     let model = GenericModel::default_model().unwrap();
-    let mesh = read_mesh(&dir.join("id4_neutral.obj"));
+    let mesh = read_mesh(dir.join("id4_neutral.obj"));
     let gt = truth["id4_neutral"];
     // Below the eyes (mouth, chin and nose only): there are no eye corners to find.
     let lower = part(&mesh, |p| p.y < 1.5);
@@ -327,7 +327,7 @@ fn regression_places_the_eye_corners_on_the_paper_set() {
     let mut names: Vec<&String> = truth.keys().collect();
     names.sort();
     for name in names {
-        let mesh = read_mesh(&dir.join(format!("{name}.obj")));
+        let mesh = read_mesh(dir.join(format!("{name}.obj")));
         let gt = truth[name.as_str()];
         let a = detect(&mesh, &model).unwrap();
         let b = detect_with(&mesh, &model, &plain).unwrap();
@@ -373,7 +373,7 @@ fn a_landmark_without_surface_is_not_found_with_its_name() {
     let Some(dir) = paper_set() else { return };
     let truth = ict_truth(&dir);
     let model = GenericModel::default_model().unwrap();
-    let mesh = read_obj(&dir.join("id2_neutral.obj"));
+    let mesh = read_mesh(dir.join("id2_neutral.obj"));
     let corner = truth["id2_neutral"][LandmarkName::OuterEyeRight as usize];
     // The whole face is found.
     detect(&mesh, &model).unwrap();
