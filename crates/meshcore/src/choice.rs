@@ -77,7 +77,7 @@ impl std::error::Error for UnknownChoice {}
 ///
 /// ```
 /// #[derive(Debug)]
-/// struct MyError(meshcore::UnknownChoice);
+/// pub struct MyError(meshcore::UnknownChoice);
 /// impl From<meshcore::UnknownChoice> for MyError {
 ///     fn from(e: meshcore::UnknownChoice) -> Self { MyError(e) }
 /// }
@@ -102,7 +102,7 @@ impl std::error::Error for UnknownChoice {}
 /// #[derive(Debug, Clone, Copy, PartialEq)]
 /// enum Shade { Flat, Smooth }
 /// #[derive(Debug)]
-/// struct MyError(meshcore::UnknownChoice);
+/// pub struct MyError(meshcore::UnknownChoice);
 /// impl From<meshcore::UnknownChoice> for MyError {
 ///     fn from(e: meshcore::UnknownChoice) -> Self { MyError(e) }
 /// }
