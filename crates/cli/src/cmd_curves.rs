@@ -104,18 +104,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let nose = resolver.resolve(&args.nose, "--nose")?;
         let solver = geodesic::new_solver(&mesh, args.method)
             .with_context(|| format!("preparing the {} solver", args.method.name()))?;
-        let longest = mesh
-            .triangles()
-            .iter()
-            .flat_map(|t| {
-                let p = t.map(|v| mesh.position(v));
-                [
-                    (p[1] - p[0]).length(),
-                    (p[2] - p[1]).length(),
-                    (p[0] - p[2]).length(),
-                ]
-            })
-            .fold(0.0f64, f64::max);
+        let longest = mesh.longest_edge();
         Some((
             radius,
             solver

@@ -165,18 +165,7 @@ pub fn describe_facial_curves_from(
 ) -> Result<FacialCurvesDescriptor, FaceCurvesError> {
     check_options(options)?;
     let mesh = surface.mesh();
-    let longest = mesh
-        .triangles()
-        .iter()
-        .flat_map(|t| {
-            let p = t.map(|v| mesh.position(v));
-            [
-                (p[1] - p[0]).length(),
-                (p[2] - p[1]).length(),
-                (p[0] - p[2]).length(),
-            ]
-        })
-        .fold(0.0f64, f64::max);
+    let longest = mesh.longest_edge();
     let cutoff = options.step * options.levels as f64 + longest;
     let field = solver.distances(
         &[nose],

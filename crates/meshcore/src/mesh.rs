@@ -209,6 +209,21 @@ impl TriMesh {
         sum / (3 * self.triangles.len()) as f64
     }
 
+    /// Length of the longest triangle edge.
+    pub fn longest_edge(&self) -> f64 {
+        self.triangles
+            .iter()
+            .flat_map(|t| {
+                let p = t.map(|v| self.positions[v as usize]);
+                [
+                    (p[1] - p[0]).length(),
+                    (p[2] - p[1]).length(),
+                    (p[0] - p[2]).length(),
+                ]
+            })
+            .fold(0.0f64, f64::max)
+    }
+
     /// Position of a surface point; an error if the face or the barycentric coordinates are invalid.
     pub fn point_position(&self, p: &SurfacePoint) -> Result<DVec3, MeshError> {
         self.check_surface_point(p)?;
@@ -273,6 +288,11 @@ mod tests {
             vec![[0, 1, 2], [0, 2, 3]],
         )
         .unwrap()
+    }
+
+    #[test]
+    fn longest_edge_is_the_diagonal_of_the_unit_quad() {
+        assert!((quad().longest_edge() - 2f64.sqrt()).abs() < 1e-15);
     }
 
     #[test]

@@ -171,18 +171,7 @@ fn centre_field(
         None => method.parse().map_err(errors::geodesic)?,
     };
     let prepared = solver.map(|s| s.get());
-    let longest = mesh
-        .triangles()
-        .iter()
-        .flat_map(|t| {
-            let p = t.map(|v| mesh.position(v));
-            [
-                (p[1] - p[0]).length(),
-                (p[2] - p[1]).length(),
-                (p[0] - p[2]).length(),
-            ]
-        })
-        .fold(0.0f64, f64::max);
+    let longest = mesh.longest_edge();
     py.detach(|| {
         let owned;
         let solver: &dyn GeodesicSolver = match prepared {
