@@ -75,17 +75,9 @@ pub enum BipolarError {
     /// The spline tangent method failed in a way that has no fallback.
     #[error("B-spline tangents: {0}")]
     Spline(#[from] bspline::BSplineError),
-    /// A descriptor file could not be read or written (the OS error is the source).
-    #[error("cannot {action} {}", path.display())]
-    Io {
-        /// What was being done (`"read"`, `"write"`).
-        action: &'static str,
-        /// File.
-        path: std::path::PathBuf,
-        /// The OS error.
-        #[source]
-        source: std::io::Error,
-    },
+    /// An operating-system failure on a file (the path and the OS error are kept).
+    #[error(transparent)]
+    Io(#[from] meshcore::FileError),
     /// A descriptor file is malformed or cannot hold the descriptor.
     #[error("{}: {message}", path.display())]
     File {

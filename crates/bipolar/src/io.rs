@@ -25,22 +25,6 @@ fn io_err(path: &Path, message: impl Into<String>) -> BipolarError {
     }
 }
 
-fn write_file(path: &Path, text: &str) -> Result<(), BipolarError> {
-    std::fs::write(path, text).map_err(|source| BipolarError::Io {
-        action: "write",
-        path: path.to_path_buf(),
-        source,
-    })
-}
-
-fn read_file(path: &Path) -> Result<String, BipolarError> {
-    std::fs::read_to_string(path).map_err(|source| BipolarError::Io {
-        action: "read",
-        path: path.to_path_buf(),
-        source,
-    })
-}
-
 /// CSV text of a descriptor (see the module docs).
 pub fn to_csv_string(d: &Descriptor) -> String {
     let mut s = String::with_capacity(64 * (d.points.len() + 1));
@@ -52,7 +36,7 @@ pub fn to_csv_string(d: &Descriptor) -> String {
 
 /// Writes the CSV file.
 pub fn write_csv(path: &Path, d: &Descriptor) -> Result<(), BipolarError> {
-    write_file(path, &to_csv_string(d))
+    Ok(meshcore::write_bytes(path, to_csv_string(d))?)
 }
 
 /// Parses CSV text; `path` only names the source in error messages.
@@ -150,7 +134,7 @@ pub fn parse_csv(text: &str, path: &Path) -> Result<Descriptor, BipolarError> {
 
 /// Reads a CSV file written by [`write_csv`].
 pub fn read_csv(path: &Path) -> Result<Descriptor, BipolarError> {
-    parse_csv(&read_file(path)?, path)
+    parse_csv(&meshcore::read_text(path)?, path)
 }
 
 #[derive(Serialize, Deserialize)]
@@ -209,7 +193,7 @@ pub fn to_json_string(d: &Descriptor) -> String {
 
 /// Writes the JSON file.
 pub fn write_json(path: &Path, d: &Descriptor) -> Result<(), BipolarError> {
-    write_file(path, &to_json_string(d))
+    Ok(meshcore::write_bytes(path, to_json_string(d))?)
 }
 
 /// Parses JSON text; `path` only names the source in error messages.
@@ -250,7 +234,7 @@ pub fn parse_json(text: &str, path: &Path) -> Result<Descriptor, BipolarError> {
 
 /// Reads a JSON file written by [`write_json`].
 pub fn read_json(path: &Path) -> Result<Descriptor, BipolarError> {
-    parse_json(&read_file(path)?, path)
+    parse_json(&meshcore::read_text(path)?, path)
 }
 
 /// ASCII PLY text of the points (with key fields and cos as vertex properties).
@@ -287,7 +271,7 @@ fn push_points(s: &mut String, d: &Descriptor, sep: char) {
 
 /// Writes the PLY file.
 pub fn write_ply(path: &Path, d: &Descriptor) -> Result<(), BipolarError> {
-    write_file(path, &to_ply_string(d))
+    Ok(meshcore::write_bytes(path, to_ply_string(d))?)
 }
 
 meshcore::choice! {

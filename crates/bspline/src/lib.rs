@@ -43,20 +43,18 @@ use thiserror::Error;
 /// Degree of every curve built by this crate (cubic).
 pub const DEGREE: usize = 3;
 
-/// How data parameters are spaced along the polyline.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Parametrization {
-    /// Parameter increments proportional to chord lengths (exponent 1). The default.
-    #[default]
-    ChordLength,
-    /// Parameter increments proportional to the square root of chord lengths (exponent 0.5);
-    /// safer when the point spacing varies a lot.
-    Centripetal,
+meshcore::choice! {
+    /// How data parameters are spaced along the polyline.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+    pub enum Parametrization: "parametrization", BSplineError {
+        /// Parameter increments proportional to chord lengths (exponent 1). The default.
+        #[default]
+        ChordLength = "chord-length" | "chord",
+        /// Parameter increments proportional to the square root of chord lengths (exponent 0.5);
+        /// safer when the point spacing varies a lot.
+        Centripetal = "centripetal",
+    }
 }
-meshcore::choice!(Parametrization, "parametrization", BSplineError {
-    ChordLength = "chord-length" | "chord",
-    Centripetal = "centripetal",
-});
 
 impl Parametrization {
     fn exponent(self) -> f64 {

@@ -14,19 +14,16 @@ use meshcore::Surface;
 use std::path::PathBuf;
 use std::time::Instant;
 
-/// Which representation `bipolar curves` computes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Kind {
-    /// Level sets of the principal curvature fields.
-    IsoCurvature,
-    /// Level curves of the geodesic distance from the nose tip.
-    Facial,
+meshcore::choice! {
+    /// Which representation `bipolar curves` computes.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum Kind: "curve kind", meshcore::UnknownChoice {
+        /// Level sets of the principal curvature fields.
+        IsoCurvature = "iso-curvature" | "isocurvature",
+        /// Level curves of the geodesic distance from the nose tip.
+        Facial = "facial",
+    }
 }
-
-meshcore::choice!(Kind, "curve kind", meshcore::UnknownChoice {
-    IsoCurvature = "iso-curvature" | "isocurvature",
-    Facial = "facial",
-});
 
 /// Arguments of `bipolar curves`.
 #[derive(Debug, clap::Args)]

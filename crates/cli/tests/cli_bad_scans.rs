@@ -3,36 +3,46 @@
 //! names the problem (exit status 1, no panic).
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use testsupport::paper_face;
 
+mod common;
+
+/// Runs the CLI: (success, stdout, stderr).
 fn bipolar(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_bipolar"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    let r = common::bipolar(args);
+    (r.ok, r.stdout, r.stderr)
 }
 
 /// Fails cleanly: not successful, exit code 1 (anyhow), no panic message, `word` in stderr.
-fn fails_with(args: &[&str], word: &str) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_bipolar"))
-        .args(args)
-        .output()
-        .unwrap();
-    let err = String::from_utf8_lossy(&out.stderr).into_owned();
-    assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
-    assert!(!err.contains("panicked"), "{args:?}: {err}");
-    assert!(err.contains(word), "{args:?}: expected {word:?} in: {err}");
-    err
+fn fails_with<S: AsRef<std::ffi::OsStr> + std::fmt::Debug>(args: &[S], word: &str) -> String {
+    eprintln!("bipolar {args:?}");
+    testsupport::cli::run(env!("CARGO_BIN_EXE_bipolar"), args).error_naming(word)
 }
 
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
+}
+
+/// `bipolar scan MESH --out BNT OPTS...`, which must succeed.
+fn scan(mesh: &Path, bnt: &Path, opts: &[&str]) {
+    let (ok, _, err) = bipolar(&[&["scan", s(mesh), "--out", s(bnt)], opts].concat());
+    assert!(ok, "{err}");
+}
+
+/// The arguments of `bipolar describe INPUT OPTS... --ref-a outer-eye-right --ref-b
+/// outer-eye-left --out DIR/d.csv`.
+fn describe_eyes(input: &Path, dir: &Path, opts: &[&str]) -> Vec<String> {
+    let out = dir.join("d.csv");
+    [
+        &["describe", s(input)],
+        opts,
+        &["--ref-a", "outer-eye-right"],
+    ]
+    .concat()
+    .into_iter()
+    .chain(["--ref-b", "outer-eye-left", "--out", s(&out)])
+    .map(str::to_string)
+    .collect()
 }
 
 /// A closed box of `w x h x d` mm (12 triangles) as OBJ: an object of face size that is no face.
@@ -67,36 +77,14 @@ fn a_scan_of_a_box_has_no_landmarks() {
     let dir = tempfile::tempdir().unwrap();
     let obj = box_obj(dir.path(), 160.0, 200.0, 120.0);
     let bnt = dir.path().join("box.bnt");
-    let (ok, _, err) = bipolar(&[
-        "scan",
-        s(&obj),
-        "--out",
-        s(&bnt),
-        "--pitch",
-        "1",
-        "--yaw",
-        "30",
-    ]);
-    assert!(ok, "{err}");
+    scan(&obj, &bnt, &["--pitch", "1", "--yaw", "30"]);
     // Cleaning works (it is a surface of face size)...
     let clean = dir.path().join("box.ply");
     let (ok, _, err) = bipolar(&["clean", s(&bnt), s(&clean)]);
     assert!(ok, "{err}");
     // ...but there is no face on it.
     fails_with(&["landmarks", s(&clean)], "landmarks not found");
-    fails_with(
-        &[
-            "describe",
-            s(&bnt),
-            "--ref-a",
-            "outer-eye-right",
-            "--ref-b",
-            "outer-eye-left",
-            "--out",
-            s(&dir.path().join("d.csv")),
-        ],
-        "landmarks not found",
-    );
+    fails_with(&describe_eyes(&bnt, dir.path(), &[]), "landmarks not found");
 }
 
 #[test]
@@ -107,17 +95,7 @@ fn the_back_of_a_head_has_no_landmarks() {
     let dir = tempfile::tempdir().unwrap();
     let bnt = dir.path().join("back.bnt");
     // Turned by 180 degrees: the scanner sees the inside of the face shell from behind.
-    let (ok, _, err) = bipolar(&[
-        "scan",
-        s(&face),
-        "--out",
-        s(&bnt),
-        "--yaw",
-        "180",
-        "--pitch",
-        "0.8",
-    ]);
-    assert!(ok, "{err}");
+    scan(&face, &bnt, &["--yaw", "180", "--pitch", "0.8"]);
     fails_with(&["landmarks", s(&bnt)], "landmarks not found");
 }
 
@@ -184,18 +162,7 @@ fn a_landmark_file_naming_a_point_outside_the_scan_is_an_error() {
     )
     .unwrap();
     let err = fails_with(
-        &[
-            "describe",
-            s(&bnt),
-            "--landmarks",
-            s(&lm3),
-            "--ref-a",
-            "outer-eye-right",
-            "--ref-b",
-            "outer-eye-left",
-            "--out",
-            s(&dir.path().join("d.csv")),
-        ],
+        &describe_eyes(&bnt, dir.path(), &["--landmarks", s(&lm3)]),
         "from the surface, farther than the tolerance",
     );
     assert!(err.contains("--ref-b"), "{err}");

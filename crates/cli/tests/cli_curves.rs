@@ -1,7 +1,8 @@
 //! `bipolar curves` and `bipolar curve-distance` end to end on ellipsoids.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
+
+mod common;
 
 /// An ellipsoid (icosphere level 4 scaled by `axes`), rotated about z by `turn` radians, with
 /// its vertices listed in reverse order when `reverse`; returns the OBJ text and the index of
@@ -38,16 +39,10 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     p
 }
 
+/// Runs the CLI: (success, stdout, stderr).
 fn bipolar(args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_bipolar"))
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
+    let r = common::bipolar(args);
+    (r.ok, r.stdout, r.stderr)
 }
 
 fn distance(a: &Path, b: &Path) -> f64 {

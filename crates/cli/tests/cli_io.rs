@@ -19,7 +19,7 @@ fn info_json(path: &Path) -> serde_json::Value {
 /// Two triangles as a soup (2 duplicate vertices), one degenerate face, an open strip: `name`
 /// in `dir`.
 fn soup(dir: &Path, name: &str) -> PathBuf {
-    testsupport::cli::write_mesh(dir, name, &testsupport::triangle_soup())
+    testsupport::cli::write_mesh(dir, name, &testsupport::shapes::triangle_soup())
 }
 
 #[test]

@@ -37,21 +37,18 @@ use crate::FaceCurvesError;
 use glam::{DMat3, DVec3};
 use meshcore::linalg::kabsch_rotation;
 
-/// How a curve is resampled before its SRVF is taken.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Resampling {
-    /// Equal arc-length spacing: removes the input's parametrisation (what the face papers do
-    /// with their level curves); the dynamic programming then only corrects for the shape.
-    ArcLength,
-    /// Equal steps of the input's own parameter (the point index, linear in between): keeps
-    /// the input parametrisation, so the dynamic programming must find the reparametrisation.
-    Parameter,
+meshcore::choice! {
+    /// How a curve is resampled before its SRVF is taken.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum Resampling: "curve resampling", crate::FaceCurvesError {
+        /// Equal arc-length spacing: removes the input's parametrisation (what the face papers do
+        /// with their level curves); the dynamic programming then only corrects for the shape.
+        ArcLength = "arc-length" | "arclength",
+        /// Equal steps of the input's own parameter (the point index, linear in between): keeps
+        /// the input parametrisation, so the dynamic programming must find the reparametrisation.
+        Parameter = "parameter",
+    }
 }
-
-meshcore::choice!(Resampling, "curve resampling", crate::FaceCurvesError {
-    ArcLength = "arc-length" | "arclength",
-    Parameter = "parameter",
-});
 
 /// Options of [`elastic_distance`].
 #[derive(Debug, Clone, Copy, PartialEq)]

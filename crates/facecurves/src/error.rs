@@ -70,17 +70,9 @@ pub enum FaceCurvesError {
     /// No curve could be extracted; the message says why.
     #[error("no curves: {0}")]
     NoCurves(String),
-    /// An operating-system failure on a file.
-    #[error("cannot {action} {}", path.display())]
-    Io {
-        /// What was being done (`"read"`, `"write"`).
-        action: &'static str,
-        /// The file.
-        path: std::path::PathBuf,
-        /// The OS error.
-        #[source]
-        source: std::io::Error,
-    },
+    /// An operating-system failure on a file (the path and the OS error are kept).
+    #[error(transparent)]
+    Io(#[from] meshcore::FileError),
     /// A curve file is malformed; the message says how.
     #[error("{}: {message}", path.display())]
     File {

@@ -15,20 +15,17 @@ use geodesic::{GeodesicSolver, SolveOptions, Source};
 use glam::DVec3;
 use meshcore::Surface;
 
-/// How the per-curve distances of two faces are combined.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Aggregate {
-    /// `sqrt(sum d_i^2)`: the distance in the product of the curves' shape spaces (Samir et
-    /// al.).
-    RootSumSquare,
-    /// `sum d_i`.
-    Sum,
+meshcore::choice! {
+    /// How the per-curve distances of two faces are combined.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum Aggregate: "curve aggregate", crate::FaceCurvesError {
+        /// `sqrt(sum d_i^2)`: the distance in the product of the curves' shape spaces (Samir et
+        /// al.).
+        RootSumSquare = "rss" | "root-sum-square",
+        /// `sum d_i`.
+        Sum = "sum",
+    }
 }
-
-meshcore::choice!(Aggregate, "curve aggregate", crate::FaceCurvesError {
-    RootSumSquare = "rss" | "root-sum-square",
-    Sum = "sum",
-});
 
 /// Options of [`describe_facial_curves`].
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -196,20 +196,12 @@ pub fn parse_json(text: &str, path: &Path) -> Result<CurveSet, FaceCurvesError> 
 
 /// Writes a curve file.
 pub fn write_json(path: &Path, set: &CurveSet) -> Result<(), FaceCurvesError> {
-    std::fs::write(path, to_json_string(set)).map_err(|source| FaceCurvesError::Io {
-        action: "write",
-        path: path.to_path_buf(),
-        source,
-    })
+    Ok(meshcore::write_bytes(path, to_json_string(set))?)
 }
 
 /// Reads a curve file.
 pub fn read_json(path: &Path) -> Result<CurveSet, FaceCurvesError> {
-    let text = std::fs::read_to_string(path).map_err(|source| FaceCurvesError::Io {
-        action: "read",
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text = meshcore::read_text(path)?;
     parse_json(&text, path)
 }
 

@@ -17,19 +17,16 @@ use glam::DVec3;
 use landmarks::curvature::{vertex_curvatures, CurvatureOptions};
 use meshcore::Surface;
 
-/// Which principal curvature field a curve is a level set of.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum PrincipalField {
-    /// The maximum principal curvature `k1`.
-    K1,
-    /// The minimum principal curvature `k2`.
-    K2,
+meshcore::choice! {
+    /// Which principal curvature field a curve is a level set of.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+    pub enum PrincipalField: "principal curvature field", crate::FaceCurvesError {
+        /// The maximum principal curvature `k1`.
+        K1 = "k1" | "max",
+        /// The minimum principal curvature `k2`.
+        K2 = "k2" | "min",
+    }
 }
-
-meshcore::choice!(PrincipalField, "principal curvature field", crate::FaceCurvesError {
-    K1 = "k1" | "max",
-    K2 = "k2" | "min",
-});
 
 /// The curvature levels whose level sets form the network.
 #[derive(Debug, Clone, PartialEq)]

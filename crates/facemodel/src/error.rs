@@ -7,17 +7,9 @@ use thiserror::Error;
 /// lookup. Every file error names the file.
 #[derive(Debug, Error)]
 pub enum FaceModelError {
-    /// The operating system could not read the file or list the folder.
-    #[error("cannot {action} {}", path.display())]
-    Io {
-        /// What was being done (`"read"`, `"list"`).
-        action: &'static str,
-        /// The file or folder.
-        path: PathBuf,
-        /// The underlying error.
-        #[source]
-        source: std::io::Error,
-    },
+    /// An operating-system failure on a file (the path and the OS error are kept).
+    #[error(transparent)]
+    Io(#[from] meshcore::FileError),
     /// A mesh file is malformed or is not a valid mesh (the message of `mesh-io` names the
     /// file and the line or byte).
     #[error("{source}")]
@@ -181,18 +173,14 @@ impl FaceModelError {
         variant: impl FnOnce(PathBuf, mesh_io::IoError) -> Self,
     ) -> Self {
         match e {
-            mesh_io::IoError::Io { action, source, .. } => Self::io(action, path, source),
+            mesh_io::IoError::Io(e) => Self::Io(e),
             e => variant(path.to_path_buf(), e),
         }
     }
 
     /// An OS error on `path`.
     pub(crate) fn io(action: &'static str, path: &Path, source: std::io::Error) -> Self {
-        Self::Io {
-            action,
-            path: path.to_path_buf(),
-            source,
-        }
+        Self::Io(meshcore::FileError::new(action, path, source))
     }
 
     /// A content problem of the JSON file `path`.

@@ -539,7 +539,7 @@ mod tests {
         let dir = write_model("npy-missing");
         std::fs::remove_file(dir.join("expressions.npy")).unwrap();
         match FaceModel::load(&dir).unwrap_err() {
-            FaceModelError::Io { path, source, .. } => {
+            FaceModelError::Io(meshcore::FileError { path, source, .. }) => {
                 assert_eq!(path, dir.join("expressions.npy"));
                 assert_eq!(source.kind(), std::io::ErrorKind::NotFound);
             }

@@ -37,45 +37,41 @@ struct UpdTri {
     kg: f64,
 }
 
-/// How the arrival time of a vertex is computed from the two other corners of a triangle.
-///
-/// Measured (see `docs/bench-geodesic.md`): the plane-wave update (classic Kimmel-Sethian)
-/// ignores the curvature of the front and overestimates around point sources; the point-source
-/// update is exact on flat and developable meshes but assumes the flat-plane front curvature
-/// `1 / T`, so it underestimates where geodesics converge (towards the antipode of a closed
-/// sphere). The curved-front update (the default) tracks the front curvature per vertex and is
-/// right in both regimes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum FmmUpdate {
-    /// Kimmel-Sethian: the front is locally a plane wave (`T` linear in the triangle with unit
-    /// gradient). Exact for plane waves.
-    PlaneWave,
-    /// The front is locally a circle around a virtual point source at distances `T_a`, `T_b`
-    /// from `a`, `b` (the unfolded source of the triangle). Exact for point sources on flat and
-    /// developable meshes.
-    PointSource,
-    /// The mean of the plane-wave and point-source updates (an empirical compromise).
-    Blend,
-    /// The front is locally a circle whose signed geodesic curvature `kappa` is carried from
-    /// vertex to vertex: diverging (virtual source behind the front, as
-    /// [`FmmUpdate::PointSource`]), converging (focus ahead of the front) or straight (plane
-    /// wave). The circle through `a` and `b` gives the time of `c`; `kappa` itself follows the
-    /// characteristics by the Riccati equation `dkappa/ds = -kappa^2 - K`, solved exactly for
-    /// the Gaussian curvature `K` of the triangle (angle defect over a third of the incident
-    /// area, averaged over its corners; zero on the boundary). Equals
-    /// [`FmmUpdate::PointSource`] on flat and developable meshes (`kappa = 1 / T`); on a sphere
-    /// it follows `kappa = cot T` through the equator (plane wave) to the converging front at
-    /// the antipode, where the point-source rule underestimates and the plane-wave rule
-    /// overestimates. The default.
-    #[default]
-    CurvedFront,
+meshcore::choice! {
+    /// How the arrival time of a vertex is computed from the two other corners of a triangle.
+    ///
+    /// Measured (see `docs/bench-geodesic.md`): the plane-wave update (classic Kimmel-Sethian)
+    /// ignores the curvature of the front and overestimates around point sources; the point-source
+    /// update is exact on flat and developable meshes but assumes the flat-plane front curvature
+    /// `1 / T`, so it underestimates where geodesics converge (towards the antipode of a closed
+    /// sphere). The curved-front update (the default) tracks the front curvature per vertex and is
+    /// right in both regimes.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+    pub enum FmmUpdate: "fast-marching update", crate::GeodesicError {
+        /// Kimmel-Sethian: the front is locally a plane wave (`T` linear in the triangle with unit
+        /// gradient). Exact for plane waves.
+        PlaneWave = "plane-wave",
+        /// The front is locally a circle around a virtual point source at distances `T_a`, `T_b`
+        /// from `a`, `b` (the unfolded source of the triangle). Exact for point sources on flat and
+        /// developable meshes.
+        PointSource = "point-source",
+        /// The mean of the plane-wave and point-source updates (an empirical compromise).
+        Blend = "blend",
+        /// The front is locally a circle whose signed geodesic curvature `kappa` is carried from
+        /// vertex to vertex: diverging (virtual source behind the front, as
+        /// [`FmmUpdate::PointSource`]), converging (focus ahead of the front) or straight (plane
+        /// wave). The circle through `a` and `b` gives the time of `c`; `kappa` itself follows the
+        /// characteristics by the Riccati equation `dkappa/ds = -kappa^2 - K`, solved exactly for
+        /// the Gaussian curvature `K` of the triangle (angle defect over a third of the incident
+        /// area, averaged over its corners; zero on the boundary). Equals
+        /// [`FmmUpdate::PointSource`] on flat and developable meshes (`kappa = 1 / T`); on a sphere
+        /// it follows `kappa = cot T` through the equator (plane wave) to the converging front at
+        /// the antipode, where the point-source rule underestimates and the plane-wave rule
+        /// overestimates. The default.
+        #[default]
+        CurvedFront = "curved-front",
+    }
 }
-meshcore::choice!(FmmUpdate, "fast-marching update", crate::GeodesicError {
-    PlaneWave = "plane-wave",
-    PointSource = "point-source",
-    Blend = "blend",
-    CurvedFront = "curved-front",
-});
 
 /// Fast marching distance on a triangle mesh.
 ///

@@ -63,25 +63,20 @@ impl SolveOptions {
     }
 }
 
-/// The available methods.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Method {
-    /// Exact polyhedral distance (window propagation).
-    Exact,
-    /// Fast marching on triangulated domains (Kimmel-Sethian) with obtuse-angle unfolding.
-    Fmm,
-    /// Heat method (Crane et al.) with a reusable sparse Cholesky factorisation.
-    Heat,
-    /// Dijkstra on mesh edges.
-    Dijkstra,
+meshcore::choice! {
+    /// The available methods.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+    pub enum Method: "geodesic method", GeodesicError {
+        /// Exact polyhedral distance (window propagation).
+        Exact = "exact",
+        /// Fast marching on triangulated domains (Kimmel-Sethian) with obtuse-angle unfolding.
+        Fmm = "fmm",
+        /// Heat method (Crane et al.) with a reusable sparse Cholesky factorisation.
+        Heat = "heat",
+        /// Dijkstra on mesh edges.
+        Dijkstra = "dijkstra",
+    }
 }
-
-meshcore::choice!(Method, "geodesic method", GeodesicError {
-    Exact = "exact",
-    Fmm = "fmm",
-    Heat = "heat",
-    Dijkstra = "dijkstra",
-});
 
 impl Method {
     /// Short lowercase name, as used on the command line ([`meshcore::Choice::name`]).

@@ -185,17 +185,9 @@ pub enum LandmarkError {
     /// Mesh error.
     #[error(transparent)]
     Mesh(#[from] MeshError),
-    /// A file could not be read or written (the OS error is the source).
-    #[error("cannot {action} {}", path.display())]
-    Io {
-        /// What was being done (`"read"`, `"write"`).
-        action: &'static str,
-        /// The file.
-        path: std::path::PathBuf,
-        /// The cause.
-        #[source]
-        source: std::io::Error,
-    },
+    /// An operating-system failure on a file (the path and the OS error are kept).
+    #[error(transparent)]
+    Io(#[from] meshcore::FileError),
     /// A landmark file could not be read or is malformed (`mesh-io` reads them).
     #[error(transparent)]
     File(#[from] mesh_io::IoError),

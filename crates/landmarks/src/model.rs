@@ -345,11 +345,7 @@ impl GenericModel {
 
     /// Reads a model file.
     pub fn load(path: &std::path::Path) -> Result<Self, LandmarkError> {
-        let text = std::fs::read_to_string(path).map_err(|e| LandmarkError::Io {
-            action: "read",
-            path: path.to_path_buf(),
-            source: e,
-        })?;
+        let text = meshcore::read_text(path)?;
         Self::from_json(&text).map_err(|e| match e {
             LandmarkError::InvalidModel(m) => {
                 LandmarkError::InvalidModel(format!("{}: {m}", path.display()))

@@ -1,6 +1,6 @@
 use meshcore::MeshError;
 use std::fmt;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use thiserror::Error;
 
 /// Where in a file a problem was found.
@@ -27,17 +27,9 @@ impl fmt::Display for Location {
 /// Errors of the mesh readers and writers. Every variant names the file.
 #[derive(Debug, Error)]
 pub enum IoError {
-    /// The operating system could not read or write the file (the OS error is the source).
-    #[error("cannot {action} {}", path.display())]
-    Io {
-        /// What was being done: `"read"` or `"write"`.
-        action: &'static str,
-        /// The file.
-        path: PathBuf,
-        /// The underlying error.
-        #[source]
-        source: std::io::Error,
-    },
+    /// An operating-system failure on a file (the path and the OS error are kept).
+    #[error(transparent)]
+    Io(#[from] meshcore::FileError),
     /// The file content is malformed: truncated, inconsistent counts, bad numbers, indices out
     /// of range, non-finite coordinates, ...
     #[error("{file}: {at}{problem}")]
@@ -111,11 +103,7 @@ impl IoError {
     }
 
     pub(crate) fn io(action: &'static str, path: &Path, source: std::io::Error) -> Self {
-        IoError::Io {
-            action,
-            path: path.to_path_buf(),
-            source,
-        }
+        IoError::Io(meshcore::FileError::new(action, path, source))
     }
 
     pub(crate) fn mesh(file: &str, source: MeshError) -> Self {

@@ -346,21 +346,18 @@ fn read_gltf_unguarded(
     Ok(out)
 }
 
-/// How the points of a [`Polyline`] are joined.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum LineMode {
-    /// Consecutive points joined (glTF `LINE_STRIP`).
-    Strip,
-    /// Consecutive points joined and the last to the first (glTF `LINE_LOOP`).
-    Loop,
-    /// Points taken in pairs, each pair one segment (glTF `LINES`).
-    Segments,
+meshcore::choice! {
+    /// How the points of a [`Polyline`] are joined.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum LineMode: "line mode", crate::IoError {
+        /// Consecutive points joined (glTF `LINE_STRIP`).
+        Strip = "strip",
+        /// Consecutive points joined and the last to the first (glTF `LINE_LOOP`).
+        Loop = "loop",
+        /// Points taken in pairs, each pair one segment (glTF `LINES`).
+        Segments = "segments",
+    }
 }
-meshcore::choice!(LineMode, "line mode", crate::IoError {
-    Strip = "strip",
-    Loop = "loop",
-    Segments = "segments",
-});
 
 /// A triangle mesh in a [`GltfScene`].
 #[derive(Debug, Clone, PartialEq)]

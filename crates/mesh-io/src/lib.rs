@@ -52,33 +52,26 @@ pub use ply::{PlyEncoding, PlyWriteOptions};
 use meshcore::{DVec3, TriMesh};
 use std::path::Path;
 
-/// The mesh file formats known to [`read_mesh`] and [`write_mesh`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Format {
-    /// Wavefront OBJ (text).
-    Obj,
-    /// Stanford PLY (ASCII or binary).
-    Ply,
-    /// STL (ASCII or binary).
-    Stl,
-    /// Object File Format (text).
-    Off,
-    /// glTF 2.0 JSON (`.gltf`, buffers embedded as data URIs or next to the file).
-    Gltf,
-    /// glTF 2.0 binary (`.glb`).
-    Glb,
-    /// Bosphorus range grid (`.bnt`, read only).
-    Bnt,
+meshcore::choice! {
+    /// The mesh file formats known to [`read_mesh`] and [`write_mesh`].
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+    pub enum Format: "mesh format", IoError {
+        /// Wavefront OBJ (text).
+        Obj = "obj",
+        /// Stanford PLY (ASCII or binary).
+        Ply = "ply",
+        /// STL (ASCII or binary).
+        Stl = "stl",
+        /// Object File Format (text).
+        Off = "off",
+        /// glTF 2.0 JSON (`.gltf`, buffers embedded as data URIs or next to the file).
+        Gltf = "gltf",
+        /// glTF 2.0 binary (`.glb`).
+        Glb = "glb",
+        /// Bosphorus range grid (`.bnt`, read only).
+        Bnt = "bnt",
+    }
 }
-meshcore::choice!(Format, "mesh format", IoError {
-    Obj = "obj",
-    Ply = "ply",
-    Stl = "stl",
-    Off = "off",
-    Gltf = "gltf",
-    Glb = "glb",
-    Bnt = "bnt",
-});
 
 impl Format {
     /// The format named by a path's extension (case-insensitive).
@@ -95,18 +88,16 @@ impl Format {
     }
 }
 
-/// How a per-vertex scalar was (or is to be) stored.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ScalarType {
-    /// 32-bit float.
-    F32,
-    /// 64-bit float.
-    F64,
+meshcore::choice! {
+    /// How a per-vertex scalar was (or is to be) stored.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum ScalarType: "scalar type", IoError {
+        /// 32-bit float.
+        F32 = "f32" | "float32" | "float",
+        /// 64-bit float.
+        F64 = "f64" | "float64" | "double",
+    }
 }
-meshcore::choice!(ScalarType, "scalar type", IoError {
-    F32 = "f32" | "float32" | "float",
-    F64 = "f64" | "float64" | "double",
-});
 
 /// A named per-vertex scalar property (e.g. a geodesic distance field).
 #[derive(Debug, Clone, PartialEq)]

@@ -207,7 +207,7 @@ fn lm3_round_trip() {
 #[test]
 fn repairs_keep_extras_aligned() {
     // Two triangles as a soup sharing an edge, plus a degenerate face.
-    let soup = testsupport::triangle_soup();
+    let soup = testsupport::shapes::triangle_soup();
     let orig = soup.positions().to_vec();
     let mut m = LoadedMesh::new(soup);
     assert_eq!(m.warnings.len(), 2, "{:?}", m.warnings);
@@ -301,7 +301,10 @@ fn landmark_json_round_trips_and_every_layout_reads() {
     assert!(e.to_string().contains("it has: f1"), "{e}");
     assert_eq!(mesh_io::read_ict_landmarks(&ict).unwrap()["f1"], f1);
     let e = mesh_io::read_landmark_file(dir.join("missing.lm3"), None).unwrap_err();
-    assert!(matches!(e, mesh_io::IoError::Io { action: "read", .. }));
+    assert!(matches!(
+        e,
+        mesh_io::IoError::Io(meshcore::FileError { action: "read", .. })
+    ));
     assert!(std::error::Error::source(&e).is_some());
     std::fs::remove_dir_all(&dir).ok();
 }

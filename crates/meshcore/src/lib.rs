@@ -20,6 +20,7 @@
 mod adjacency;
 pub mod choice;
 mod error;
+mod file;
 pub mod linalg;
 mod locate;
 mod mesh;
@@ -32,6 +33,7 @@ pub mod units;
 pub use adjacency::VertexAdjacency;
 pub use choice::{Choice, UnknownChoice};
 pub use error::MeshError;
+pub use file::{read_text, write_bytes, FileError};
 pub use glam::{DAffine3, DMat3, DQuat, DVec3};
 pub use locate::{closest_point_on_triangle, FaceLocator};
 pub use mesh::{Aabb, SurfacePoint, TriMesh};

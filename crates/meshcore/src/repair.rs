@@ -201,15 +201,10 @@ mod tests {
     #[test]
     fn weld_and_drop() {
         // Two triangles written as separate soups (STL style) sharing an edge, plus a sliver.
-        let p = vec![
-            DVec3::ZERO,
-            DVec3::X,
-            DVec3::Y,
-            DVec3::X,
-            DVec3::new(1.0, 1.0, 0.0),
-            DVec3::Y + DVec3::splat(1e-13),
-        ];
-        let m = TriMesh::new(p, vec![[0, 1, 2], [3, 4, 5], [0, 0, 1]]).unwrap();
+        let soup = crate::shapes::triangle_soup();
+        let mut p = soup.positions().to_vec();
+        p[5] += DVec3::splat(1e-13);
+        let m = TriMesh::new(p, soup.triangles().to_vec()).unwrap();
         let w = weld_vertices(&m, 1e-9).unwrap();
         assert_eq!(w.mesh.n_vertices(), 4);
         assert_eq!(w.mesh.n_faces(), 2);

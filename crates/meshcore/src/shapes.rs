@@ -1,25 +1,23 @@
-//! Generated test shapes: jittered plane grids (optionally with holes), icospheres and UV
-//! spheres. Deterministic (the jitter comes from a fixed-seed generator), so tests and
-//! benchmarks may pick vertices by index. Every crate's tests, benches and the sphere
-//! validation use these instead of their own copies.
+//! Generated test shapes: jittered plane grids (optionally with holes), icospheres, UV
+//! spheres and the triangle soup of the repair tests. Deterministic (the jitter comes from a
+//! fixed-seed generator), so tests and benchmarks may pick vertices by index. Every crate's
+//! tests, benches and the sphere validation use these instead of their own copies.
 
 use crate::{MeshError, TriMesh};
 use glam::DVec3;
 use std::collections::HashMap;
 
-/// How [`grid`] splits each square of the grid into two triangles. With corners
-/// `a = (i, j)`, `b = (i + 1, j)`, `c = (i + 1, j + 1)`, `d = (i, j + 1)`:
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Diagonals {
-    /// Every square along `a-c`: triangles `a b c` and `a c d`.
-    Uniform,
-    /// Chequerboard: `a b c`, `a c d` where `i + j` is even, else along `b-d`: `a b d`, `b c d`.
-    Alternating,
+crate::choice! {
+    /// How [`grid`] splits each square of the grid into two triangles. With corners
+    /// `a = (i, j)`, `b = (i + 1, j)`, `c = (i + 1, j + 1)`, `d = (i, j + 1)`:
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum Diagonals: "diagonal layout", MeshError {
+        /// Every square along `a-c`: triangles `a b c` and `a c d`.
+        Uniform = "uniform",
+        /// Chequerboard: `a b c`, `a c d` where `i + j` is even, else along `b-d`: `a b d`, `b c d`.
+        Alternating = "alternating",
+    }
 }
-crate::choice!(Diagonals, "diagonal layout", MeshError {
-    Uniform = "uniform",
-    Alternating = "alternating",
-});
 
 /// Grid of `nx x ny` squares, counter-clockwise in the `(i, j)` parameter plane. Vertex
 /// `(i, j)`, `0 <= i <= nx`, `0 <= j <= ny`, has id `j * (nx + 1) + i` and the position
@@ -248,6 +246,21 @@ pub fn cylinder(r: f64, h: f64, na: usize, nh: usize) -> TriMesh {
         }
     }
     TriMesh::new(v, f).expect("a generated cylinder is a valid mesh")
+}
+
+/// The unit square's two triangles written as a soup (STL style: the two vertices of the shared
+/// edge written twice, so 2 duplicate vertices), plus the degenerate face `[0, 0, 1]`: 6
+/// vertices, 3 faces, the input of the repair tests.
+pub fn triangle_soup() -> TriMesh {
+    let p = vec![
+        DVec3::ZERO,
+        DVec3::X,
+        DVec3::Y,
+        DVec3::X,
+        DVec3::new(1.0, 1.0, 0.0),
+        DVec3::Y,
+    ];
+    TriMesh::new(p, vec![[0, 1, 2], [3, 4, 5], [0, 0, 1]]).expect("the soup is a valid mesh")
 }
 
 #[cfg(test)]

@@ -107,7 +107,7 @@ pub fn chain(e: &dyn std::error::Error) -> String {
 fn io_kind(e: &mesh_io::IoError) -> Kind {
     use mesh_io::IoError as E;
     match e {
-        E::Io { .. } => Kind::File,
+        E::Io(_) => Kind::File,
         E::Malformed { .. } | E::Unsupported { .. } | E::UnknownFormat { .. } | E::Mesh { .. } => {
             Kind::Format
         }
@@ -156,7 +156,7 @@ pub fn descriptor(e: bipolar::BipolarError) -> PyErr {
         E::Geodesic(g) => geodesic_kind(g),
         E::NoIntersections(_) => Kind::NoPoints,
         E::Spline(_) => Kind::Computation,
-        E::Io { .. } => Kind::File,
+        E::Io(_) => Kind::File,
         E::File { .. } => Kind::Format,
         _ => Kind::Input,
     };
@@ -175,7 +175,7 @@ pub fn landmarks(e: landmarks::LandmarkError) -> PyErr {
         // A surface whose size fits no face is a face not found (the message says why).
         E::NotFound { .. } | E::Units(_) => Kind::NotFound,
         E::Mesh(m) => return mesh(m.clone()),
-        E::Io { .. } => Kind::File,
+        E::Io(_) => Kind::File,
         E::File(f) => return io_kind_err(f, chain(&e)),
         E::MissingLandmark { .. } => Kind::Format,
         E::InvalidModel(_) | E::InvalidTraining(_) | E::InvalidOption(_) | E::UnknownChoice(_) => {
@@ -212,7 +212,7 @@ pub fn facecurves(e: facecurves::FaceCurvesError) -> PyErr {
         E::Mesh(m) => return mesh(m.clone()),
         E::Geodesic(g) => geodesic_kind(g),
         E::ShapeDist(_) => Kind::Input,
-        E::Io { .. } => Kind::File,
+        E::Io(_) => Kind::File,
         E::File { .. } => Kind::Format,
         E::NoCurves(_) | E::NoSharedCurves { .. } => Kind::NoPoints,
         _ => Kind::Input,

@@ -181,21 +181,19 @@ impl PreparedSet {
     }
 }
 
-/// Point-to-point or point-to-plane error.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
-pub enum IcpVariant {
-    /// Besl & McKay: minimise the squared distances to the closest points (closed form per
-    /// iteration).
-    #[default]
-    PointToPoint,
-    /// Chen & Medioni: minimise squared distances to the tangent planes of the target
-    /// (linearised rotation per iteration); converges in far fewer iterations on surfaces.
-    PointToPlane,
+meshcore::choice! {
+    /// Point-to-point or point-to-plane error.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+    pub enum IcpVariant: "ICP variant", ShapeDistError {
+        /// Besl & McKay: minimise the squared distances to the closest points (closed form per
+        /// iteration).
+        #[default]
+        PointToPoint = "point" | "point-to-point",
+        /// Chen & Medioni: minimise squared distances to the tangent planes of the target
+        /// (linearised rotation per iteration); converges in far fewer iterations on surfaces.
+        PointToPlane = "plane" | "point-to-plane",
+    }
 }
-meshcore::choice!(IcpVariant, "ICP variant", ShapeDistError {
-    PointToPoint = "point" | "point-to-point",
-    PointToPlane = "plane" | "point-to-plane",
-});
 
 /// Options of one ICP run.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

@@ -9,19 +9,17 @@ use crate::error::{ShapeDistError, Which};
 use crate::points::{check_spread, outer, validate};
 use meshcore::linalg::{horn_rotation, kabsch_rotation};
 
-/// Closed-form solver for the rotation.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
-pub enum RotationMethod {
-    /// SVD of the 3x3 correlation matrix with the reflection guard.
-    #[default]
-    Kabsch,
-    /// Horn's unit quaternion (largest eigenvector of a 4x4 symmetric matrix).
-    Horn,
+meshcore::choice! {
+    /// Closed-form solver for the rotation.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+    pub enum RotationMethod: "rotation solver", ShapeDistError {
+        /// SVD of the 3x3 correlation matrix with the reflection guard.
+        #[default]
+        Kabsch = "kabsch",
+        /// Horn's unit quaternion (largest eigenvector of a 4x4 symmetric matrix).
+        Horn = "horn",
+    }
 }
-meshcore::choice!(RotationMethod, "rotation solver", ShapeDistError {
-    Kabsch = "kabsch",
-    Horn = "horn",
-});
 
 /// Robust loss for iteratively reweighted least squares on the pair residuals.
 ///

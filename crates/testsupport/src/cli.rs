@@ -12,6 +12,8 @@ use std::process::Command;
 pub struct Run {
     /// The program exited with status 0.
     pub ok: bool,
+    /// The exit status (`None` when a signal ended the program).
+    pub code: Option<i32>,
     /// Standard output (lossy UTF-8).
     pub stdout: String,
     /// Standard error (lossy UTF-8).
@@ -40,6 +42,27 @@ impl Run {
         );
         self.stderr
     }
+
+    /// Its stderr; panics unless the program failed as an error does (exit status 1: a panic
+    /// exits with 101, a signal with none), without a panic message, and its stderr contains
+    /// `word`.
+    #[track_caller]
+    pub fn error_naming(self, word: &str) -> String {
+        assert_eq!(
+            self.code,
+            Some(1),
+            "expected exit status 1\nstdout:\n{}\nstderr:\n{}",
+            self.stdout,
+            self.stderr
+        );
+        assert!(!self.stderr.contains("panicked"), "{}", self.stderr);
+        assert!(
+            self.stderr.contains(word),
+            "expected {word:?} in stderr:\n{}",
+            self.stderr
+        );
+        self.stderr
+    }
 }
 
 /// Runs `exe` (in a test of a binary crate: `env!("CARGO_BIN_EXE_<name>")`) with `args`; panics
@@ -52,6 +75,7 @@ pub fn run<S: AsRef<OsStr>>(exe: impl AsRef<OsStr>, args: &[S]) -> Run {
         .unwrap_or_else(|e| panic!("running {}: {e}", exe.to_string_lossy()));
     Run {
         ok: out.status.success(),
+        code: out.status.code(),
         stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
         stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
     }

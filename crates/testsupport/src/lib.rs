@@ -84,22 +84,6 @@ pub fn height_field(n: usize, half: f64, f: impl Fn(f64, f64) -> f64) -> TriMesh
     .expect("a height field of finite heights is a valid mesh")
 }
 
-/// The unit square's two triangles written as a soup (STL style: the two vertices of the shared
-/// edge written twice, so 2 duplicate vertices), plus the degenerate face `[0, 0, 1]`: 6
-/// vertices, 3 faces, the input of the repair tests.
-pub fn triangle_soup() -> TriMesh {
-    use meshcore::DVec3;
-    let p = vec![
-        DVec3::ZERO,
-        DVec3::X,
-        DVec3::Y,
-        DVec3::X,
-        DVec3::new(1.0, 1.0, 0.0),
-        DVec3::Y,
-    ];
-    TriMesh::new(p, vec![[0, 1, 2], [3, 4, 5], [0, 0, 1]]).expect("the soup is a valid mesh")
-}
-
 /// UV sphere of radius `r` with its poles on the y axis (vertex 0 at `+r y`, the last vertex at
 /// `-r y`, the rings in between at `y = r cos(theta)`), the view-friendly sphere of the render
 /// tests: [`shapes::uv_sphere`] with y and z exchanged and every face reversed so that it stays

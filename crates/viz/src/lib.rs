@@ -52,16 +52,9 @@ pub enum VizError {
     /// The output path has an extension other than `.svg` or `.png`.
     #[error("unsupported picture format for {0} (use .svg or .png)")]
     UnsupportedFormat(PathBuf),
-    /// Writing the file failed.
-    #[error("cannot {action} {}", path.display())]
-    Io {
-        /// What was being done (`"write"`).
-        action: &'static str,
-        /// The file.
-        path: PathBuf,
-        /// The underlying error.
-        source: std::io::Error,
-    },
+    /// An operating-system failure on a file (the path and the OS error are kept).
+    #[error(transparent)]
+    Io(#[from] meshcore::FileError),
     /// PNG encoding failed.
     #[error("PNG encoding failed: {0}")]
     Png(String),
@@ -88,18 +81,16 @@ pub enum VizError {
     UnknownChoice(#[from] meshcore::UnknownChoice),
 }
 
-/// Picture formats chosen from the file extension.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Format {
-    /// `.svg`
-    Svg,
-    /// `.png`
-    Png,
+meshcore::choice! {
+    /// Picture formats chosen from the file extension.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum Format: "picture format", VizError {
+        /// `.svg`
+        Svg = "svg",
+        /// `.png`
+        Png = "png",
+    }
 }
-meshcore::choice!(Format, "picture format", VizError {
-    Svg = "svg",
-    Png = "png",
-});
 
 impl Format {
     /// Format of a path by its (case-insensitive) extension.
@@ -112,11 +103,7 @@ impl Format {
 }
 
 pub(crate) fn write_bytes(path: &Path, bytes: &[u8]) -> Result<(), VizError> {
-    std::fs::write(path, bytes).map_err(|source| VizError::Io {
-        action: "write",
-        path: path.to_path_buf(),
-        source,
-    })
+    Ok(meshcore::write_bytes(path, bytes)?)
 }
 
 /// Renders the scene to `path`, SVG or PNG by extension (validating size and vertex colours

@@ -205,9 +205,12 @@ fn introduction(rep: &mut Report, inp: &Input<'_>, failures: &Failures) {
 
 /// Reference distances and point counts per face.
 fn reference_distances(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
-    let faces = inp.faces;
-    let results = inp.results;
-    let names = &inp.names;
+    let &Input {
+        faces,
+        results,
+        ref names,
+        ..
+    } = inp;
     // D per face.
     rep.heading(2, "Reference distances and point counts");
     let mut rows = Vec::new();
@@ -232,10 +235,13 @@ fn reference_distances(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
 
 /// Section 1: the renders (figures 4, 5).
 fn renders(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
-    let faces = inp.faces;
-    let test = inp.test;
-    let results = inp.results;
-    let n = inp.n;
+    let &Input {
+        faces,
+        test,
+        results,
+        n,
+        ..
+    } = inp;
     // 1. Renders.
     rep.heading(
         2,
@@ -265,10 +271,13 @@ fn renders(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
 
 /// Section 2: distance against resolution (figure 6) and the matrices (figure 7), with the separation table.
 fn resolution(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
-    let faces = inp.faces;
-    let test = inp.test;
-    let results = inp.results;
-    let n = inp.n;
+    let &Input {
+        faces,
+        test,
+        results,
+        n,
+        ..
+    } = inp;
     // 2. Resolution sweep and matrix.
     rep.heading(
         2,
@@ -347,10 +356,13 @@ fn resolution(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
 
 /// Section 3: the perturbation grid (figures 9, 10).
 fn robustness(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
-    let faces = inp.faces;
-    let test = inp.test;
-    let results = inp.results;
-    let n = inp.n;
+    let &Input {
+        faces,
+        test,
+        results,
+        n,
+        ..
+    } = inp;
     // 3. Robustness.
     rep.heading(2, "3. Robustness to reference-point errors (figures 9-13)");
     rep.para(&format!("The left outer eye corner q of `{}` is moved along a straightest geodesic of length {}% of D, leaving at angle theta from the direction towards r (counter-clockwise about the outward normal); its distance field is recomputed from the moved surface point, D is recomputed, and the static descriptor at N = {n} is compared with the original one.", faces[test].name, RADII_PCT.iter().map(|p| format!("{p}")).collect::<Vec<_>>().join(", ")));
@@ -492,10 +504,13 @@ fn figure11(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
 
 /// Figures 12 and 13: matrices with random errors.
 fn random_errors(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
-    let faces = inp.faces;
-    let test = inp.test;
-    let results = inp.results;
-    let n = inp.n;
+    let &Input {
+        faces,
+        test,
+        results,
+        n,
+        ..
+    } = inp;
     // Figures 12-13.
     rep.para(&format!("Figures 12 and 13: every face gets its own random error (seeded), radius uniform in [0, 5%] of D and a uniform direction: on q only, then on both r and q (independent draws); the 12 x 12 matrices are computed between the perturbed descriptors (N = {n}, static area)."));
     let mut rows = Vec::new();
@@ -527,11 +542,14 @@ fn random_errors(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
 
 /// Section 4: the single pole under the same errors (figure 17).
 fn single_pole(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
-    let args = inp.args;
-    let faces = inp.faces;
-    let test = inp.test;
-    let results = inp.results;
-    let n = inp.n;
+    let &Input {
+        args,
+        faces,
+        test,
+        results,
+        n,
+        ..
+    } = inp;
     // 4. Single pole.
     rep.heading(
         2,
@@ -594,9 +612,12 @@ fn single_pole(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
 
 /// The figure-15 argument.
 fn figure15(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
-    let faces = inp.faces;
-    let test = inp.test;
-    let methods = inp.methods;
+    let &Input {
+        faces,
+        test,
+        methods,
+        ..
+    } = inp;
     // Figure 15 argument.
     let Figure15 {
         other,
@@ -619,9 +640,12 @@ fn figure15(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
 
 /// Section 5: what exactness changes.
 fn exactness(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
-    let faces = inp.faces;
-    let test = inp.test;
-    let results = inp.results;
+    let &Input {
+        faces,
+        test,
+        results,
+        ..
+    } = inp;
     // 5. Exact vs Dijkstra.
     rep.heading(2, "5. What exactness changes");
     let mut rows = Vec::new();

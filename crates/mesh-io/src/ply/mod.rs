@@ -15,21 +15,18 @@ use binary::read_binary;
 use header::parse_header;
 use records::Sink;
 
-/// PLY storage encoding.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PlyEncoding {
-    /// Text.
-    Ascii,
-    /// Binary, little endian.
-    BinaryLittleEndian,
-    /// Binary, big endian.
-    BinaryBigEndian,
+meshcore::choice! {
+    /// PLY storage encoding.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+    pub enum PlyEncoding: "PLY encoding", crate::IoError {
+        /// Text.
+        Ascii = "ascii",
+        /// Binary, little endian.
+        BinaryLittleEndian = "binary_little_endian" | "binary_le" | "binary",
+        /// Binary, big endian.
+        BinaryBigEndian = "binary_big_endian" | "binary_be",
+    }
 }
-meshcore::choice!(PlyEncoding, "PLY encoding", crate::IoError {
-    Ascii = "ascii",
-    BinaryLittleEndian = "binary_little_endian" | "binary_le" | "binary",
-    BinaryBigEndian = "binary_big_endian" | "binary_be",
-});
 
 /// What [`crate::write_ply`] writes besides positions (always `double x y z`) and faces
 /// (`list uchar int vertex_indices`).
