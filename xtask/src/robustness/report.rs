@@ -205,25 +205,19 @@ fn introduction(rep: &mut Report, inp: &Input<'_>, failures: &Failures) {
 
 /// Reference distances and point counts per face.
 fn reference_distances(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
-    let &Input {
-        faces,
-        results,
-        ref names,
-        ..
-    } = inp;
     // D per face.
     rep.heading(2, "Reference distances and point counts");
     let mut rows = Vec::new();
-    for (i, f) in faces.iter().enumerate() {
+    for (i, f) in inp.faces.iter().enumerate() {
         let mut r = vec![f.name.clone()];
-        for res in results {
+        for res in inp.results {
             r.push(format!("{:.3}", res.d[i]));
             r.push(format!("{} / {}", res.n_points[i].0, res.n_points[i].1));
         }
         rows.push(r);
     }
     let mut header = vec!["face".to_string()];
-    for nm in names {
+    for nm in &inp.names {
         header.push(format!("D ({nm}, cm)"));
         header.push(format!("points static / whole ({nm})"));
     }
@@ -235,26 +229,20 @@ fn reference_distances(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
 
 /// Section 1: the renders (figures 4, 5).
 fn renders(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
-    let &Input {
-        faces,
-        test,
-        results,
-        n,
-        ..
-    } = inp;
+    let n = inp.n;
     // 1. Renders.
     rep.heading(
         2,
         "1. Level curves, descriptor points and the static area (figures 4, 5)",
     );
     rep.para("Red: level curves of U_r (right outer eye corner); blue: of U_q (left); yellow: descriptor points (levels up to 2N); green: reference points. The static area (blue tint) is the set of vertices within D of both corners and above the horizontal plane through the nose tip (`docs/experiments.md`); orange points are the descriptor restricted to it.");
-    for res in results {
+    for res in inp.results {
         for nl in [5, 10, 30] {
             rep.figure(
                 &format!("render_{}_levels{nl}.svg", res.name),
                 &format!(
                     "{}: {nl} level curves between the corners ({})",
-                    faces[test].name, res.name
+                    inp.faces[inp.test].name, res.name
                 ),
             );
         }
@@ -271,32 +259,26 @@ fn renders(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
 
 /// Section 2: distance against resolution (figure 6) and the matrices (figure 7), with the separation table.
 fn resolution(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
-    let &Input {
-        faces,
-        test,
-        results,
-        n,
-        ..
-    } = inp;
+    let n = inp.n;
     // 2. Resolution sweep and matrix.
     rep.heading(
         2,
         "2. Shape distance against resolution (figure 6) and the 12 x 12 matrix (figure 7)",
     );
-    for res in results {
+    for res in inp.results {
         let mut series = Vec::new();
-        for j in 0..faces.len() {
-            if j == test {
+        for j in 0..inp.faces.len() {
+            if j == inp.test {
                 continue;
             }
             series.push(Series {
-                name: faces[j].name.clone(),
+                name: inp.faces[j].name.clone(),
                 points: res
                     .sweep
                     .iter()
                     .map(|(nl, row)| (f64::from(*nl), row[j]))
                     .collect(),
-                dashed: faces[j].person != faces[test].person,
+                dashed: inp.faces[j].person != inp.faces[inp.test].person,
             });
         }
         plot_figure(
@@ -305,16 +287,16 @@ fn resolution(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
             (
                 &format!(
                     "{} vs every other face, static area ({})",
-                    faces[test].name, res.name
+                    inp.faces[inp.test].name, res.name
                 ),
                 "levels N between the corners",
                 "normalised shape distance",
             ),
             &series,
-            &format!("distance from the test face against resolution; solid: same person, dashed: other persons ({})", res.name),
+            &format!("distance from the inp.test face against resolution; solid: same person, dashed: other persons ({})", res.name),
         )?;
         let mut hdr = vec!["N".to_string()];
-        hdr.extend(faces.iter().map(|f| f.name.clone()));
+        hdr.extend(inp.faces.iter().map(|f| f.name.clone()));
         let rows: Vec<Vec<String>> = res
             .sweep
             .iter()
@@ -328,7 +310,7 @@ fn resolution(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
         rep.csv(&format!("fig6_{}.csv", res.name), &h, &rows)?;
     }
     let mut sep_rows = Vec::new();
-    for res in results {
+    for res in inp.results {
         for (label, m, file) in [
             ("static area", &res.m_static, "static"),
             ("whole face (levels up to 2N)", &res.m_whole, "whole"),
@@ -341,10 +323,14 @@ fn resolution(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
                 &format!("pairwise distances, {label}, N = {n} ({})", res.name),
                 &format!("12 x 12 matrix, {label} ({})", res.name),
             )?;
-            sep_rows.push((res.name.clone(), label.to_string(), Sep::of(m, faces, test)));
+            sep_rows.push((
+                res.name.clone(),
+                label.to_string(),
+                Sep::of(m, inp.faces, inp.test),
+            ));
         }
     }
-    rep.para("Separation: the largest distance between two faces of the same person, the smallest between faces of different persons, and their ratio (> 1 means every same-person pair is closer than every different-person pair). 'Test row' restricts this to the pairs involving the neutral test face, which is what the paper's figure 6 shows.");
+    rep.para("Separation: the largest distance between two inp.faces of the same person, the smallest between inp.faces of different persons, and their ratio (> 1 means every same-person pair is closer than every different-person pair). 'Test row' restricts this to the pairs involving the neutral inp.test face, which is what the paper's figure 6 shows.");
     sep_table(
         rep,
         "separation.csv",
@@ -356,17 +342,11 @@ fn resolution(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
 
 /// Section 3: the perturbation grid (figures 9, 10).
 fn robustness(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
-    let &Input {
-        faces,
-        test,
-        results,
-        n,
-        ..
-    } = inp;
+    let n = inp.n;
     // 3. Robustness.
     rep.heading(2, "3. Robustness to reference-point errors (figures 9-13)");
-    rep.para(&format!("The left outer eye corner q of `{}` is moved along a straightest geodesic of length {}% of D, leaving at angle theta from the direction towards r (counter-clockwise about the outward normal); its distance field is recomputed from the moved surface point, D is recomputed, and the static descriptor at N = {n} is compared with the original one.", faces[test].name, RADII_PCT.iter().map(|p| format!("{p}")).collect::<Vec<_>>().join(", ")));
-    for res in results {
+    rep.para(&format!("The left outer eye corner q of `{}` is moved along a straightest geodesic of length {}% of D, leaving at angle theta from the direction towards r (counter-clockwise about the outward normal); its distance field is recomputed from the moved surface point, D is recomputed, and the static descriptor at N = {n} is compared with the original one.", inp.faces[inp.test].name, RADII_PCT.iter().map(|p| format!("{p}")).collect::<Vec<_>>().join(", ")));
+    for res in inp.results {
         rep.para(&format!("{}: {} of {} corner walks and {} nose-tip walks met the mesh boundary (the eye opening) before the full radius; those cells are left out (blank in the plots, NaN in the CSV).", res.name, res.truncated.0, RADII_PCT.len() * N_DIRS, res.truncated.1));
         let series: Vec<Series> = RADII_PCT
             .iter()
@@ -504,17 +484,11 @@ fn figure11(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
 
 /// Figures 12 and 13: matrices with random errors.
 fn random_errors(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
-    let &Input {
-        faces,
-        test,
-        results,
-        n,
-        ..
-    } = inp;
+    let n = inp.n;
     // Figures 12-13.
     rep.para(&format!("Figures 12 and 13: every face gets its own random error (seeded), radius uniform in [0, 5%] of D and a uniform direction: on q only, then on both r and q (independent draws); the 12 x 12 matrices are computed between the perturbed descriptors (N = {n}, static area)."));
     let mut rows = Vec::new();
-    for res in results {
+    for res in inp.results {
         for (label, m, file) in [
             ("error on q", &res.m_rand_one, "fig12_random_one"),
             ("errors on r and q", &res.m_rand_both, "fig13_random_both"),
@@ -527,7 +501,11 @@ fn random_errors(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
                 &format!("{label}, static area, N = {n} ({})", res.name),
                 &format!("{label} ({})", res.name),
             )?;
-            rows.push((res.name.clone(), label.to_string(), Sep::of(m, faces, test)));
+            rows.push((
+                res.name.clone(),
+                label.to_string(),
+                Sep::of(m, inp.faces, inp.test),
+            ));
         }
     }
     use SepColumn::*;
@@ -542,22 +520,15 @@ fn random_errors(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
 
 /// Section 4: the single pole under the same errors (figure 17).
 fn single_pole(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
-    let &Input {
-        args,
-        faces,
-        test,
-        results,
-        n,
-        ..
-    } = inp;
+    let n = inp.n;
     // 4. Single pole.
     rep.heading(
         2,
         "4. Single-pole representation around the nose tip (figures 15-17)",
     );
-    rep.para(&format!("Geodesic polar coordinates around the nose tip: {} rays (straightest geodesics at equal angles from the direction towards the eye-corner midpoint) and N = {n} radius levels of step D/N (radius from the same solver's distance field); keys (level, sector). Under the same perturbation grid the nose tip is moved by the same geodesic distances (directions measured from the eye-midpoint direction).", args.sectors));
+    rep.para(&format!("Geodesic polar coordinates around the nose tip: {} rays (straightest geodesics at equal angles from the direction towards the eye-corner midpoint) and N = {n} radius levels of step D/N (radius from the same solver's distance field); keys (level, sector). Under the same perturbation grid the nose tip is moved by the same geodesic distances (directions measured from the eye-midpoint direction).", inp.args.sectors));
     let mut rows = Vec::new();
-    for res in results {
+    for res in inp.results {
         let series = vec![
             radius_series("bipolar (q moved), mean", &res.grid_bip, mean, false),
             radius_series("single pole (nose moved), mean", &res.grid_pol, mean, false),
@@ -594,7 +565,11 @@ fn single_pole(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
                 let title = format!("{label} ({})", res.name);
                 matrix_figure(rep, inp, m, (file, &res.name), &title, &title)?;
             }
-            rows.push((res.name.clone(), label.to_string(), Sep::of(m, faces, test)));
+            rows.push((
+                res.name.clone(),
+                label.to_string(),
+                Sep::of(m, inp.faces, inp.test),
+            ));
         }
         let gb: Vec<f64> = res.grid_bip.iter().map(|g| g.2).collect();
         let gp: Vec<f64> = res.grid_pol.iter().map(|g| g.2).collect();
@@ -612,12 +587,6 @@ fn single_pole(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
 
 /// The figure-15 argument.
 fn figure15(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
-    let &Input {
-        faces,
-        test,
-        methods,
-        ..
-    } = inp;
     // Figure 15 argument.
     let Figure15 {
         other,
@@ -626,7 +595,7 @@ fn figure15(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
         reference,
     } = inp.fig15;
     let (global, reference) = (*global, *reference);
-    rep.para(&format!("Figure 15, on `{}` ({}): the polar rings 2, 4 and 6 are each rotated about their own centroid by a random rotation (0.5-1.5 rad). Aligning ring by ring (each ring with its own best rotation, as curve-by-curve methods do) gives distances ~0 for every ring, yet the global keyed distance between the two point sets is {}, {} the distance to another person (`{}`: {}).", faces[test].name, methods[0].used.name(), f4(global), if global > reference { "larger than" } else { "compared with" }, faces[*other].name, f4(reference)));
+    rep.para(&format!("Figure 15, on `{}` ({}): the polar rings 2, 4 and 6 are each rotated about their own centroid by a random rotation (0.5-1.5 rad). Aligning ring by ring (each ring with its own best rotation, as curve-by-curve inp.methods do) gives distances ~0 for every ring, yet the global keyed distance between the two point sets is {}, {} the distance to another person (`{}`: {}).", inp.faces[inp.test].name, inp.methods[0].used.name(), f4(global), if global > reference { "larger than" } else { "compared with" }, inp.faces[*other].name, f4(reference)));
     rep.table(
         &["ring", "per-ring distance"],
         &per_ring
@@ -640,17 +609,11 @@ fn figure15(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
 
 /// Section 5: what exactness changes.
 fn exactness(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
-    let &Input {
-        faces,
-        test,
-        results,
-        ..
-    } = inp;
     // 5. Exact vs Dijkstra.
     rep.heading(2, "5. What exactness changes");
     let mut rows = Vec::new();
-    for res in results {
-        let s = Sep::of(&res.m_static, faces, test);
+    for res in inp.results {
+        let s = Sep::of(&res.m_static, inp.faces, inp.test);
         let gb: Vec<f64> = res.grid_bip.iter().map(|g| g.2).collect();
         rows.push(vec![
             res.name.clone(),
@@ -666,20 +629,20 @@ fn exactness(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
             "method",
             "mean D (cm)",
             "static ratio (matrix)",
-            "static ratio (test row)",
+            "static ratio (inp.test row)",
             "mean perturbation distance",
             "seconds",
         ],
         &rows,
     );
-    if results.len() >= 2 {
-        let (a, b) = (&results[0], &results[1]);
+    if inp.results.len() >= 2 {
+        let (a, b) = (&inp.results[0], &inp.results[1]);
         let dd: Vec<f64> =
             a.d.iter()
                 .zip(&b.d)
                 .map(|(x, y)| (y - x) / x * 100.0)
                 .collect();
-        rep.para(&format!("D from {} exceeds D from {} by {:.2}% to {:.2}% across faces (edge paths overestimate).", b.name, a.name, min(&dd), max(&dd)));
+        rep.para(&format!("D from {} exceeds D from {} by {:.2}% to {:.2}% across inp.faces (edge paths overestimate).", b.name, a.name, min(&dd), max(&dd)));
     }
     Ok(())
 }
