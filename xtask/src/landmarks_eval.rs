@@ -6,6 +6,7 @@ use crate::experiments::pipeline::bar;
 use crate::experiments::scans::{
     sample_weights, scan_faces, scan_seed, FaceSpec, ScanArgs, ScanSetOptions,
 };
+use crate::paths::ModelArgs;
 use anyhow::{Context, Result};
 use facemodel::{FaceModel, LANDMARK_NAMES};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -32,12 +33,10 @@ pub struct Args {
     /// Seed (training and test faces use different streams derived from it).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Output folder (default `target/landmarks-eval/` in the workspace).
-    #[arg(long)]
-    pub out: Option<PathBuf>,
-    /// ICT model folder (default `<shared>/faces/ict-facekit/model`).
-    #[arg(long)]
-    pub model_dir: Option<PathBuf>,
+    /// ICT model folder (`--model-dir` or `--model`) and output folder (default
+    /// `target/landmarks-eval`).
+    #[command(flatten)]
+    pub io: ModelArgs,
     /// Test neutral faces only (no expressions).
     #[arg(long)]
     pub neutral: bool,
@@ -218,18 +217,11 @@ fn stats(name: &str, errs: &[f64]) -> Stats {
 
 /// Runs the evaluation.
 pub fn run(args: Args) -> Result<()> {
-    let model_dir = args
-        .model_dir
-        .clone()
-        .unwrap_or_else(crate::paths::default_model_dir);
+    let model_dir = args.io.model_dir();
     let ict = FaceModel::load(&model_dir)
         .with_context(|| format!("loading the ICT face model from {}", model_dir.display()))?;
     anyhow::ensure!(args.faces > 0, "--faces must be positive");
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| root.join("target").join("landmarks-eval"));
+    let out = args.io.out_dir("landmarks-eval");
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
     // Different streams for training and test faces.
     let train_seed = training_seed(args.seed);

@@ -35,3 +35,62 @@ pub fn default_out_dir(name: &str) -> PathBuf {
     };
     target.join(name)
 }
+
+/// `--faces` and `--out` of the tasks that read a face set.
+#[derive(Debug, Clone, clap::Args)]
+pub struct FaceSetArgs {
+    /// Folder of the face set (OBJ files + landmarks.json); default
+    /// `$BIPOLAR_SHARED/faces/ict-facekit/paper-set` (BIPOLAR_SHARED defaults to `../shared`).
+    #[arg(long)]
+    pub faces: Option<PathBuf>,
+    /// Report folder (default `target/<task>`).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+impl FaceSetArgs {
+    /// The face-set folder: `--faces` or the shared paper set.
+    pub fn faces_dir(&self) -> PathBuf {
+        self.faces.clone().unwrap_or_else(default_paper_set)
+    }
+
+    /// The report folder: `--out` or `target/<task>`.
+    pub fn out_dir(&self, task: &str) -> PathBuf {
+        self.out.clone().unwrap_or_else(|| default_out_dir(task))
+    }
+}
+
+/// The resolution of the bipolar and single-pole descriptors.
+#[derive(Debug, Clone, Copy, clap::Args)]
+pub struct ResolutionArgs {
+    /// Levels N between the two reference points (the bipolar step is D / N; the single-pole
+    /// radius levels use the same step).
+    #[arg(long, default_value_t = 10)]
+    pub levels: u32,
+    /// Angular sectors of the single-pole representation.
+    #[arg(long, default_value_t = 16)]
+    pub sectors: u32,
+}
+
+/// `--model` and `--out` of the tasks that sample faces from the ICT face model.
+#[derive(Debug, Clone, clap::Args)]
+pub struct ModelArgs {
+    /// ICT model folder (default `$BIPOLAR_SHARED/faces/ict-facekit/model`).
+    #[arg(long = "model", visible_alias = "model-dir")]
+    pub model: Option<PathBuf>,
+    /// Output folder (default `target/<task>`).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+impl ModelArgs {
+    /// The model folder: `--model` or the shared one.
+    pub fn model_dir(&self) -> PathBuf {
+        self.model.clone().unwrap_or_else(default_model_dir)
+    }
+
+    /// The output folder: `--out` or `target/<task>`.
+    pub fn out_dir(&self, task: &str) -> PathBuf {
+        self.out.clone().unwrap_or_else(|| default_out_dir(task))
+    }
+}

@@ -73,7 +73,7 @@ pub(super) fn run(
     base: &Base,
     res: &mut MethodResults,
 ) -> Result<()> {
-    let (faces, test, n) = (ctx.faces, ctx.test, ctx.args.levels);
+    let (faces, test, n) = (ctx.faces, ctx.test, ctx.args.res.levels);
     let tf = &faces[test];
     let cells: Vec<(f64, f64)> = RADII_PCT
         .iter()

@@ -21,7 +21,7 @@ use crate::experiments::pipeline::{
 };
 use crate::experiments::polar::PolarOptions;
 use crate::experiments::walk::Walker;
-use crate::paths::{default_out_dir, default_paper_set};
+use crate::paths::{FaceSetArgs, ResolutionArgs};
 use anyhow::{bail, Result};
 use bipolar::PolarDescriptor;
 use facemodel::{face_frame, load_face_set, Face};
@@ -29,29 +29,22 @@ use geodesic::{GeodesicSolver, Method, Source};
 use meshcore::{DVec3, TriMesh};
 use rayon::prelude::*;
 use shapedist::ShapeDistError;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Mutex;
 use std::time::Instant;
 
 /// Arguments of `cargo xtask robustness`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
-    /// Folder of the face set (OBJ files + landmarks.json); default
-    /// `$BIPOLAR_SHARED/faces/ict-facekit/paper-set` (BIPOLAR_SHARED defaults to `../shared`).
-    #[arg(long)]
-    pub faces: Option<PathBuf>,
-    /// Report folder (default `target/robustness`).
-    #[arg(long)]
-    pub out: Option<PathBuf>,
+    /// Face set and report folder (default `target/robustness`).
+    #[command(flatten)]
+    pub set: FaceSetArgs,
     /// Geodesic methods to run, comma separated (exact, fmm, heat, dijkstra).
     #[arg(long, default_value = "exact,dijkstra")]
     pub methods: String,
-    /// Number of levels between the two reference points (the default resolution).
-    #[arg(long, default_value_t = 10)]
-    pub levels: u32,
-    /// Angular sectors of the single-pole representation.
-    #[arg(long, default_value_t = 16)]
-    pub sectors: u32,
+    /// Descriptor resolution (the default N of the figures that do not vary it).
+    #[command(flatten)]
+    pub res: ResolutionArgs,
     /// Seed of the random reference-point errors.
     #[arg(long, default_value_t = 2013)]
     pub seed: u64,
@@ -233,9 +226,9 @@ impl Ctx<'_> {
     /// Options of the single-pole descriptor for a configuration.
     fn polar_opts(&self, r: &Refs) -> PolarOptions {
         PolarOptions {
-            step: r.d / f64::from(self.args.levels),
-            levels: self.args.levels,
-            sectors: self.args.sectors,
+            step: r.d / f64::from(self.args.res.levels),
+            levels: self.args.res.levels,
+            sectors: self.args.res.sectors,
         }
     }
 }
@@ -257,19 +250,16 @@ fn n_keys(d: &Desc) -> usize {
 /// Runs the task; prints the report folder on the last line.
 pub fn run(args: Args) -> Result<()> {
     let t0 = Instant::now();
-    let dir = args.faces.clone().unwrap_or_else(default_paper_set);
+    let dir = args.set.faces_dir();
     let faces = load_face_set(&dir)?;
     let test = faces
         .iter()
         .position(|f| f.name == "id1_neutral")
         .unwrap_or(0);
-    if args.levels < 2 || args.sectors < 3 {
+    if args.res.levels < 2 || args.res.sectors < 3 {
         bail!("--levels must be >= 2 and --sectors >= 3");
     }
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| default_out_dir("robustness"));
+    let out = args.set.out_dir("robustness");
     eprintln!(
         "{} faces from {}; test face {}",
         faces.len(),

@@ -5,7 +5,6 @@ use super::stats::{matrix_rows, max, mean, min, Sep, SepColumn};
 use super::{Args, Failures, MethodResults, N_DIRS, RADII_PCT};
 use crate::experiments::pipeline::{DescriptorRule, MethodUse};
 use crate::experiments::report::{f4, line_plot, Report, Series};
-use crate::paths::default_paper_set;
 use anyhow::Result;
 use facemodel::Face;
 use std::path::Path;
@@ -131,7 +130,7 @@ pub(super) fn write_report(
         fig15,
         labels: faces.iter().map(|f| f.name.clone()).collect(),
         names: results.iter().map(|r| r.name.as_str()).collect(),
-        n: args.levels,
+        n: args.res.levels,
     };
     let mut rep = Report::new(
         out,
@@ -169,10 +168,7 @@ fn introduction(rep: &mut Report, inp: &Input<'_>, failures: &Failures) {
          the optimal rotation, normalised to [0, 1] (see `docs/experiments.md`). Random seed {}.",
         faces.len(),
         persons.len(),
-        args.faces
-            .clone()
-            .unwrap_or_else(default_paper_set)
-            .display(),
+        args.set.faces_dir().display(),
         faces[inp.test].name,
         args.seed
     ));
@@ -526,7 +522,7 @@ fn single_pole(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
         2,
         "4. Single-pole representation around the nose tip (figures 15-17)",
     );
-    rep.para(&format!("Geodesic polar coordinates around the nose tip: {} rays (straightest geodesics at equal angles from the direction towards the eye-corner midpoint) and N = {n} radius levels of step D/N (radius from the same solver's distance field); keys (level, sector). Under the same perturbation grid the nose tip is moved by the same geodesic distances (directions measured from the eye-midpoint direction).", inp.args.sectors));
+    rep.para(&format!("Geodesic polar coordinates around the nose tip: {} rays (straightest geodesics at equal angles from the direction towards the eye-corner midpoint) and N = {n} radius levels of step D/N (radius from the same solver's distance field); keys (level, sector). Under the same perturbation grid the nose tip is moved by the same geodesic distances (directions measured from the eye-midpoint direction).", inp.args.res.sectors));
     let mut rows = Vec::new();
     for res in inp.results {
         let series = vec![
