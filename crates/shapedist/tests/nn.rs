@@ -46,16 +46,31 @@ fn tree_case(seed: u64, n: usize, kind: u8) -> (rand_chacha::ChaCha8Rng, Vec<DVe
     (r, pts, tree)
 }
 
+/// `(seed, n, kind)` of a [`tree_case`] with `1 <= n < max_n`.
+fn case(max_n: usize) -> impl Strategy<Value = (u64, usize, u8)> {
+    (0u64..1_000_000, 1usize..max_n, 0u8..3)
+}
+
+/// A uniform random offset in the cube of side `scale` centred at the origin.
+fn jitter(r: &mut rand_chacha::ChaCha8Rng, scale: f64) -> DVec3 {
+    DVec3::new(
+        r.random::<f64>() - 0.5,
+        r.random::<f64>() - 0.5,
+        r.random::<f64>() - 0.5,
+    ) * scale
+}
+
+/// A valid warm-start candidate for `q`: a random point of `pts` and its squared distance.
+fn random_candidate(r: &mut rand_chacha::ChaCha8Rng, pts: &[DVec3], q: DVec3) -> (f64, u32) {
+    let j = r.random_range(0..pts.len());
+    (dist2(pts[j], q), j as u32)
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
     #[test]
-    fn prop_tree_queries_equal_brute_force(
-        seed in 0u64..1_000_000,
-        n in 1usize..400,
-        kind in 0u8..3,
-        far in 0.0f64..3.0,
-    ) {
+    fn prop_tree_queries_equal_brute_force((seed, n, kind) in case(400), far in 0.0f64..3.0) {
         let (mut r, pts, tree) = tree_case(seed, n, kind);
         prop_assert_eq!(tree.len(), n);
         // Queries near and far from the set; on the grid, half-integer offsets give ties.
@@ -65,11 +80,7 @@ proptest! {
                 if kind == 2 && k % 2 == 0 {
                     base + DVec3::new(0.5, -0.5, 0.0) * (k % 4) as f64
                 } else {
-                    base + DVec3::new(
-                        r.random::<f64>() - 0.5,
-                        r.random::<f64>() - 0.5,
-                        r.random::<f64>() - 0.5,
-                    ) * far
+                    base + jitter(&mut r, far)
                 }
             })
             .collect();
@@ -77,8 +88,7 @@ proptest! {
         for (q, w) in qs.iter().zip(&want) {
             prop_assert_eq!(tree.nearest(*q), *w);
             // Warm start from any valid candidate gives the same exact answer.
-            let j = r.random_range(0..n) as u32;
-            let mut best = (dist2(pts[j as usize], *q), j);
+            let mut best = random_candidate(&mut r, &pts, *q);
             tree.nearest_from(*q, &mut best);
             prop_assert_eq!(best, *w);
             // A group of one (its group box is the point itself: the same pruning bound).
@@ -94,8 +104,7 @@ proptest! {
                 if k % 3 == 0 {
                     (f64::INFINITY, u32::MAX)
                 } else {
-                    let j = r.random_range(0..n) as u32;
-                    (dist2(pts[j as usize], q), j)
+                    random_candidate(&mut r, &pts, q)
                 }
             })
             .collect();
@@ -171,12 +180,7 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(48))]
 
     #[test]
-    fn prop_k_nearest_queries_equal_brute_force(
-        seed in 0u64..1_000_000,
-        n in 1usize..300,
-        kind in 0u8..3,
-        far in 0.0f64..2.0,
-    ) {
+    fn prop_k_nearest_queries_equal_brute_force((seed, n, kind) in case(300), far in 0.0f64..2.0) {
         let (mut r, pts, tree) = tree_case(seed, n, kind);
         let qs: Vec<DVec3> = (0..2 * GROUP + 5)
             .map(|_| {
@@ -191,8 +195,7 @@ proptest! {
             .map(|(k, &q)| {
                 let mut b = [(f64::INFINITY, u32::MAX); 5];
                 if k % 2 == 1 {
-                    let j = r.random_range(0..n) as u32;
-                    b[0] = (dist2(pts[j as usize], q), j);
+                    b[0] = random_candidate(&mut r, &pts, q);
                 }
                 b
             })
@@ -204,11 +207,7 @@ proptest! {
     }
 
     #[test]
-    fn prop_neighbour_graph_is_the_exact_k_nearest_graph(
-        seed in 0u64..1_000_000,
-        n in 1usize..300,
-        kind in 0u8..3,
-    ) {
+    fn prop_neighbour_graph_is_the_exact_k_nearest_graph((seed, n, kind) in case(300)) {
         let (_, pts, tree) = tree_case(seed, n, kind);
         let graph = NeighbourGraph::new(&tree);
         prop_assert_eq!(graph.len(), n);
@@ -225,12 +224,7 @@ proptest! {
     }
 
     #[test]
-    fn prop_certified_graph_walks_equal_brute_force(
-        seed in 0u64..1_000_000,
-        n in 1usize..400,
-        kind in 0u8..3,
-        off in 0.0f64..0.3,
-    ) {
+    fn prop_certified_graph_walks_equal_brute_force((seed, n, kind) in case(400), off in 0.0f64..0.3) {
         let (mut r, pts, tree) = tree_case(seed, n, kind);
         let graph = NeighbourGraph::new(&tree);
         let mut certified = 0;
@@ -241,11 +235,7 @@ proptest! {
             let q = if kind == 2 && k % 3 == 0 {
                 base + DVec3::new(0.5, 0.0, 0.0)
             } else {
-                base + DVec3::new(
-                    r.random::<f64>() - 0.5,
-                    r.random::<f64>() - 0.5,
-                    r.random::<f64>() - 0.5,
-                ) * off
+                base + jitter(&mut r, off)
             };
             let start = r.random_range(0..n) as u32;
             let (got, sure) = graph.descend(q, start, 64);

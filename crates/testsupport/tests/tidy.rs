@@ -32,6 +32,26 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
 /// `file:line: text` of every doc-comment line (`///`, `//!`) of the workspace's sources that
 /// satisfies `pred` (given the line in lower case); this file is left out.
 fn offenders(pred: impl Fn(&str) -> bool) -> Vec<String> {
+    lines_where(|t| (t.starts_with("///") || t.starts_with("//!")) && pred(&t.to_lowercase()))
+}
+
+/// `file:line: text` of every code line (not a comment) of the workspace's sources that
+/// satisfies `pred` (given the trimmed line), outside the files whose path ends with one of
+/// `except`; this file is left out.
+fn code_offenders(pred: impl Fn(&str) -> bool, except: &[&str]) -> Vec<String> {
+    lines_where(|t| !t.starts_with("//") && pred(t))
+        .into_iter()
+        .filter(|l| {
+            !except
+                .iter()
+                .any(|e| l.split(':').next().unwrap_or("").ends_with(e))
+        })
+        .collect()
+}
+
+/// `file:line: text` of every line of the workspace's sources whose trimmed text satisfies
+/// `pred`; this file is left out.
+fn lines_where(pred: impl Fn(&str) -> bool) -> Vec<String> {
     let root = workspace_root();
     let mut files = Vec::new();
     rust_files(&root.join("crates"), &mut files);
@@ -51,7 +71,7 @@ fn offenders(pred: impl Fn(&str) -> bool) -> Vec<String> {
         let rel = f.strip_prefix(&root).unwrap_or(f).display().to_string();
         for (i, line) in text.lines().enumerate() {
             let t = line.trim_start();
-            if (t.starts_with("///") || t.starts_with("//!")) && pred(&t.to_lowercase()) {
+            if pred(t) {
                 out.push(format!("{rel}:{}: {t}", i + 1));
             }
         }
@@ -93,6 +113,29 @@ fn no_until_it_lands_notes() {
     assert!(
         bad.is_empty(),
         "stale 'until X lands' notes:\n{}",
+        bad.join("\n")
+    );
+}
+
+#[test]
+fn os_errors_go_through_file_error() {
+    let bad = code_offenders(
+        |t| t.contains("std::io::Error,") && t.starts_with("source"),
+        &["meshcore/src/file.rs"],
+    );
+    assert!(
+        bad.is_empty(),
+        "an error variant carrying std::io::Error itself (use meshcore::FileError):\n{}",
+        bad.join("\n")
+    );
+}
+
+#[test]
+fn option_enums_are_declared_inside_choice() {
+    let bad = code_offenders(|t| t.contains("choice!("), &["meshcore/src/choice.rs"]);
+    assert!(
+        bad.is_empty(),
+        "choice!(Enum, ...) beside a separate enum (declare it inside choice! {{ ... }}):\n{}",
         bad.join("\n")
     );
 }
