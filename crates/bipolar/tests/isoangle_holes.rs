@@ -10,28 +10,16 @@ use bipolar::{
     describe, Descriptor, DescriptorOptions, Fields, IsoAngleOptions, IsoRepeats, LevelSpec,
     SelectionRule, Surface,
 };
-use facemodel::{face_frame, load_face_set, static_mask, Face};
-use geodesic::{new_solver, Method, SolveOptions, Source};
+use facemodel::{load_face_set, Face};
+use geodesic::Method;
+
+mod common;
 
 /// The iso-angle descriptor of `face` with `repeats`, and the second field.
 fn iso_descriptor(face: &Face, repeats: IsoRepeats) -> (Descriptor, Vec<f64>) {
-    let (m, lm) = (&face.mesh, face.landmarks);
-    let solver = new_solver(m, Method::Exact).unwrap();
-    let field = |v: u32| {
-        solver
-            .distances(&[Source::Vertex(v)], &SolveOptions::default())
-            .unwrap()
-    };
-    let (ur, uq) = (field(lm.right_eye_outer), field(lm.left_eye_outer));
-    let d = 0.5 * (ur[lm.left_eye_outer as usize] + uq[lm.right_eye_outer as usize]);
-    let (r, q, nose) = (
-        m.position(lm.right_eye_outer),
-        m.position(lm.left_eye_outer),
-        m.position(lm.nose_tip),
-    );
-    let mask = static_mask(m, &ur, &uq, d, &face_frame(m, r, q, nose), nose);
+    let common::CornerFields { ur, uq, d, mask } = common::corner_fields(face, Method::Exact);
     let desc = describe(
-        &Surface::new(m.clone()),
+        &Surface::new(face.mesh.clone()),
         Fields::Precomputed {
             fields: &[ur, uq.clone()],
             references: None,
