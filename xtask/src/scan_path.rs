@@ -6,7 +6,7 @@
 //! artifacts) at `--pitch` and writes the scan into the output folder first.
 
 use crate::paths::{default_model_dir, default_out_dir};
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use facemodel::FaceModel;
 use landmarks::GenericModel;
 use std::path::PathBuf;
@@ -25,9 +25,31 @@ pub struct Args {
     /// Runs of the whole path; the median of each step is reported.
     #[arg(long, default_value_t = 5)]
     pub repeats: usize,
+    /// Region of the descriptor: levels `1..=max_level` of both fields (default: as far as the
+    /// fields go, as `bipolar describe` without `--max-level`).
+    #[arg(long)]
+    pub max_level: Option<u32>,
     /// Output folder (default `target/scan-path`).
     #[arg(long)]
     pub out: Option<PathBuf>,
+}
+
+/// FNV-1a hash of the descriptor's keys and point positions (bit patterns): equal fingerprints
+/// mean the same descriptor, so a speed-up can be checked not to change it.
+fn fingerprint(d: &bipolar::Descriptor) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325_u64;
+    let mut eat = |x: u64| {
+        for b in x.to_le_bytes() {
+            h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+        }
+    };
+    for p in &d.points {
+        eat(p.key.pack());
+        for c in p.position.to_array() {
+            eat(c.to_bits());
+        }
+    }
+    h
 }
 
 fn median(mut v: Vec<Duration>) -> Duration {
@@ -62,58 +84,92 @@ pub fn run(args: Args) -> Result<()> {
         }
     };
     let generic = GenericModel::default_model()?;
+    let opts = bipolar::DescriptorOptions {
+        max_level: args.max_level,
+        ..bipolar::DescriptorOptions::default()
+    };
     let steps = [
         "read .bnt",
         "clean",
         "detect landmarks",
-        "describe (exact, N = 10)",
+        "prepare the exact solver",
+        "topology (Surface::new)",
+        "two exact fields (parallel)",
+        "descriptor from the fields",
     ];
     let mut times: Vec<Vec<Duration>> = vec![Vec::new(); steps.len() + 1];
     let mut info = String::new();
     for run in 0..args.repeats.max(1) {
-        let t0 = Instant::now();
+        let mut t = vec![Instant::now()];
         let grid = mesh_io::read_bnt_grid(&bnt)?;
-        let t1 = Instant::now();
+        t.push(Instant::now());
         let cleaned = scanprep::clean(
             scanprep::Input::Grid(&grid),
             &scanprep::CleanOptions::default(),
         )?;
-        let t2 = Instant::now();
+        t.push(Instant::now());
         let lm = landmarks::detect(&cleaned.mesh, &generic)?;
-        let t3 = Instant::now();
+        t.push(Instant::now());
         let n_vertices = cleaned.mesh.n_vertices();
         let solver = geodesic::new_solver(&cleaned.mesh, geodesic::Method::Exact)?;
+        t.push(Instant::now());
         let surface = bipolar::Surface::new(cleaned.mesh);
+        t.push(Instant::now());
+        let references = [
+            geodesic::Source::Vertex(lm.outer_eye_right.vertex),
+            geodesic::Source::Vertex(lm.outer_eye_left.vertex),
+        ];
+        // The fields as `bipolar::describe` solves them (in parallel, cut off past the region
+        // when there is one), timed apart from the rest of the descriptor.
+        let fields = bipolar::solve_fields(&surface, solver.as_ref(), &references, &opts)?;
+        t.push(Instant::now());
         let d = bipolar::describe(
             &surface,
-            bipolar::Fields::Solve {
-                solver: solver.as_ref(),
-                references: &[
-                    geodesic::Source::Vertex(lm.outer_eye_right.vertex),
-                    geodesic::Source::Vertex(lm.outer_eye_left.vertex),
-                ],
+            bipolar::Fields::Precomputed {
+                fields: &fields,
+                references: Some(&references),
             },
-            &bipolar::DescriptorOptions::default(),
+            &opts,
         )?;
-        let t4 = Instant::now();
-        for (k, (a, b)) in [(t0, t1), (t1, t2), (t2, t3), (t3, t4), (t0, t4)]
-            .into_iter()
-            .enumerate()
-        {
-            times[k].push(b - a);
+        t.push(Instant::now());
+        let n = t.len() - 1;
+        for k in 0..n {
+            times[k].push(t[k + 1] - t[k]);
         }
+        times[n].push(t[n] - t[0]);
         if run == 0 {
+            // The split must not change the result: the same descriptor as in one call.
+            let whole = bipolar::describe(
+                &surface,
+                bipolar::Fields::Solve {
+                    solver: solver.as_ref(),
+                    references: &references,
+                },
+                &opts,
+            )?;
+            if whole.points != d.points {
+                bail!("the descriptor from the timed fields differs from describe's own");
+            }
             let valid = (0..grid.xyz.len()).filter(|&i| grid.is_valid(i)).count();
             info = format!(
-                "{}: {} x {} grid, {valid} valid samples; cleaned mesh {} vertices; descriptor {} points",
+                "{}: {} x {} grid, {valid} valid samples; cleaned mesh {} vertices; landmarks at vertices {:?}; descriptor {} points ({} ambiguous), fingerprint {:016x}",
                 bnt.display(),
                 grid.nrows,
                 grid.ncols,
                 n_vertices,
-                d.points.len()
+                [
+                    lm.outer_eye_right.vertex,
+                    lm.inner_eye_right.vertex,
+                    lm.inner_eye_left.vertex,
+                    lm.outer_eye_left.vertex,
+                    lm.nose_tip.vertex
+                ],
+                d.points.len(),
+                d.stats.ambiguous,
+                fingerprint(&d)
             );
         }
-        eprintln!("run {}: {:.3} s", run + 1, (t4 - t0).as_secs_f64());
+        eprintln!("run {}: {:.3} s", run + 1, (t[n] - t[0]).as_secs_f64());
     }
     println!("{info}");
     println!(
@@ -127,7 +183,7 @@ pub fn run(args: Args) -> Result<()> {
         .enumerate()
     {
         let m = median(times[k].clone());
-        println!("  {name:<26} {:>8.1} ms", m.as_secs_f64() * 1e3);
+        println!("  {name:<30} {:>8.1} ms", m.as_secs_f64() * 1e3);
         md += &format!("| {name} | {:.1} ms |\n", m.as_secs_f64() * 1e3);
     }
     std::fs::write(out.join("report.md"), md)?;

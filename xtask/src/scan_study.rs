@@ -51,8 +51,17 @@ pub struct Args {
     #[arg(long, default_value_t = 0)]
     pub settings: usize,
     /// ICP probe points per scan (static-area vertices, evenly strided).
-    #[arg(long, default_value_t = 300)]
+    #[arg(long, default_value_t = 200)]
     pub icp_points: usize,
+    /// Which pairs of scans are compared: `study` (every pair of two acquisitions of one face,
+    /// and every pair within one setting: other persons and id1's expressions are compared
+    /// under equal conditions) or `all` (every pair, which for the 8 settings is 4.6k pairs,
+    /// five times as many, mostly other persons across settings).
+    #[arg(long, default_value = "study", value_parser = ["study", "all"])]
+    pub pairs: String,
+    /// Only the faces whose name contains one of these strings (comma separated; default all).
+    #[arg(long, value_delimiter = ',')]
+    pub only: Vec<String>,
     /// Largest distance (mm) between a projected landmark and the cleaned scan surface; farther
     /// landmarks (occluded, in a hole, cropped) make the scan unusable.
     #[arg(long, default_value_t = 2.0)]
@@ -419,8 +428,10 @@ impl Variant {
 }
 
 /// The bipolar variants: the experiments' rule (`All`, grid keys) and the iso-angle rule with
-/// every crossing (the former behaviour) and with the monotone fit (the library's default).
-const VARIANTS: [Variant; 3] = [
+/// every crossing (the first behaviour), with the monotone fit keeping repeated keys as ambiguous
+/// (the second) and with the monotone fit and repeated keys resolved to the place nearest the
+/// geodesic between the references (the library's default).
+const VARIANTS: [Variant; 4] = [
     Variant {
         name: "bipolar All",
         options: || bipolar::DescriptorOptions {
@@ -434,17 +445,31 @@ const VARIANTS: [Variant; 3] = [
             rule: bipolar::SelectionRule::IsoAngle,
             isoangle: bipolar::IsoAngleOptions {
                 crossings: bipolar::IsoCrossings::Every,
+                repeats: bipolar::IsoRepeats::Ambiguous,
                 ..Default::default()
             },
             ..Default::default()
         },
     },
     Variant {
-        name: "bipolar iso-angle, monotone",
+        name: "bipolar iso-angle, monotone, repeats ambiguous",
         options: || bipolar::DescriptorOptions {
             rule: bipolar::SelectionRule::IsoAngle,
             isoangle: bipolar::IsoAngleOptions {
                 crossings: bipolar::IsoCrossings::Monotone,
+                repeats: bipolar::IsoRepeats::Ambiguous,
+                ..Default::default()
+            },
+            ..Default::default()
+        },
+    },
+    Variant {
+        name: "bipolar iso-angle, monotone, nearest",
+        options: || bipolar::DescriptorOptions {
+            rule: bipolar::SelectionRule::IsoAngle,
+            isoangle: bipolar::IsoAngleOptions {
+                crossings: bipolar::IsoCrossings::Monotone,
+                repeats: bipolar::IsoRepeats::Nearest,
                 ..Default::default()
             },
             ..Default::default()
@@ -481,7 +506,17 @@ fn quantiles(v: &[f64]) -> (f64, f64, f64, usize) {
 pub fn run(args: Args) -> Result<()> {
     let t0 = Instant::now();
     let dir = args.faces.clone().unwrap_or_else(default_paper_set);
-    let faces = load_face_set(&dir)?;
+    let mut faces = load_face_set(&dir)?;
+    if !args.only.is_empty() {
+        faces.retain(|f| args.only.iter().any(|o| f.name.contains(o.as_str())));
+        if faces.is_empty() {
+            bail!(
+                "no face of {} matches --only {:?}",
+                dir.display(),
+                args.only
+            );
+        }
+    }
     let out = args
         .out
         .clone()
@@ -527,9 +562,15 @@ pub fn run(args: Args) -> Result<()> {
         .collect();
     let locators: Vec<FaceLocator<'_>> =
         ok.iter().map(|(_, d)| FaceLocator::new(&d.mesh)).collect();
+    let all_pairs = args.pairs == "all";
     let idx_pairs: Vec<(usize, usize)> = (0..ok.len())
         .flat_map(|a| (a + 1..ok.len()).map(move |b| (a, b)))
+        .filter(|&(a, b)| {
+            let (x, y) = (&scans[ok[a].0], &scans[ok[b].0]);
+            all_pairs || x.face == y.face || x.setting == y.setting
+        })
         .collect();
+    let t_pairs = Instant::now();
     let pb = bar(idx_pairs.len(), "distances");
     let pairs: Vec<Pair> = idx_pairs
         .par_iter()
@@ -563,6 +604,11 @@ pub fn run(args: Args) -> Result<()> {
         })
         .collect();
     pb.finish();
+    eprintln!(
+        "{} pairs compared in {:.0} s",
+        pairs.len(),
+        t_pairs.elapsed().as_secs_f64()
+    );
     write_outputs(&args, &faces, &sets, &scans, &pairs, &out, t0)?;
     println!("{}", out.display());
     Ok(())
@@ -661,6 +707,18 @@ fn write_outputs(
         args.levels,
         args.sectors,
         args.icp_points
+    );
+    let _ = writeln!(
+        md,
+        "Pairs compared ({} of them, `--pairs {}`): {}\n",
+        pairs.len(),
+        args.pairs,
+        if args.pairs == "all" {
+            "every pair of usable scans."
+        } else {
+            "every two acquisitions of one face, and every two faces within one setting \
+             (pairs of other persons across settings are left out)."
+        }
     );
     let failed: Vec<String> = scans
         .iter()

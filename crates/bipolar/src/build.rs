@@ -65,14 +65,28 @@ pub fn describe(
     }
 }
 
-/// [`Fields::Solve`]: one field per reference with `solver`, then [`describe_fields`].
-fn solve_and_describe(
+/// The distance fields [`describe`] solves for [`Fields::Solve`]: one per reference point, in
+/// parallel, each cut off just past the region when `opts.max_level` limits it (every value the
+/// descriptor reads is the uncut one). `describe` with [`Fields::Precomputed`] of these fields
+/// and the same references gives the same descriptor as with [`Fields::Solve`]; the split lets
+/// callers time or reuse the fields.
+pub fn solve_fields(
+    surface: &Surface,
+    solver: &dyn GeodesicSolver,
+    references: &[Source],
+    opts: &DescriptorOptions,
+) -> Result<Vec<Vec<f64>>, BipolarError> {
+    fields_for(surface.mesh(), surface.topology(), solver, references, opts)
+}
+
+/// [`solve_fields`] on a mesh and its topology.
+fn fields_for(
     mesh: &TriMesh,
     topo: &Topology,
     solver: &dyn GeodesicSolver,
     refs: &[Source],
     opts: &DescriptorOptions,
-) -> Result<Descriptor, BipolarError> {
+) -> Result<Vec<Vec<f64>>, BipolarError> {
     if refs.len() < 2 || refs.len() > 256 {
         return Err(BipolarError::ReferenceCount(refs.len()));
     }
@@ -84,10 +98,22 @@ fn solve_and_describe(
         )));
     }
     check_references(mesh, topo, refs)?;
-    let fields = match opts.max_level {
-        Some(m) if m > 0 => region_fields(mesh, topo, solver, refs, opts.levels, m)?,
-        _ => solve_all(solver, refs, &vec![None; refs.len()])?,
-    };
+    match opts.max_level {
+        Some(m) if m > 0 => region_fields(mesh, topo, solver, refs, opts.levels, m),
+        _ => solve_all(solver, refs, &vec![None; refs.len()]),
+    }
+}
+
+/// [`Fields::Solve`]: one field per reference with `solver` ([`fields_for`]), then
+/// [`describe_fields`].
+fn solve_and_describe(
+    mesh: &TriMesh,
+    topo: &Topology,
+    solver: &dyn GeodesicSolver,
+    refs: &[Source],
+    opts: &DescriptorOptions,
+) -> Result<Descriptor, BipolarError> {
+    let fields = fields_for(mesh, topo, solver, refs, opts)?;
     describe_fields(mesh, topo, &fields, Some(refs), opts)
 }
 

@@ -33,7 +33,7 @@ pub mod polar;
 pub mod synthetic;
 mod types;
 
-pub use build::{describe, Fields};
+pub use build::{describe, solve_fields, Fields};
 pub use error::BipolarError;
 pub use geodesic::Source;
 pub use key::Key;
@@ -41,5 +41,6 @@ pub use meshcore::Surface;
 pub use polar::{describe_polar, PolarDescriptor, PolarKey, PolarOptions, PolarPoint};
 pub use types::{
     Descriptor, DescriptorOptions, DescriptorPoint, DescriptorStats, IsoAngleOptions, IsoCrossings,
-    LevelSpec, SelectionKind, SelectionRule, SplineOptions, StripOptions, TangentMethod,
+    IsoRepeats, LevelSpec, SelectionKind, SelectionRule, SplineOptions, StripOptions,
+    TangentMethod,
 };

@@ -111,6 +111,28 @@ meshcore::choice!(IsoCrossings, "iso-angle crossings", crate::BipolarError {
     Every = "every",
 });
 
+/// What the iso-angle rule ([`SelectionRule::IsoAngle`]) does with a key found at several
+/// places of one level curve of the first field. A level curve cut by a hole (on faces, the eye
+/// openings between the outer eye corners) comes in pieces, one on each side of the hole, whose
+/// opening ranges overlap: each piece then holds a point with the same key `(i, k, side, sign)`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum IsoRepeats {
+    /// Keep the place nearest the geodesic between the two references, the one with the
+    /// smallest second field `U_b` (on level `i` of `U_a`, the smallest `U_a + U_b`): the piece
+    /// on the side of the hole where the two fields meet directly. Only when every other place is
+    /// farther by at least a quarter of the level step; otherwise all stay, flagged ambiguous.
+    /// The default.
+    #[default]
+    Nearest,
+    /// Keep every place, flagged ambiguous (never paired by a keyed distance).
+    Ambiguous,
+}
+
+meshcore::choice!(IsoRepeats, "iso-angle repeated keys", crate::BipolarError {
+    Nearest = "nearest",
+    Ambiguous = "ambiguous",
+});
+
 /// Settings of the iso-angle rule.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct IsoAngleOptions {
@@ -119,6 +141,9 @@ pub struct IsoAngleOptions {
     /// Gaussian smoothing of the opening angle along the curve before the crossings are taken:
     /// standard deviation in units of the mean edge length (0: none).
     pub smoothing: f64,
+    /// What happens to a key found at several places.
+    #[serde(default)]
+    pub repeats: IsoRepeats,
 }
 
 impl Default for IsoAngleOptions {
@@ -126,6 +151,7 @@ impl Default for IsoAngleOptions {
         Self {
             crossings: IsoCrossings::Monotone,
             smoothing: 0.0,
+            repeats: IsoRepeats::Nearest,
         }
     }
 }

@@ -743,6 +743,8 @@ fn option_names_round_trip_and_bad_names_list_the_choices() {
     use bipolar::{BipolarError, SelectionKind, SelectionRule, TangentMethod};
     meshcore::choice::check_choice::<TangentMethod>("normal").unwrap();
     meshcore::choice::check_choice::<SelectionKind>("band").unwrap();
+    meshcore::choice::check_choice::<bipolar::IsoRepeats>("first").unwrap();
+    meshcore::choice::check_choice::<bipolar::IsoCrossings>("some").unwrap();
     let k: SelectionKind = "iso-angle".parse().unwrap();
     assert_eq!(k.rule(0.1), SelectionRule::IsoAngle);
     assert_eq!(

@@ -278,6 +278,7 @@ fn monotone_rule_is_invariant_under_renumbering_and_rigid_motion_on_a_noisy_plan
         isoangle: IsoAngleOptions {
             crossings: IsoCrossings::Monotone,
             smoothing: 2.0,
+            ..IsoAngleOptions::default()
         },
         ..o.clone()
     };
@@ -322,6 +323,7 @@ fn bad_smoothing_is_refused() {
             isoangle: IsoAngleOptions {
                 crossings: IsoCrossings::Monotone,
                 smoothing: s,
+                ..IsoAngleOptions::default()
             },
             ..DescriptorOptions::default()
         };

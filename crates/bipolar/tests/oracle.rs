@@ -5,9 +5,11 @@
 //! face's bounding-box diagonal. Skipped when the shared data folder is absent.
 
 use bipolar::{describe, DescriptorOptions, Fields, LevelSpec, SelectionRule, Surface};
-use facemodel::{face_frame, load_face_set, static_mask};
-use geodesic::{new_solver, Method, SolveOptions, Source};
+use facemodel::load_face_set;
+use geodesic::Method;
 use testsupport::oracle::{bipolar_grid, grid_key_parts, GridOptions};
+
+mod common;
 
 #[test]
 fn rule_all_equals_the_oracle_on_paper_faces() {
@@ -18,21 +20,8 @@ fn rule_all_equals_the_oracle_on_paper_faces() {
         .iter()
         .filter(|f| ["id1_neutral", "id1_anger", "id2_neutral"].contains(&f.name.as_str()))
     {
-        let (m, lm) = (&f.mesh, f.landmarks);
-        let solver = new_solver(m, Method::Dijkstra).unwrap();
-        let field = |v: u32| {
-            solver
-                .distances(&[Source::Vertex(v)], &SolveOptions::default())
-                .unwrap()
-        };
-        let (ur, uq) = (field(lm.right_eye_outer), field(lm.left_eye_outer));
-        let d = 0.5 * (ur[lm.left_eye_outer as usize] + uq[lm.right_eye_outer as usize]);
-        let (r, q, nose) = (
-            m.position(lm.right_eye_outer),
-            m.position(lm.left_eye_outer),
-            m.position(lm.nose_tip),
-        );
-        let mask = static_mask(m, &ur, &uq, d, &face_frame(m, r, q, nose), nose);
+        let m = &f.mesh;
+        let common::CornerFields { ur, uq, d, mask } = common::corner_fields(f, Method::Dijkstra);
         let surface = Surface::new(m.clone());
         let tol = 1e-12 * m.bbox().diagonal();
         let step = d / 10.0;

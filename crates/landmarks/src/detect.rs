@@ -80,11 +80,11 @@ pub(crate) fn surface_index(mesh: &TriMesh) -> SurfaceIndex {
 }
 
 /// The vertices at which candidates are looked for, in increasing order: every vertex when the
-/// mesh's mean edge is at least half of `spacing`, else the first vertex (lowest id) in each
-/// occupied cube of side `spacing`.
+/// mesh's mean edge is at least `spacing` (a mesh as coarse as the training faces), else the
+/// first vertex (lowest id) in each occupied cube of side `spacing`.
 fn spaced_vertices(mesh: &TriMesh, spacing: f64) -> Vec<u32> {
     let n = mesh.n_vertices() as u32;
-    if !(spacing > 0.0 && spacing.is_finite()) || mesh.mean_edge_length() >= 0.5 * spacing {
+    if !(spacing > 0.0 && spacing.is_finite()) || mesh.mean_edge_length() >= spacing {
         return (0..n).collect();
     }
     let mut seen = std::collections::HashSet::new();
@@ -261,6 +261,14 @@ pub fn detect_with(
     // apart: every vertex of a mesh as coarse as the training faces, a subsample of a dense scan
     // (its fits still use every neighbour).
     let at = spaced_vertices(mesh_m, p.curvature_radius / 6.0);
+    if debug {
+        eprintln!(
+            "[{:.1} ms] index and adjacency built; curvature at {} of {} vertices",
+            clock.elapsed().as_secs_f64() * 1e3,
+            at.len(),
+            mesh_m.n_vertices()
+        );
+    }
     let curv = curvatures_at(
         mesh_m,
         &idx.nrm,
@@ -428,6 +436,10 @@ pub fn detect_with(
         fits.extend(fine);
         fits.sort_by(|a, b| a.h.fit.cost.total_cmp(&b.h.fit.cost));
         if debug {
+            eprintln!(
+                "[{:.1} ms] coarse and fine fits done",
+                clock.elapsed().as_secs_f64() * 1e3
+            );
             for f in &fits {
                 eprintln!(
                     "fit cost {:.4} confidence {:.3} symmetry {:.3} nose at {:?}",
@@ -532,6 +544,12 @@ pub fn detect_with(
             ..l
         });
         let pose = DAffine3::from_mat3_translation(best.t.matrix3, best.t.translation * s);
+        if debug {
+            eprintln!(
+                "[{:.1} ms] landmarks placed and checked",
+                clock.elapsed().as_secs_f64() * 1e3
+            );
+        }
         return Ok(Landmarks {
             outer_eye_right: out[L::OuterEyeRight as usize],
             inner_eye_right: out[L::InnerEyeRight as usize],

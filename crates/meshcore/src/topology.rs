@@ -82,10 +82,11 @@ impl Topology {
             }
         }
 
-        // Unique edges.
-        let mut map: HashMap<(u32, u32), u32> = HashMap::with_capacity(tris.len() * 3 / 2 + 1);
+        // Unique edges. An edge met before was met as a side of an earlier face around its lower
+        // end (those faces are listed in increasing order), or as an earlier side of this face:
+        // a look-up in that fan, no hashing.
         let mut edges: Vec<Edge> = Vec::with_capacity(tris.len() * 3 / 2 + 1);
-        let mut face_edges = Vec::with_capacity(tris.len());
+        let mut face_edges: Vec<[u32; 3]> = Vec::with_capacity(tris.len());
         let mut inconsistent = Vec::new();
         // Directed orientation of each edge in its first face: true if traversed lo->hi.
         let mut first_dir: Vec<bool> = Vec::with_capacity(edges.capacity());
@@ -95,7 +96,23 @@ impl Topology {
                 let (a, b) = (t[k], t[(k + 1) % 3]);
                 let key = (a.min(b), a.max(b));
                 let forward = a < b;
-                let id = *map.entry(key).or_insert_with(|| {
+                let same = |s: &[u32; 3], j: usize| {
+                    let (x, y) = (s[j], s[(j + 1) % 3]);
+                    (x.min(y), x.max(y)) == key
+                };
+                let lo = key.0 as usize;
+                let fan = &list[offsets[lo] as usize..offsets[lo + 1] as usize];
+                let earlier = fan
+                    .iter()
+                    .take_while(|&&g| (g as usize) < f)
+                    .find_map(|&g| {
+                        let s = &tris[g as usize];
+                        (0..3)
+                            .find(|&j| same(s, j))
+                            .map(|j| face_edges[g as usize][j])
+                    })
+                    .or_else(|| (0..k).find(|&j| same(t, j)).map(|j| fe[j]));
+                let id = earlier.unwrap_or_else(|| {
                     edges.push(Edge {
                         v: [key.0, key.1],
                         faces: [NO_FACE, NO_FACE],
@@ -148,12 +165,17 @@ impl Topology {
                 }
             }
         }
-        let mut comp_of_root: HashMap<u32, u32> = HashMap::new();
+        // Components numbered in order of their first vertex.
+        let mut comp_of_root = vec![u32::MAX; n];
+        let mut n_components = 0u32;
         let mut vertex_component = vec![0u32; n];
         for v in 0..n as u32 {
-            let r = find(&mut parent, v);
-            let next = comp_of_root.len() as u32;
-            vertex_component[v as usize] = *comp_of_root.entry(r).or_insert(next);
+            let r = find(&mut parent, v) as usize;
+            if comp_of_root[r] == u32::MAX {
+                comp_of_root[r] = n_components;
+                n_components += 1;
+            }
+            vertex_component[v as usize] = comp_of_root[r];
         }
         let isolated_vertices = (0..n).filter(|&v| offsets[v + 1] == offsets[v]).count();
 
@@ -164,7 +186,7 @@ impl Topology {
             face_edges,
             boundary_loops: Vec::new(),
             vertex_component,
-            n_components: comp_of_root.len(),
+            n_components: n_components as usize,
             isolated_vertices,
             non_manifold_edges,
             non_manifold_vertices: Vec::new(),
@@ -388,6 +410,64 @@ mod tests {
         let tris: Vec<[u32; 3]> = tris.into_iter().map(|[a, b, c]| [c, b, a]).rev().collect();
         let t = Topology::new(&TriMesh::new(pos, tris).unwrap());
         assert_eq!(t.n_components, 1);
+    }
+
+    /// Edge ids by first appearance, counted with a hash map (the plain statement of the rule).
+    fn reference_edges(tris: &[[u32; 3]]) -> (Vec<[u32; 2]>, Vec<[u32; 3]>) {
+        let mut map: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut ends = Vec::new();
+        let face_edges = tris
+            .iter()
+            .map(|t| {
+                [0, 1, 2].map(|k| {
+                    let (a, b) = (t[k], t[(k + 1) % 3]);
+                    let key = (a.min(b), a.max(b));
+                    *map.entry(key).or_insert_with(|| {
+                        ends.push([key.0, key.1]);
+                        (ends.len() - 1) as u32
+                    })
+                })
+            })
+            .collect();
+        (ends, face_edges)
+    }
+
+    #[test]
+    fn edge_ids_follow_first_appearance() {
+        // Shuffled faces and corners, repeated corners, non-manifold edges, duplicate faces.
+        let mut state = 7u64;
+        let mut next = |m: u32| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((state >> 33) % m as u64) as u32
+        };
+        let (pos, mut tris) = grid(9, 7).into_parts();
+        for i in (1..tris.len()).rev() {
+            tris.swap(i, next(i as u32 + 1) as usize);
+        }
+        for t in tris.iter_mut() {
+            t.rotate_left(next(3) as usize);
+        }
+        let nv = pos.len() as u32;
+        for _ in 0..20 {
+            let t = [next(nv), next(nv), next(nv)];
+            tris.push(t);
+            tris.push([t[0], t[0], t[1]]);
+        }
+        let dup = tris[3];
+        tris.push(dup);
+        let m = TriMesh::new(pos, tris).unwrap();
+        let topo = Topology::new(&m);
+        let (ends, face_edges) = reference_edges(m.triangles());
+        assert_eq!(topo.face_edges, face_edges);
+        assert_eq!(topo.edges.iter().map(|e| e.v).collect::<Vec<_>>(), ends);
+        for (f, fe) in topo.face_edges.iter().enumerate() {
+            for &e in fe {
+                let edge = &topo.edges[e as usize];
+                assert!(edge.faces[0] as usize <= f);
+            }
+        }
     }
 
     #[test]

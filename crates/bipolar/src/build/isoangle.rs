@@ -2,7 +2,9 @@
 //! opening equals an angle level exactly.
 
 use super::{sort_points, Ctx, PairCtx, SplineSet, Strip};
-use crate::{BipolarError, DescriptorPoint, DescriptorStats, IsoCrossings, Key, TangentMethod};
+use crate::{
+    BipolarError, DescriptorPoint, DescriptorStats, IsoCrossings, IsoRepeats, Key, TangentMethod,
+};
 use glam::DVec3;
 use levelcurves::isolines_uniform;
 use levelcurves::Isoline;
@@ -151,10 +153,19 @@ impl Ctx<'_> {
                 }
             }
         }
-        // Ambiguity: several points with one key.
+        // Repeated keys: one key at several places (pieces of one level curve separated by a
+        // hole, wiggles of the opening with every crossing).
         let mine = &mut out[start..];
         sort_points(mine);
         let n = mine.len();
+        let ub_at = |p: &DescriptorPoint| {
+            let t = self.mesh.triangles()[p.face as usize];
+            (0..3)
+                .map(|k| p.bary[k] * pair.fb[t[k] as usize])
+                .sum::<f64>()
+        };
+        let margin = 0.25 * self.step;
+        let mut drop = vec![false; n];
         let mut s = 0;
         while s < n {
             let mut e = s + 1;
@@ -162,10 +173,26 @@ impl Ctx<'_> {
                 e += 1;
             }
             if e - s > 1 {
-                mine[s..e].iter_mut().for_each(|p| p.ambiguous = true);
+                let nearest = match self.opts.isoangle.repeats {
+                    IsoRepeats::Nearest => {
+                        nearest_of(&mine[s..e].iter().map(ub_at).collect::<Vec<_>>(), margin)
+                    }
+                    IsoRepeats::Ambiguous => None,
+                };
+                match nearest {
+                    Some(keep) => (s..e)
+                        .filter(|&q| q != s + keep)
+                        .for_each(|q| drop[q] = true),
+                    None => mine[s..e].iter_mut().for_each(|p| p.ambiguous = true),
+                }
             }
             s = e;
         }
+        let mut q = 0;
+        out.retain(|_| {
+            q += 1;
+            q <= start || !drop[q - 1 - start]
+        });
         Ok(n)
     }
 
@@ -373,6 +400,18 @@ impl Ctx<'_> {
     }
 }
 
+/// [`IsoRepeats::Nearest`]: among the places of one key with second-field values `ub` (on one
+/// level of the first field, so `ub` orders them by `U_a + U_b`, their distance from the
+/// geodesic between the references), the index of the one nearest the geodesic when every other
+/// is farther by at least `margin`; `None` when two are too close to tell.
+fn nearest_of(ub: &[f64], margin: f64) -> Option<usize> {
+    let best = (0..ub.len()).min_by(|&x, &y| ub[x].total_cmp(&ub[y]))?;
+    let clear = ub.iter().enumerate().all(|(k, &u)| {
+        k == best || (u.is_finite() && ub[best].is_finite() && u - ub[best] >= margin)
+    });
+    clear.then_some(best)
+}
+
 /// Per-point values along one level-curve piece.
 struct CurveValues<'a> {
     /// Cosine of the opening (NaN where a tangent is undefined).
@@ -499,6 +538,14 @@ mod tests {
         );
         let f = isotonic_increasing(&[3.0, 1.0, 2.0], &[1.0, 1.0, 2.0]);
         assert!(f.iter().all(|&x| (x - 2.0).abs() < 1e-15), "{f:?}");
+    }
+
+    #[test]
+    fn nearest_needs_a_clear_margin() {
+        assert_eq!(nearest_of(&[80.0, 76.0, 90.0], 2.5), Some(1));
+        assert_eq!(nearest_of(&[76.5, 76.0], 2.5), None);
+        assert_eq!(nearest_of(&[f64::NAN, 76.0], 2.5), None);
+        assert_eq!(nearest_of(&[], 2.5), None);
     }
 
     #[test]
