@@ -87,51 +87,45 @@ impl SelectionRule {
     }
 }
 
-/// How the iso-angle rule ([`SelectionRule::IsoAngle`]) turns the opening along a level curve
-/// into points.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-pub enum IsoCrossings {
-    /// One point per angle level and curve run: along each run of a level curve (a piece, cut
-    /// where a tangent is undefined), the signed opening angle `psi = atan2(sin, cos)` between
-    /// the two tangents (unwrapped, `sin` signed by the side) is replaced by its best monotone
-    /// least-squares fit (isotonic regression, weighted by arc length; increasing or decreasing,
-    /// whichever fits better), and each angle level is taken where the fit crosses it. On a
-    /// smooth surface the opening is monotone along the curve and this equals
-    /// [`IsoCrossings::Every`]; on noisy or faceted meshes the raw opening wiggles around a
-    /// level and crosses it several times, which this rule turns into one point. The default.
-    #[default]
-    Monotone,
-    /// Every crossing of an angle level by the piecewise-linear opening along the curve (several
-    /// per key where the opening wiggles; those keys are then ambiguous).
-    Every,
+meshcore::choice! {
+    /// How the iso-angle rule ([`SelectionRule::IsoAngle`]) turns the opening along a level curve
+    /// into points.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+    pub enum IsoCrossings: "iso-angle crossings", crate::BipolarError {
+        /// One point per angle level and curve run: along each run of a level curve (a piece, cut
+        /// where a tangent is undefined), the signed opening angle `psi = atan2(sin, cos)` between
+        /// the two tangents (unwrapped, `sin` signed by the side) is replaced by its best monotone
+        /// least-squares fit (isotonic regression, weighted by arc length; increasing or decreasing,
+        /// whichever fits better), and each angle level is taken where the fit crosses it. On a
+        /// smooth surface the opening is monotone along the curve and this equals
+        /// [`IsoCrossings::Every`]; on noisy or faceted meshes the raw opening wiggles around a
+        /// level and crosses it several times, which this rule turns into one point. The default.
+        #[default]
+        Monotone = "monotone",
+        /// Every crossing of an angle level by the piecewise-linear opening along the curve (several
+        /// per key where the opening wiggles; those keys are then ambiguous).
+        Every = "every",
+    }
 }
 
-meshcore::choice!(IsoCrossings, "iso-angle crossings", crate::BipolarError {
-    Monotone = "monotone",
-    Every = "every",
-});
-
-/// What the iso-angle rule ([`SelectionRule::IsoAngle`]) does with a key found at several
-/// places of one level curve of the first field. A level curve cut by a hole (on faces, the eye
-/// openings between the outer eye corners) comes in pieces, one on each side of the hole, whose
-/// opening ranges overlap: each piece then holds a point with the same key `(i, k, side, sign)`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-pub enum IsoRepeats {
-    /// Keep the place nearest the geodesic between the two references, the one with the
-    /// smallest second field `U_b` (on level `i` of `U_a`, the smallest `U_a + U_b`): the piece
-    /// on the side of the hole where the two fields meet directly. Only when every other place is
-    /// farther by at least a quarter of the level step; otherwise all stay, flagged ambiguous.
-    /// The default.
-    #[default]
-    Nearest,
-    /// Keep every place, flagged ambiguous (never paired by a keyed distance).
-    Ambiguous,
+meshcore::choice! {
+    /// What the iso-angle rule ([`SelectionRule::IsoAngle`]) does with a key found at several
+    /// places of one level curve of the first field. A level curve cut by a hole (on faces, the eye
+    /// openings between the outer eye corners) comes in pieces, one on each side of the hole, whose
+    /// opening ranges overlap: each piece then holds a point with the same key `(i, k, side, sign)`.
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+    pub enum IsoRepeats: "iso-angle repeated keys", crate::BipolarError {
+        /// Keep the place nearest the geodesic between the two references, the one with the
+        /// smallest second field `U_b` (on level `i` of `U_a`, the smallest `U_a + U_b`): the piece
+        /// on the side of the hole where the two fields meet directly. Only when every other place is
+        /// farther by at least a quarter of the level step; otherwise all stay, flagged ambiguous.
+        /// The default.
+        #[default]
+        Nearest = "nearest",
+        /// Keep every place, flagged ambiguous (never paired by a keyed distance).
+        Ambiguous = "ambiguous",
+    }
 }
-
-meshcore::choice!(IsoRepeats, "iso-angle repeated keys", crate::BipolarError {
-    Nearest = "nearest",
-    Ambiguous = "ambiguous",
-});
 
 /// Settings of the iso-angle rule.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
