@@ -392,30 +392,7 @@ fn vertex_renumbering_does_not_change_the_descriptor() {
     let plane = plane_setup(40, 0.3);
     let n = plane.mesh.n_vertices();
     // A deterministic permutation and a rotation of each face's corner order, faces reversed.
-    let perm: Vec<u32> = (0..n as u32).map(|v| (v * 7919 + 13) % n as u32).collect();
-    let mut seen = vec![false; n];
-    perm.iter().for_each(|&p| seen[p as usize] = true);
-    assert!(seen.iter().all(|&s| s), "not a permutation");
-    let mut pos = vec![DVec3::ZERO; n];
-    for v in 0..n {
-        pos[perm[v] as usize] = plane.mesh.positions()[v];
-    }
-    let tris: Vec<[u32; 3]> = plane
-        .mesh
-        .triangles()
-        .iter()
-        .rev()
-        .enumerate()
-        .map(|(k, t)| {
-            let t = t.map(|v| perm[v as usize]);
-            match k % 3 {
-                0 => t,
-                1 => [t[1], t[2], t[0]],
-                _ => [t[2], t[0], t[1]],
-            }
-        })
-        .collect();
-    let m2 = TriMesh::new(pos, tris).unwrap();
+    let (m2, perm) = testsupport::renumbered(&plane.mesh);
     let t2 = Surface::new(m2.clone());
     let mut f2 = vec![vec![0.0; n]; 2];
     for (f2k, fk) in f2.iter_mut().zip(&plane.fields) {

@@ -231,31 +231,6 @@ fn monotone_equals_every_crossing_where_the_opening_is_monotone() {
     }
 }
 
-/// The same mesh with vertices renumbered and faces reordered (corners rotated).
-fn renumbered(mesh: &TriMesh) -> (TriMesh, Vec<u32>) {
-    let n = mesh.n_vertices();
-    let perm: Vec<u32> = (0..n as u32).map(|v| (v * 7919 + 13) % n as u32).collect();
-    let mut pos = vec![DVec3::ZERO; n];
-    for v in 0..n {
-        pos[perm[v] as usize] = mesh.positions()[v];
-    }
-    let tris: Vec<[u32; 3]> = mesh
-        .triangles()
-        .iter()
-        .rev()
-        .enumerate()
-        .map(|(k, t)| {
-            let t = t.map(|v| perm[v as usize]);
-            match k % 3 {
-                0 => t,
-                1 => [t[1], t[2], t[0]],
-                _ => [t[2], t[0], t[1]],
-            }
-        })
-        .collect();
-    (TriMesh::new(pos, tris).unwrap(), perm)
-}
-
 fn assert_same(a: &Descriptor, b: &Descriptor, t: &DAffine3, tol: f64) {
     assert_eq!(a.packed_keys(), b.packed_keys());
     for (p, q) in a.points.iter().zip(&b.points) {
@@ -285,7 +260,7 @@ fn monotone_rule_is_invariant_under_renumbering_and_rigid_motion_on_a_noisy_plan
     for o in [o, smoothed] {
         let d1 = describe_with(&mesh, &fields, refs, &o);
         // Renumbered.
-        let (m2, perm) = renumbered(&mesh);
+        let (m2, perm) = testsupport::renumbered(&mesh);
         let mut f2 = vec![vec![0.0; mesh.n_vertices()]; 2];
         for k in 0..2 {
             for v in 0..mesh.n_vertices() {

@@ -179,3 +179,39 @@ pub fn read_mesh(path: impl AsRef<Path>) -> TriMesh {
         Err(e) => panic!("reading {}: {e}", path.display()),
     }
 }
+
+/// `mesh` with its vertices renumbered by the permutation `v -> (7919 v + 13) mod n`, its faces
+/// listed in reverse order and each face's corners rotated by `k mod 3` places (`k` its new
+/// index): the same surface under another numbering. Returns the mesh and the permutation
+/// (`perm[old] = new`); panics if the map is not a permutation (7919 shares a factor with `n`).
+pub fn renumbered(mesh: &TriMesh) -> (TriMesh, Vec<u32>) {
+    let n = mesh.n_vertices();
+    let perm: Vec<u32> = (0..n as u64)
+        .map(|v| ((v * 7919 + 13) % n as u64) as u32)
+        .collect();
+    let mut seen = vec![false; n];
+    perm.iter().for_each(|&p| seen[p as usize] = true);
+    assert!(seen.iter().all(|&s| s), "not a permutation of {n} vertices");
+    let mut pos = vec![meshcore::DVec3::ZERO; n];
+    for (v, &p) in perm.iter().enumerate() {
+        pos[p as usize] = mesh.positions()[v];
+    }
+    let tris: Vec<[u32; 3]> = mesh
+        .triangles()
+        .iter()
+        .rev()
+        .enumerate()
+        .map(|(k, t)| {
+            let t = t.map(|v| perm[v as usize]);
+            match k % 3 {
+                0 => t,
+                1 => [t[1], t[2], t[0]],
+                _ => [t[2], t[0], t[1]],
+            }
+        })
+        .collect();
+    (
+        TriMesh::new(pos, tris).expect("a renumbered valid mesh is valid"),
+        perm,
+    )
+}
