@@ -17,7 +17,7 @@
 
 use crate::experiments::pipeline::{bar, dist};
 use crate::experiments::polar::{polar_descriptor, PolarOptions, Pole};
-use crate::paths::{default_out_dir, default_paper_set};
+use crate::paths::{FaceSetArgs, ResolutionArgs};
 use anyhow::{bail, Context, Result};
 use facemodel::{face_frame, load_face_set, static_mask, Face};
 use geodesic::{Method, SolveOptions, Source};
@@ -28,25 +28,17 @@ use rayon::prelude::*;
 use scanprep::{CleanOptions, Crop, Input};
 use shapedist::{icp_to_target, Convergence, IcpLoopOptions, IcpVariant, TrimRounding};
 use std::fmt::Write as _;
-use std::path::PathBuf;
 use std::time::Instant;
 
 /// Arguments of `cargo xtask scan-study`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
-    /// Folder of the face set (OBJ files + landmarks.json); default
-    /// `$BIPOLAR_SHARED/faces/ict-facekit/paper-set`.
-    #[arg(long)]
-    pub faces: Option<PathBuf>,
-    /// Report folder (default `target/scan-study`).
-    #[arg(long)]
-    pub out: Option<PathBuf>,
-    /// Number of levels between the two reference points (static area: levels <= N).
-    #[arg(long, default_value_t = 10)]
-    pub levels: u32,
-    /// Angular sectors of the single-pole representation.
-    #[arg(long, default_value_t = 16)]
-    pub sectors: u32,
+    /// Face set and report folder (default `target/scan-study`).
+    #[command(flatten)]
+    pub set: FaceSetArgs,
+    /// Descriptor resolution (static area: levels <= N).
+    #[command(flatten)]
+    pub res: ResolutionArgs,
     /// Only the first `n` scan settings (of the fixed list; 0 = all).
     #[arg(long, default_value_t = 0)]
     pub settings: usize,
@@ -301,8 +293,8 @@ fn describe_scan(face: &Face, setting: &Setting, args: &Args) -> Result<Describe
         .iter()
         .map(|v| {
             let opts = bipolar::DescriptorOptions {
-                levels: bipolar::LevelSpec::Step(d / f64::from(args.levels)),
-                max_level: Some(args.levels),
+                levels: bipolar::LevelSpec::Step(d / f64::from(args.res.levels)),
+                max_level: Some(args.res.levels),
                 vertex_mask: Some(mask.clone()),
                 ..v.options()
             };
@@ -329,9 +321,9 @@ fn describe_scan(face: &Face, setting: &Setting, args: &Args) -> Result<Describe
         Pole::Point(sp[2]),
         0.5 * (pos[0] + pos[1]),
         &PolarOptions {
-            step: d / f64::from(args.levels),
-            levels: args.levels,
-            sectors: args.sectors,
+            step: d / f64::from(args.res.levels),
+            levels: args.res.levels,
+            sectors: args.res.sectors,
         },
     )?;
     let inside: Vec<DVec3> = (0..mesh.n_vertices())
@@ -505,7 +497,7 @@ fn quantiles(v: &[f64]) -> (f64, f64, f64, usize) {
 /// Runs the study; prints the report folder on the last line.
 pub fn run(args: Args) -> Result<()> {
     let t0 = Instant::now();
-    let dir = args.faces.clone().unwrap_or_else(default_paper_set);
+    let dir = args.set.faces_dir();
     let mut faces = load_face_set(&dir)?;
     if !args.only.is_empty() {
         faces.retain(|f| args.only.iter().any(|o| f.name.contains(o.as_str())));
@@ -517,10 +509,7 @@ pub fn run(args: Args) -> Result<()> {
             );
         }
     }
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| default_out_dir("scan-study"));
+    let out = args.set.out_dir("scan-study");
     std::fs::create_dir_all(&out)?;
     let mut sets = settings();
     if args.settings > 0 {
@@ -698,14 +687,15 @@ fn write_outputs(
          (levels <= N, `facemodel::static_mask`); single pole with {} sectors; ICP of {} \
          static-area points, symmetric mean of the two directions, RMS in mm.\n",
         faces.len(),
-        args.faces
+        args.set
+            .faces
             .as_ref()
             .map_or("paper-set".to_string(), |p| p.display().to_string()),
         sets.len(),
         sets.iter().map(|s| s.name).collect::<Vec<_>>().join(", "),
         args.landmark_tolerance_mm,
-        args.levels,
-        args.sectors,
+        args.res.levels,
+        args.res.sectors,
         args.icp_points
     );
     let _ = writeln!(
