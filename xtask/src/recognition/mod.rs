@@ -45,7 +45,7 @@ use std::time::Instant;
 /// Arguments of `cargo xtask recognition`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
-    /// Number of sampled identities (default 50; with `--scans` 12).
+    /// Number of sampled identities (default 50; with `--scans` 16).
     #[arg(long)]
     pub identities: Option<usize>,
     /// Faces per identity, the first neutral for the gallery (default 6; with `--scans` 3).

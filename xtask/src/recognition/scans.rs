@@ -45,6 +45,8 @@ struct Sweep {
     apply: fn(ScanSettings, f64) -> ScanSettings,
 }
 
+/// The sweeps (each value rescans `--sweep-identities` faces); the gallery's default setting
+/// (noise 0.1 mm, pitch 0.5 mm, yaw 0) is among the values.
 fn sweeps() -> Vec<Sweep> {
     vec![
         Sweep {
@@ -253,7 +255,7 @@ fn p95(mut v: Vec<f64>) -> f64 {
 
 /// Runs the scan benchmark; prints the output folder on the last line.
 pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
-    let identities = args.identities.unwrap_or(12);
+    let identities = args.identities.unwrap_or(16);
     let expressions = args.expressions.unwrap_or(3);
     if identities < 2 || expressions < 2 {
         bail!("need at least 2 identities and 2 expressions (one neutral gallery face + probes)");
