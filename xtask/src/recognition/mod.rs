@@ -92,7 +92,7 @@ pub struct Args {
     #[arg(long, default_value_t = SCAN_EDGE_MM)]
     pub scan_edge: f64,
     /// Identities whose probes are rescanned at every sweep setting (`--scans`).
-    #[arg(long, default_value_t = 6)]
+    #[arg(long, default_value_t = 4)]
     pub sweep_identities: usize,
     /// Skip the sweeps (`--scans`).
     #[arg(long)]
@@ -116,7 +116,7 @@ struct Lm {
 }
 
 /// Default of `--scan-edge`, mm.
-const SCAN_EDGE_MM: f64 = 1.0;
+const SCAN_EDGE_MM: f64 = 1.5;
 
 /// Default of `--curve-samples`.
 const CURVE_SAMPLES: usize = 50;
