@@ -843,7 +843,7 @@ pub fn run(args: Args) -> Result<()> {
         .map(|&p| icp_points(&samples[p].mesh, args.icp_points))
         .collect();
     let mut timed = Vec::new();
-    for k in 0..2 {
+    for k in [0, 1] {
         let gal: Vec<Option<(&Described, &FaceLocator<'_>)>> = gallery
             .iter()
             .zip(&locators)
