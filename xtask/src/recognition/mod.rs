@@ -593,15 +593,20 @@ const SCORES: [&str; 5] = [
 /// Index in [`Described::secs`] of each score's description (ICP has none).
 const DESCRIPTION_OF: [Option<usize>; 5] = [Some(0), Some(1), None, Some(2), Some(3)];
 
-/// Median of the finite values (NaN when there is none).
-fn median(mut v: Vec<f64>) -> f64 {
+/// The element at `pick(len)` of the sorted finite values (NaN when there is none).
+fn order_stat(mut v: Vec<f64>, pick: impl Fn(usize) -> usize) -> f64 {
     v.retain(|x| x.is_finite());
     v.sort_by(f64::total_cmp);
     if v.is_empty() {
         f64::NAN
     } else {
-        v[v.len() / 2]
+        v[pick(v.len())]
     }
+}
+
+/// Median of the finite values (the upper one of an even count; NaN when there is none).
+fn median(v: Vec<f64>) -> f64 {
+    order_stat(v, |n| n / 2)
 }
 
 /// The figures of the five score matrices of one landmark set (rows from [`score_row`]), with

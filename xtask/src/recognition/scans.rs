@@ -9,7 +9,7 @@
 //! the scan, a descriptor error) is listed with the face's name and counted, never replaced.
 
 use super::{
-    describe_face, elastic_options, icp_points, iso_levels_of, median, print_results,
+    describe_face, elastic_options, icp_points, iso_levels_of, median, order_stat, print_results,
     results_table, roc_figure, score_row, summarize, time_comparisons, time_descriptions,
     timed_pairs, Args, DescribeOptions, Described, Lm, Metrics, Row, TIMED_FACES,
 };
@@ -243,14 +243,9 @@ fn failures(faces: &[Face], group: &str) -> Vec<[String; 4]> {
     out
 }
 
-fn p95(mut v: Vec<f64>) -> f64 {
-    v.retain(|x| x.is_finite());
-    v.sort_by(f64::total_cmp);
-    if v.is_empty() {
-        f64::NAN
-    } else {
-        v[((v.len() - 1) as f64 * 0.95).round() as usize]
-    }
+/// 95th percentile (nearest rank) of the finite values.
+fn p95(v: Vec<f64>) -> f64 {
+    order_stat(v, |n| ((n - 1) as f64 * 0.95).round() as usize)
 }
 
 /// Runs the scan benchmark; prints the output folder on the last line.
