@@ -17,7 +17,8 @@
 //! 2. Start points (when a curve is closed): every cyclic shift of the closed curve's segments
 //!    is scored by the best rotation without reparametrisation (Kabsch trace); the
 //!    `start_candidates` best shifts are refined to a fraction of a segment (golden-section
-//!    search on the same score, the curve resampled from the new start).
+//!    search on the squared distance without reparametrisation, `|q_a|^2 + |q_b|^2 - 2 trace`,
+//!    the curve resampled from the new start).
 //! 3. For each candidate, rotation and reparametrisation alternate `iterations` times: the
 //!    reparametrisation is the dynamic-programming optimum over the piecewise-linear `gamma`
 //!    through the nodes of the `m x m` grid whose pieces have slopes `b / a` with
@@ -372,9 +373,13 @@ fn one_sided(x: &Curve, y: &Curve, opts: &ElasticOptions) -> OneSided {
     let mut dp = Dp::new(m);
     for &(_, p) in &candidates {
         let offset = if shift_any {
+            // Scored by the squared distance without warping, not by the trace alone: a
+            // fractional start resamples a polygon's corners differently, which changes the
+            // resampled length, and a longer resampling raises the trace while moving away
+            // (an identical coarse polygon was then found at a positive distance).
             refine_offset(p as f64, |o| {
                 let (a, b) = pair(o);
-                trace(&a, &b)
+                2.0 * trace(&a, &b) - norm2(&a) - norm2(&b)
             })
         } else {
             0.0

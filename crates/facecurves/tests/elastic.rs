@@ -221,6 +221,39 @@ fn bad_input_is_an_error() {
     assert!(e.to_string().contains("samples"), "{e}");
 }
 
+/// Coarse polygons (as few points as the rings of a 16-sector polar descriptor) against
+/// themselves and a rigid copy: the start-point refinement must not trade the exact start for
+/// a fractional one whose resampling cuts the corners differently (it did when it maximised
+/// the trace alone, which a longer resampling raises).
+#[test]
+fn coarse_polygons_are_at_zero_from_themselves_and_rigid_copies() {
+    for n in [7, 12, 16, 23] {
+        // Irregular spacing: the polygon's corners fall between the resampled points.
+        let a: Vec<DVec3> = (0..n)
+            .map(|i| {
+                let t = (i as f64 + 0.35 * ((i * 7 % 5) as f64 / 5.0)) / n as f64;
+                lobes(t) * (1.0 + 0.2 * (i % 3) as f64)
+            })
+            .collect();
+        let b: Vec<DVec3> = a.iter().map(|p| motion().transform_point3(*p)).collect();
+        let scale = length(&a, true).sqrt();
+        for opts in [
+            ElasticOptions::default(),
+            ElasticOptions {
+                samples: 50,
+                start_candidates: 1,
+                iterations: 1,
+                ..Default::default()
+            },
+        ] {
+            for other in [&a, &b] {
+                let d = elastic_distance(&a, true, other, true, &opts).unwrap();
+                assert!(d.distance < 1e-6 * scale, "{n} points: {}", d.distance);
+            }
+        }
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(16))]
 

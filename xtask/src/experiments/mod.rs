@@ -1,8 +1,10 @@
-//! Shared pieces of `cargo xtask robustness` and `cargo xtask recognition`: the single-pole
-//! descriptor, the pipeline glue around `bipolar` and `shapedist`, and report writing. Straightest geodesics are
+//! Shared pieces of `cargo xtask robustness`, `recognition` and `section6`: the single-pole
+//! descriptor, the curve representations of section 6 (`curves`), the pipeline glue around
+//! `bipolar` and `shapedist`, and report writing. Straightest geodesics are
 //! `geodesic::straightest`, the single-pole descriptor is `bipolar::polar`; face-set loading,
 //! the face frame and the static-area mask are in the `facemodel` crate.
 
+pub mod curves;
 pub mod pipeline;
 pub mod report;
 pub mod scans;

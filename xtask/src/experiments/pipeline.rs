@@ -235,3 +235,18 @@ pub fn bar(len: usize, msg: &str) -> ProgressBar {
     pb.set_message(msg.to_string());
     pb
 }
+
+/// Runs `f` on a pool of one thread and returns its result and wall time: the single-thread
+/// cost of a step, free of the work other tasks steal into the wait of a nested parallel loop
+/// (which inflates times measured inside a parallel loop).
+pub fn single_thread<T: Send>(f: impl FnOnce() -> T + Send) -> Result<(T, std::time::Duration)> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .context("a one-thread pool for timing")?;
+    Ok(pool.install(|| {
+        let t = std::time::Instant::now();
+        let out = f();
+        (out, t.elapsed())
+    }))
+}

@@ -188,7 +188,7 @@ pub const MAX_SNAP_MM: f64 = 3.0;
 pub struct StepTimes {
     /// Sampling the face and scanning it.
     pub scan: Duration,
-    /// `scanprep::clean`.
+    /// `scanprep::clean` (with the decimation, if any).
     pub clean: Duration,
     /// `landmarks::detect`.
     pub detect: Duration,
@@ -249,6 +249,9 @@ pub struct ScanSetOptions {
     /// by the one recognised from the scan, `landmarks::mesh_units_per_model_unit`); `None`:
     /// no detection.
     pub detect: Option<DetectOptions>,
+    /// Target edge length (mm) of the cleaned scan, decimated by `scanprep`
+    /// (`CleanOptions::target_edge_mm`); `None`: the scan's own sampling.
+    pub target_edge_mm: Option<f64>,
 }
 
 impl Default for ScanSetOptions {
@@ -256,6 +259,7 @@ impl Default for ScanSetOptions {
         Self {
             crop_radius_mm: scanprep::DEFAULT_CROP_RADIUS_MM,
             detect: Some(DetectOptions::default()),
+            target_edge_mm: None,
         }
     }
 }
@@ -365,6 +369,7 @@ pub fn scan_face(
                 centre: nose,
                 radius_mm: options.crop_radius_mm,
             }),
+            target_edge_mm: options.target_edge_mm,
             ..CleanOptions::default()
         },
     )?;

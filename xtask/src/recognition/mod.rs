@@ -1,6 +1,8 @@
 //! `cargo xtask recognition`: identification and verification on faces sampled from the ICT
-//! face model, for the bipolar descriptor, the single-pole descriptor and ICP on the raw meshes,
-//! each with ground-truth and with detected landmarks.
+//! face model, for the bipolar descriptor, the single-pole descriptor, ICP on the raw meshes and
+//! the two curve representations of the paper's section 6 (facial curves, iso-curvature curves:
+//! `experiments::curves`), each with ground-truth and with detected landmarks, with the time
+//! per comparison and per description.
 //!
 //! N identities x M expressions are sampled (seeded); expression 0 of every identity is the
 //! neutral face and forms the gallery, the M - 1 others are the probes. Every face is moved by
@@ -11,8 +13,12 @@
 
 mod scans;
 
+use crate::experiments::curves::{
+    facial_curves, facial_distance, iso_curves, iso_distance_from, iso_point_set,
+    reference_iso_levels,
+};
 use crate::experiments::pipeline::{
-    bar, bipolar, dist, resolve_methods, DescriptorRule, Refs, Region,
+    bar, bipolar, dist, resolve_methods, single_thread, DescriptorRule, Refs, Region,
 };
 use crate::experiments::polar::{self, polar_descriptor, PolarOptions, Pole};
 use crate::experiments::report::{f4, line_plot, Report, Series};
@@ -21,21 +27,25 @@ use crate::experiments::walk::Walker;
 use crate::paths::{default_model_dir, default_out_dir};
 use anyhow::{bail, Context, Result};
 use bipolar::PolarDescriptor;
+use facecurves::{ElasticOptions, FacialCurvesDescriptor, IsoLevels};
 use facemodel::{face_frame, random_rigid_motion, FaceModel};
 use geodesic::{SolveOptions, Source};
 use meshcore::linalg::fit_rigid;
-use meshcore::{DVec3, FaceLocator, TriMesh};
+use meshcore::{DVec3, FaceLocator, Surface, TriMesh};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
-use shapedist::{icp_to_target, Convergence, IcpLoopOptions, IcpVariant, TrimRounding};
+use shapedist::{
+    icp_to_target, Convergence, IcpLoopOptions, IcpOptions, IcpVariant, PreparedSet, TrimRounding,
+    Which,
+};
 use std::path::PathBuf;
 use std::time::Instant;
 
 /// Arguments of `cargo xtask recognition`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
-    /// Number of sampled identities (default 50; with `--scans` 12).
+    /// Number of sampled identities (default 50; with `--scans` 16).
     #[arg(long)]
     pub identities: Option<usize>,
     /// Faces per identity, the first neutral for the gallery (default 6; with `--scans` 3).
@@ -53,6 +63,13 @@ pub struct Args {
     /// Sectors of the single-pole descriptor.
     #[arg(long, default_value_t = 16)]
     pub sectors: u32,
+    /// Levels per principal field of the iso-curvature network (between the 5 % and 95 %
+    /// quantiles of the first gallery face's curvatures, the same levels for every face).
+    #[arg(long = "iso-levels", default_value_t = 6)]
+    pub iso_levels: usize,
+    /// Segments each facial curve is resampled into for the elastic distance.
+    #[arg(long = "curve-samples", default_value_t = CURVE_SAMPLES)]
+    pub curve_samples: usize,
     /// Probe vertices used by ICP (evenly strided).
     #[arg(long, default_value_t = 100)]
     pub icp_points: usize,
@@ -70,8 +87,12 @@ pub struct Args {
     /// Scanner settings of the gallery (and the reference of the sweeps) with `--scans`.
     #[command(flatten)]
     pub scan: ScanArgs,
+    /// Target edge length (mm) the cleaned scans are decimated to before detection and
+    /// description (`--scans`; 0 keeps the scan's sampling).
+    #[arg(long, default_value_t = SCAN_EDGE_MM)]
+    pub scan_edge: f64,
     /// Identities whose probes are rescanned at every sweep setting (`--scans`).
-    #[arg(long, default_value_t = 6)]
+    #[arg(long, default_value_t = 4)]
     pub sweep_identities: usize,
     /// Skip the sweeps (`--scans`).
     #[arg(long)]
@@ -94,28 +115,128 @@ struct Lm {
     nose: u32,
 }
 
-/// Per face and landmark set: descriptors and landmark positions.
-#[derive(Debug, Clone)]
+/// Default of `--scan-edge`, mm.
+const SCAN_EDGE_MM: f64 = 1.5;
+
+/// Default of `--curve-samples`.
+const CURVE_SAMPLES: usize = 50;
+
+/// Points of an iso-curvature network kept for its ICP (every k-th point in curve order).
+const ISO_POINTS: usize = 2000;
+
+/// The ICP of the iso-curvature networks, started from the landmark alignment: 10
+/// point-to-point iterations on a 500-point subsample, then at most 10 on all points (the
+/// other settings those of `shapedist`'s global refinement).
+const ISO_ICP: IcpOptions = IcpOptions {
+    variant: IcpVariant::PointToPoint,
+    max_iterations: 10,
+    tolerance: 1e-6,
+    trim: 0.0,
+    translation: false,
+    coarse_iterations: 10,
+};
+
+/// The elastic distance of the facial curves in the benchmark: `samples` segments per curve,
+/// one start-point candidate and one rotation / reparametrisation alternation (the crate's
+/// default is 100, 3 and 2: about 25 times the cost).
+fn elastic_options(samples: usize) -> ElasticOptions {
+    ElasticOptions {
+        samples,
+        start_candidates: 1,
+        iterations: 1,
+        ..ElasticOptions::default()
+    }
+}
+
+/// Per face and landmark set: descriptors, landmark positions and description times.
+#[derive(Debug)]
 struct Described {
     bip: Result<bipolar::Descriptor, String>,
     pol: PolarDescriptor,
+    facial: Result<FacialCurvesDescriptor, String>,
+    /// The iso-curvature network's points prepared for ICP (the network itself is not kept).
+    iso: Result<PreparedSet, String>,
     lm_pos: [DVec3; 3],
+    /// Wall time of each description (bipolar, single pole, facial curves, iso-curvature): the
+    /// geodesic fields it needs (both corners; the nose tip) and its own build.
+    secs: [f64; 4],
 }
 
 /// Descriptor settings of the benchmark.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 struct DescribeOptions {
-    /// Levels N between the outer eye corners.
+    /// Levels N between the outer eye corners (also the facial curves: N levels up to D).
     levels: u32,
     /// Sectors of the single-pole descriptor.
     sectors: u32,
+    /// Iso-curvature levels shared by every face (`None`: not described).
+    iso_levels: Option<IsoLevels>,
 }
 
-/// The bipolar (static area, grid reading) and single-pole descriptors of one face for one
-/// landmark set. Only the static lens (within D of both corners, D ~ 1.1 |q - r|) and polar
-/// radii up to D are used: the fields are cut off at 1.4 |q - r|. Errors name what failed
-/// (a bipolar descriptor the crate refuses is kept as its error; an empty single-pole one is
-/// the empty set).
+/// The three fields of a face cut off at 1.4 |q - r| (corners r, q; nose tip), D, and the wall
+/// time of the corner fields and of the nose field.
+struct Fields {
+    ur: Vec<f64>,
+    uq: Vec<f64>,
+    un: Vec<f64>,
+    d: f64,
+    secs: [f64; 2],
+}
+
+fn fields(mesh: &TriMesh, solver: &dyn geodesic::GeodesicSolver, lm: Lm) -> Result<Fields, String> {
+    if lm.r == lm.q {
+        return Err(format!(
+            "the two outer eye corners are the same vertex {}",
+            lm.r
+        ));
+    }
+    let cut = SolveOptions {
+        max_distance: Some(1.4 * (mesh.position(lm.q) - mesh.position(lm.r)).length()),
+    };
+    let field = |v: u32| {
+        solver
+            .distances(&[Source::Vertex(v)], &cut)
+            .map_err(|e| format!("geodesic field: {e}"))
+    };
+    let t = Instant::now();
+    let (ur, uq) = (field(lm.r)?, field(lm.q)?);
+    let t_corners = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let un = field(lm.nose)?;
+    let t_nose = t.elapsed().as_secs_f64();
+    let d = 0.5 * (ur[lm.q as usize] + uq[lm.r as usize]);
+    if !d.is_finite() || d <= 0.0 {
+        return Err(format!(
+            "the geodesic distance between the outer eye corners is {d} (not reachable within 1.4 times their distance)"
+        ));
+    }
+    Ok(Fields {
+        ur,
+        uq,
+        un,
+        d,
+        secs: [t_corners, t_nose],
+    })
+}
+
+/// The iso-curvature levels of a benchmark: `count` per principal field from the reference
+/// face `mesh` with landmarks `lm` ([`reference_iso_levels`] on its nose disc of radius D).
+fn iso_levels_of(
+    mesh: &TriMesh,
+    solver: &dyn geodesic::GeodesicSolver,
+    lm: Lm,
+    count: usize,
+) -> Result<IsoLevels> {
+    let f = fields(mesh, solver, lm).map_err(|e| anyhow::anyhow!("{e}"))?;
+    reference_iso_levels(&Surface::new(mesh.clone()), &f.un, f.d, count)
+        .context("iso-curvature levels of the reference face")
+}
+
+/// The four descriptions of one face for one landmark set: bipolar (static area, grid
+/// reading), single pole, facial curves and iso-curvature. Only the static lens (within D of
+/// both corners, D ~ 1.1 |q - r|) and radii up to D from the nose tip are used: the fields are
+/// cut off at 1.4 |q - r|. Errors name what failed (a descriptor the crate refuses is kept as
+/// its error; an empty single-pole one is the empty set).
 fn describe_face(
     mesh: &TriMesh,
     solver: &dyn geodesic::GeodesicSolver,
@@ -123,42 +244,24 @@ fn describe_face(
     lm: Lm,
     o: &DescribeOptions,
 ) -> Result<Described, String> {
-    if lm.r == lm.q {
-        return Err(format!(
-            "the two outer eye corners are the same vertex {}",
-            lm.r
-        ));
-    }
+    let f = fields(mesh, solver, lm)?;
     let (r, q, nose) = (
         mesh.position(lm.r),
         mesh.position(lm.q),
         mesh.position(lm.nose),
     );
-    let cut = SolveOptions {
-        max_distance: Some(1.4 * (q - r).length()),
-    };
-    let field = |v: u32| {
-        solver
-            .distances(&[Source::Vertex(v)], &cut)
-            .map_err(|e| format!("geodesic field: {e}"))
-    };
-    let (ur, uq, un) = (field(lm.r)?, field(lm.q)?, field(lm.nose)?);
-    let d = 0.5 * (ur[lm.q as usize] + uq[lm.r as usize]);
-    if !d.is_finite() || d <= 0.0 {
-        return Err(format!(
-            "the geodesic distance between the outer eye corners is {d} (not reachable within 1.4 times their distance)"
-        ));
-    }
-    let frame = face_frame(mesh, r, q, nose);
+    let [t_corners, t_nose] = f.secs;
+    let d = f.d;
     let refs = Refs {
-        ur,
-        uq,
+        ur: f.ur,
+        uq: f.uq,
         d,
         r,
         q,
         nose,
-        frame,
+        frame: face_frame(mesh, r, q, nose),
     };
+    let t = Instant::now();
     let bip = bipolar(
         mesh,
         &refs,
@@ -167,17 +270,46 @@ fn describe_face(
         DescriptorRule::CrateAll,
     )
     .map_err(|e| format!("bipolar descriptor: {e}"));
+    let t_bip = t.elapsed().as_secs_f64();
     let opts = PolarOptions {
         step: d / f64::from(o.levels),
         levels: o.levels,
         sectors: o.sectors,
     };
-    let pol = polar_descriptor(walker, &un, Pole::Vertex(lm.nose), 0.5 * (r + q), &opts)
+    let t = Instant::now();
+    let pol = polar_descriptor(walker, &f.un, Pole::Vertex(lm.nose), 0.5 * (r + q), &opts)
         .unwrap_or_else(|_| polar::empty(&opts));
+    let t_pol = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let surface = Surface::new(mesh.clone());
+    let t_surface = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let facial =
+        facial_curves(&surface, &f.un, d, o.levels).map_err(|e| format!("facial curves: {e}"));
+    let t_facial = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let iso = match &o.iso_levels {
+        Some(l) => iso_curves(&surface, &f.un, d, l)
+            .map_err(|e| format!("iso-curvature: {e}"))
+            .and_then(|c| {
+                iso_point_set(&c, Which::B, Some(ISO_POINTS))
+                    .map_err(|e| format!("iso-curvature points: {e}"))
+            }),
+        None => Err("iso-curvature: no levels".to_string()),
+    };
+    let t_iso = t.elapsed().as_secs_f64();
     Ok(Described {
         bip,
         pol,
+        facial,
+        iso,
         lm_pos: [r, q, nose],
+        secs: [
+            t_corners + t_bip,
+            t_nose + t_pol,
+            t_nose + t_surface + t_facial,
+            t_nose + t_surface + t_iso,
+        ],
     })
 }
 
@@ -191,6 +323,11 @@ struct Metrics {
     genuine_mean: f64,
     impostor_mean: f64,
     failures: usize,
+    /// Mean single-thread wall time of one comparison (ms), over [`TIMED_PAIRS`] pairs.
+    ms_per_comparison: f64,
+    /// Median single-thread wall time of one description (ms): its geodesic fields and its
+    /// build; NaN for ICP, which compares the meshes themselves.
+    ms_per_description: f64,
     #[serde(skip)]
     roc: Vec<(f64, f64)>,
 }
@@ -314,36 +451,171 @@ fn icp_points(mesh: &TriMesh, n: usize) -> Vec<DVec3> {
     mesh.positions().iter().step_by(stride).copied().collect()
 }
 
-/// Scores of one probe (its description and ICP points) against every gallery face:
-/// bipolar, single pole and ICP; NaN where either side has no description or the score fails.
+/// Score `k` of [`SCORES`] of a probe (its description `x` and ICP points `pts`) against a
+/// gallery face (`y`, its surface `loc`); NaN when a description is missing or the score
+/// fails.
+fn score_one(
+    k: usize,
+    x: &Described,
+    pts: &[DVec3],
+    y: &Described,
+    loc: &FaceLocator<'_>,
+    elastic: &ElasticOptions,
+) -> f64 {
+    match k {
+        0 => dist(&x.bip, &y.bip).unwrap_or(f64::NAN),
+        1 => dist(&x.pol, &y.pol).unwrap_or(f64::NAN),
+        2 => icp_score(pts, &x.lm_pos, loc, &y.lm_pos),
+        3 => match (&x.facial, &y.facial) {
+            (Ok(a), Ok(b)) => facial_distance(a, b, elastic).unwrap_or(f64::NAN),
+            _ => f64::NAN,
+        },
+        _ => match (&x.iso, &y.iso) {
+            (Ok(a), Ok(b)) => fit_rigid(&x.lm_pos, &y.lm_pos, None).map_or(f64::NAN, |m| {
+                iso_distance_from(b, a, m.matrix3, &ISO_ICP).unwrap_or(f64::NAN)
+            }),
+            _ => f64::NAN,
+        },
+    }
+}
+
+/// Scores of one probe against every gallery face, per score of [`SCORES`] (NaN where either
+/// side has no description or the score fails).
+type Row = [Vec<f64>; 5];
+
+/// Scores of one probe (its description and ICP points) against every gallery face: bipolar,
+/// single pole, ICP, facial curves (elastic distance with `elastic`) and iso-curvature (ICP of
+/// the networks' points from the landmark alignment).
 fn score_row(
     probe: Option<&Described>,
     pts: &[DVec3],
     gallery: &[Option<(&Described, &FaceLocator<'_>)>],
-) -> [Vec<f64>; 3] {
-    let mut out = [Vec::new(), Vec::new(), Vec::new()];
-    for g in gallery {
-        let [b, s, c] = match (probe, g) {
-            (Some(x), Some((y, loc))) => [
-                dist(&x.bip, &y.bip).unwrap_or(f64::NAN),
-                dist(&x.pol, &y.pol).unwrap_or(f64::NAN),
-                icp_score(pts, &x.lm_pos, loc, &y.lm_pos),
-            ],
-            _ => [f64::NAN; 3],
-        };
-        out[0].push(b);
-        out[1].push(s);
-        out[2].push(c);
+    elastic: &ElasticOptions,
+) -> Row {
+    std::array::from_fn(|k| {
+        gallery
+            .iter()
+            .map(|g| match (probe, g) {
+                (Some(x), Some((y, loc))) => score_one(k, x, pts, y, loc, elastic),
+                _ => f64::NAN,
+            })
+            .collect()
+    })
+}
+
+/// Faces whose descriptions are timed (single thread).
+const TIMED_FACES: usize = 6;
+
+/// Pairs timed per landmark set (single thread).
+const TIMED_PAIRS: usize = 24;
+
+/// Mean single-thread wall time (ms) of each score of [`SCORES`] over `pairs` (probe, its ICP
+/// points, gallery face, its surface), run on a one-thread pool after the parallel scoring.
+fn time_comparisons(
+    pairs: &[(&Described, &[DVec3], &Described, &FaceLocator<'_>)],
+    elastic: &ElasticOptions,
+) -> Result<[f64; 5]> {
+    let (ms, _) = single_thread(|| {
+        std::array::from_fn(|k| {
+            let t = Instant::now();
+            for (x, pts, y, loc) in pairs {
+                std::hint::black_box(score_one(k, x, pts, y, loc, elastic));
+            }
+            1e3 * t.elapsed().as_secs_f64() / pairs.len().max(1) as f64
+        })
+    })?;
+    Ok(ms)
+}
+
+/// Up to [`TIMED_PAIRS`] probe x gallery pairs where both faces are described: probes in
+/// order, each against the gallery faces in turn.
+fn timed_pairs<'a>(
+    probes: &[(Option<&'a Described>, &'a [DVec3])],
+    gallery: &[Option<(&'a Described, &'a FaceLocator<'a>)>],
+) -> Vec<(
+    &'a Described,
+    &'a [DVec3],
+    &'a Described,
+    &'a FaceLocator<'a>,
+)> {
+    let mut out = Vec::new();
+    for (i, (p, pts)) in probes.iter().enumerate() {
+        let Some(p) = p else { continue };
+        let g = gallery
+            .iter()
+            .skip(i % gallery.len().max(1))
+            .flatten()
+            .next();
+        if let Some((y, loc)) = g {
+            out.push((*p, *pts, *y, *loc));
+        }
+        if out.len() == TIMED_PAIRS {
+            break;
+        }
     }
     out
 }
 
-/// Names of the three scores of [`score_row`].
-const SCORES: [&str; 3] = ["bipolar", "single_pole", "icp_raw_mesh"];
+/// Median single-thread wall time (ms) of each description (bipolar, single pole, facial
+/// curves, iso-curvature: their fields and builds) over `faces`, described again on a
+/// one-thread pool.
+fn time_descriptions(
+    faces: &[(&TriMesh, Lm)],
+    method: geodesic::Method,
+    o: &DescribeOptions,
+) -> Result<[f64; 4]> {
+    let (secs, _) = single_thread(|| -> Result<Vec<[f64; 4]>> {
+        let mut v = Vec::new();
+        for (mesh, lm) in faces {
+            let solver = geodesic::new_solver(mesh, method)?;
+            let walker = Walker::new(mesh);
+            if let Ok(d) = describe_face(mesh, solver.as_ref(), &walker, *lm, o) {
+                v.push(d.secs);
+            }
+        }
+        Ok(v)
+    })?;
+    let secs = secs?;
+    Ok(std::array::from_fn(|k| {
+        1e3 * median(secs.iter().map(|s| s[k]).collect())
+    }))
+}
 
-/// The figures of the three score matrices of one landmark set (rows from [`score_row`]).
+/// Names of the five scores of [`score_row`].
+const SCORES: [&str; 5] = [
+    "bipolar",
+    "single_pole",
+    "icp_raw_mesh",
+    "facial_curves",
+    "iso_curvature",
+];
+
+/// Index in [`Described::secs`] of each score's description (ICP has none).
+const DESCRIPTION_OF: [Option<usize>; 5] = [Some(0), Some(1), None, Some(2), Some(3)];
+
+/// The element at `pick(len)` of the sorted finite values (NaN when there is none).
+fn order_stat(mut v: Vec<f64>, pick: impl Fn(usize) -> usize) -> f64 {
+    v.retain(|x| x.is_finite());
+    v.sort_by(f64::total_cmp);
+    if v.is_empty() {
+        f64::NAN
+    } else {
+        v[pick(v.len())]
+    }
+}
+
+/// Median of the finite values (the upper one of an even count; NaN when there is none).
+fn median(v: Vec<f64>) -> f64 {
+    order_stat(v, |n| n / 2)
+}
+
+/// The figures of the five score matrices of one landmark set (rows from [`score_row`]), with
+/// the times per comparison ([`time_comparisons`]) and per description
+/// ([`time_descriptions`]; ICP has none).
 fn summarize(
-    rows: &[[Vec<f64>; 3]],
+    rows: &[Row],
+    ms_comparison: &[f64; 5],
+    ms_description: &[f64; 4],
     probe_id: &[usize],
     gallery_id: &[usize],
     landmarks: &str,
@@ -362,15 +634,24 @@ fn summarize(
                 genuine_mean: gm,
                 impostor_mean: im,
                 failures,
+                ms_per_comparison: ms_comparison[j],
+                ms_per_description: DESCRIPTION_OF[j].map_or(f64::NAN, |k| ms_description[k]),
                 roc,
             }
         })
         .collect()
 }
 
-/// Appends the table of `all` (rank-1, EER, mean scores, failed pairs) to the report and
-/// writes it as the CSV file `csv`.
+/// Appends the table of `all` (rank-1, EER, mean scores, failed pairs, times) to the report
+/// and writes it as the CSV file `csv`.
 fn results_table(rep: &mut Report, all: &[Metrics], csv: &str) -> Result<()> {
+    let ms = |x: f64| {
+        if x.is_finite() {
+            format!("{x:.3}")
+        } else {
+            "-".to_string()
+        }
+    };
     let rows: Vec<Vec<String>> = all
         .iter()
         .map(|m| {
@@ -382,6 +663,8 @@ fn results_table(rep: &mut Report, all: &[Metrics], csv: &str) -> Result<()> {
                 f4(m.genuine_mean),
                 f4(m.impostor_mean),
                 m.failures.to_string(),
+                ms(m.ms_per_comparison),
+                ms(m.ms_per_description),
             ]
         })
         .collect();
@@ -393,9 +676,21 @@ fn results_table(rep: &mut Report, all: &[Metrics], csv: &str) -> Result<()> {
         "mean genuine score",
         "mean impostor score",
         "failed pairs",
+        "ms per comparison",
+        "ms per description",
     ];
     rep.table(&hdr, &rows);
     rep.csv(csv, &hdr, &rows)
+}
+
+/// One line per result on stderr (the end of a run).
+fn print_results(all: &[Metrics]) {
+    for m in all {
+        eprintln!(
+            "{:<14} {:<13} rank-1 {:.3}  EER {:.3}  failed pairs {}  {:.3} ms/comparison  {:.1} ms/description",
+            m.descriptor, m.landmarks, m.rank1, m.eer, m.failures, m.ms_per_comparison, m.ms_per_description
+        );
+    }
 }
 
 /// Draws the ROC curves of `all` into `file` and appends the figure to the report.
@@ -477,10 +772,18 @@ pub fn run(args: Args) -> Result<()> {
         expressions,
         method.name()
     );
+    // Iso-curvature levels: from the first gallery face (ground-truth landmarks).
+    let iso_levels = {
+        let s = &samples[0];
+        let solver = geodesic::new_solver(&s.mesh, method)?;
+        iso_levels_of(&s.mesh, solver.as_ref(), gt, args.iso_levels)?
+    };
     let desc_opts = DescribeOptions {
         levels: args.levels,
         sectors: args.sectors,
+        iso_levels: Some(iso_levels),
     };
+    let elastic = elastic_options(args.curve_samples);
     // Landmark detection.
     let generic = landmarks::GenericModel::default_model()
         .map_err(|e| anyhow::anyhow!("landmark model: {e}"))?;
@@ -539,33 +842,54 @@ pub fn run(args: Args) -> Result<()> {
         .map(|&g| FaceLocator::new(&samples[g].mesh))
         .collect();
     let mut all = Vec::new();
-    let pb = bar(2 * probes.len(), "scoring (ICP dominates)");
-    for (k, lname) in ["ground_truth", "detected"].iter().enumerate() {
+    let pb = bar(2 * probes.len(), "scoring");
+    let probe_pts: Vec<Vec<DVec3>> = probes
+        .iter()
+        .map(|&p| icp_points(&samples[p].mesh, args.icp_points))
+        .collect();
+    let mut timed = Vec::new();
+    for k in [0, 1] {
         let gal: Vec<Option<(&Described, &FaceLocator<'_>)>> = gallery
             .iter()
             .zip(&locators)
             .map(|(&g, l)| described[g][k].as_ref().map(|d| (d, l)))
             .collect();
-        let rows: Vec<[Vec<f64>; 3]> = probes
+        let rows: Vec<Row> = probes
             .par_iter()
-            .map(|&p| {
-                let pts = icp_points(&samples[p].mesh, args.icp_points);
-                let r = score_row(described[p][k].as_ref(), &pts, &gal);
+            .zip(&probe_pts)
+            .map(|(&p, pts)| {
+                let r = score_row(described[p][k].as_ref(), pts, &gal, &elastic);
                 pb.inc(1);
                 r
             })
             .collect();
-        all.extend(summarize(&rows, &pid, &gid, lname));
+        let pr: Vec<(Option<&Described>, &[DVec3])> = probes
+            .iter()
+            .zip(&probe_pts)
+            .map(|(&p, pts)| (described[p][k].as_ref(), pts.as_slice()))
+            .collect();
+        timed.push((rows, time_comparisons(&timed_pairs(&pr, &gal), &elastic)?));
     }
     pb.finish();
+    // Description times: the first gallery faces again, one at a time on one thread.
+    let first: Vec<(&TriMesh, Lm)> = gallery
+        .iter()
+        .take(TIMED_FACES)
+        .map(|&g| (&samples[g].mesh, gt))
+        .collect();
+    let ms_desc = time_descriptions(&first, method, &desc_opts)?;
+    for ((rows, ms_cmp), lname) in timed.iter().zip(["ground_truth", "detected"]) {
+        all.extend(summarize(rows, ms_cmp, &ms_desc, &pid, &gid, lname));
+    }
 
     // Output.
     let mut rep = Report::new(&out, "Recognition benchmark on sampled ICT faces")?;
     rep.para(&format!(
-        "{} identities x {} faces (seed {}): {} gallery faces (neutral), {} probes (random expressions: with probability 1/2 a recipe at strength 0.3-1, plus random blendshapes), every face under a random rigid motion. Geodesics: {}{}. Bipolar descriptor: static area, N = {} levels between the outer eye corners (grid reading, keyed distance); single pole: {} sectors x {} radius levels around the nose tip; ICP: {} probe vertices onto the gallery surface, started from the 3-landmark alignment, 10 % trimmed, score = RMS closest-point distance (cm).",
+        "{} identities x {} faces (seed {}): {} gallery faces (neutral), {} probes (random expressions: with probability 1/2 a recipe at strength 0.3-1, plus random blendshapes), every face under a random rigid motion. Geodesics: {}{}. Bipolar descriptor: static area, N = {} levels between the outer eye corners (grid reading, keyed distance); single pole: {} sectors x {} radius levels around the nose tip; ICP: {} probe vertices onto the gallery surface, started from the 3-landmark alignment, 10 % trimmed, score = RMS closest-point distance (cm); facial curves: N = {} level curves of the nose-tip field up to D, elastic distance ({} segments per curve, one start-point candidate, one rotation / reparametrisation alternation), root sum of squares; iso-curvature: {} levels per principal field (quantiles of the first gallery face) in the geodesic disc of radius D around the nose tip, ICP of the networks' points (thinned to at most {ISO_POINTS}, every k-th point) started from the 3-landmark alignment (10 iterations on a 500-point subsample, at most 10 on all points), score = normalised RMS closest-point distance. Times, single thread (a one-thread pool, after the parallel scoring; the machine is shared, so compare them as ratios): ms per comparison is the mean over {TIMED_PAIRS} probe x gallery pairs per landmark set; ms per description the median over the first {TIMED_FACES} gallery faces (ground-truth landmarks) of the fields a representation needs (both corners; the nose tip) plus its build.",
         identities, expressions, args.seed, gallery.len(), probes.len(), method.name(),
         method_note.as_ref().map(|n| format!(" (exact requested: {n})")).unwrap_or_default(),
-        args.levels, args.sectors, args.levels, icp_points(&samples[0].mesh, args.icp_points).len()
+        args.levels, args.sectors, args.levels, icp_points(&samples[0].mesh, args.icp_points).len(),
+        args.levels, args.curve_samples, args.iso_levels
     ));
     let n_det = detected.iter().filter(|d| d.is_some()).count();
     let mean_err =
@@ -587,6 +911,8 @@ pub fn run(args: Args) -> Result<()> {
         "geodesic_note": method_note,
         "levels": args.levels,
         "sectors": args.sectors,
+        "iso_levels": args.iso_levels,
+        "curve_samples": args.curve_samples,
         "landmark_detection": { "detected": n_det, "faces": samples.len(), "mean_error_cm": { "right_eye_outer": mean_err(0), "left_eye_outer": mean_err(1), "nose_tip": mean_err(2) } },
         "results": all,
         "roc_plot": "roc.svg",
@@ -596,6 +922,8 @@ pub fn run(args: Args) -> Result<()> {
         out.join("summary.json"),
         serde_json::to_string_pretty(&summary)?,
     )?;
+    print_results(&all);
+    eprintln!("{secs:.1} s wall");
     println!("{}", out.display());
     Ok(())
 }

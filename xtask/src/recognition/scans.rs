@@ -9,8 +9,9 @@
 //! the scan, a descriptor error) is listed with the face's name and counted, never replaced.
 
 use super::{
-    describe_face, icp_points, results_table, roc_figure, score_row, summarize, Args,
-    DescribeOptions, Described, Lm, Metrics,
+    describe_face, elastic_options, icp_points, iso_levels_of, median, order_stat, print_results,
+    results_table, roc_figure, score_row, summarize, time_comparisons, time_descriptions,
+    timed_pairs, Args, DescribeOptions, Described, Lm, Metrics, Row, TIMED_FACES,
 };
 use crate::experiments::pipeline::{bar, resolve_methods};
 use crate::experiments::report::{line_plot, Report, Series};
@@ -19,7 +20,8 @@ use crate::experiments::scans::{
 };
 use crate::experiments::walk::Walker;
 use crate::paths::default_out_dir;
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
+use facecurves::ElasticOptions;
 use facemodel::FaceModel;
 use geodesic::Method;
 use landmarks::GenericModel;
@@ -43,6 +45,8 @@ struct Sweep {
     apply: fn(ScanSettings, f64) -> ScanSettings,
 }
 
+/// The sweeps (each value rescans `--sweep-identities` faces); the gallery's default setting
+/// (noise 0.1 mm, pitch 0.5 mm, yaw 0) is among the values.
 fn sweeps() -> Vec<Sweep> {
     vec![
         Sweep {
@@ -72,6 +76,8 @@ struct Face {
     identity: usize,
     /// The cleaned scan, kept for gallery faces (ICP target).
     mesh: Option<TriMesh>,
+    /// Its ground-truth landmark vertices, when on the scan.
+    gt_lm: Option<Lm>,
     /// ICP probe points.
     pts: Vec<DVec3>,
     /// Per landmark set: the description or why there is none.
@@ -128,6 +134,7 @@ fn describe_spec(
         name: spec.name.clone(),
         identity: spec.identity,
         mesh: None,
+        gt_lm: None,
         pts: Vec::new(),
         desc: [Err(String::new()), Err(String::new())],
         det_err: None,
@@ -157,6 +164,7 @@ fn describe_spec(
     }
     let t = Instant::now();
     let lms = [s.truth_vertices(), s.detected_vertices()];
+    face.gt_lm = lms[0].as_ref().ok().map(|&[r, q, nose]| Lm { r, q, nose });
     face.desc = match geodesic::new_solver(&s.mesh, method) {
         Ok(solver) => {
             let walker = Walker::new(&s.mesh);
@@ -178,12 +186,15 @@ fn describe_spec(
     face
 }
 
-/// Figures of a probe group against the gallery, per landmark set and score.
+/// Figures of a probe group against the gallery, per landmark set and score, with the times
+/// per comparison (timed on pairs of this group) and per description (`ms_desc`).
 fn score_group(
     gallery: &[Face],
     locators: &[Option<FaceLocator<'_>>],
     probes: &[Face],
-) -> Vec<Metrics> {
+    elastic: &ElasticOptions,
+    ms_desc: &[f64; 4],
+) -> Result<Vec<Metrics>> {
     let gid: Vec<usize> = gallery.iter().map(|g| g.identity).collect();
     let pid: Vec<usize> = probes.iter().map(|p| p.identity).collect();
     let mut all = Vec::new();
@@ -193,13 +204,18 @@ fn score_group(
             .zip(locators)
             .map(|(g, l)| g.desc[k].as_ref().ok().zip(l.as_ref()))
             .collect();
-        let rows: Vec<[Vec<f64>; 3]> = probes
+        let rows: Vec<Row> = probes
             .par_iter()
-            .map(|p| score_row(p.desc[k].as_ref().ok(), &p.pts, &gal))
+            .map(|p| score_row(p.desc[k].as_ref().ok(), &p.pts, &gal, elastic))
             .collect();
-        all.extend(summarize(&rows, &pid, &gid, set));
+        let pr: Vec<(Option<&Described>, &[DVec3])> = probes
+            .iter()
+            .map(|p| (p.desc[k].as_ref().ok(), p.pts.as_slice()))
+            .collect();
+        let ms_cmp = time_comparisons(&timed_pairs(&pr, &gal), elastic)?;
+        all.extend(summarize(&rows, &ms_cmp, ms_desc, &pid, &gid, set));
     }
-    all
+    Ok(all)
 }
 
 /// Every failure of a group: (face, landmark set, what failed).
@@ -207,11 +223,19 @@ fn failures(faces: &[Face], group: &str) -> Vec<[String; 4]> {
     let mut out = Vec::new();
     for f in faces {
         for (k, set) in SETS.iter().enumerate() {
-            let what = match &f.desc[k] {
-                Err(e) => Some(e.clone()),
-                Ok(d) => d.bip.as_ref().err().cloned(),
+            let what: Vec<String> = match &f.desc[k] {
+                Err(e) => vec![e.clone()],
+                Ok(d) => [
+                    d.bip.as_ref().err(),
+                    d.facial.as_ref().err(),
+                    d.iso.as_ref().err(),
+                ]
+                .into_iter()
+                .flatten()
+                .cloned()
+                .collect(),
             };
-            if let Some(w) = what {
+            for w in what {
                 out.push([group.to_string(), f.name.clone(), set.to_string(), w]);
             }
         }
@@ -219,29 +243,14 @@ fn failures(faces: &[Face], group: &str) -> Vec<[String; 4]> {
     out
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.retain(|x| x.is_finite());
-    v.sort_by(f64::total_cmp);
-    if v.is_empty() {
-        f64::NAN
-    } else {
-        v[v.len() / 2]
-    }
-}
-
-fn p95(mut v: Vec<f64>) -> f64 {
-    v.retain(|x| x.is_finite());
-    v.sort_by(f64::total_cmp);
-    if v.is_empty() {
-        f64::NAN
-    } else {
-        v[((v.len() - 1) as f64 * 0.95).round() as usize]
-    }
+/// 95th percentile (nearest rank) of the finite values.
+fn p95(v: Vec<f64>) -> f64 {
+    order_stat(v, |n| ((n - 1) as f64 * 0.95).round() as usize)
 }
 
 /// Runs the scan benchmark; prints the output folder on the last line.
 pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
-    let identities = args.identities.unwrap_or(12);
+    let identities = args.identities.unwrap_or(16);
     let expressions = args.expressions.unwrap_or(3);
     if identities < 2 || expressions < 2 {
         bail!("need at least 2 identities and 2 expressions (one neutral gallery face + probes)");
@@ -253,14 +262,23 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
     let base = args.scan.settings();
     let generic =
         GenericModel::default_model().map_err(|e| anyhow::anyhow!("landmark model: {e}"))?;
+    if !(args.scan_edge.is_finite() && args.scan_edge >= 0.0) {
+        bail!(
+            "--scan-edge {} mm (must be 0, for no decimation, or positive)",
+            args.scan_edge
+        );
+    }
     let scan_opts = ScanSetOptions {
         crop_radius_mm: args.scan.crop_radius,
+        target_edge_mm: (args.scan_edge > 0.0).then_some(args.scan_edge),
         ..ScanSetOptions::default()
     };
-    let dopt = DescribeOptions {
+    let mut dopt = DescribeOptions {
         levels: args.levels,
         sectors: args.sectors,
+        iso_levels: None,
     };
+    let elastic = elastic_options(args.curve_samples);
     // Specs: gallery, main probes, sweeps (each face its own scan seed).
     let weights = sample_weights(model, identities, expressions, args.seed);
     let mut rng = ChaCha8Rng::seed_from_u64(scan_seed(args.seed, u64::MAX));
@@ -308,6 +326,35 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         .collect();
     let methods = resolve_methods(&args.method, &meshcore::shapes::icosphere(1))?;
     let method = methods[0].used;
+    // Iso-curvature levels: from the first gallery scan (ground-truth landmarks), scanned once
+    // more here (without detection) before the runs.
+    {
+        let first = scan_face(
+            model,
+            &generic,
+            &gallery_specs[0],
+            &ScanSetOptions {
+                detect: None,
+                ..scan_opts.clone()
+            },
+        )
+        .with_context(|| {
+            format!(
+                "scanning {} for the iso-curvature levels",
+                gallery_specs[0].name
+            )
+        })?;
+        let [r, q, nose] = first
+            .truth_vertices()
+            .map_err(|e| anyhow::anyhow!("{}: {e}", gallery_specs[0].name))?;
+        let solver = geodesic::new_solver(&first.mesh, method)?;
+        dopt.iso_levels = Some(iso_levels_of(
+            &first.mesh,
+            solver.as_ref(),
+            Lm { r, q, nose },
+            args.iso_levels,
+        )?);
+    }
     let n_faces = gallery_specs.len()
         + probe_specs.len()
         + sweep_specs.iter().flatten().map(Vec::len).sum::<usize>();
@@ -335,7 +382,17 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         .map(|g| g.mesh.as_ref().map(FaceLocator::new))
         .collect();
     let probes = run(&probe_specs, false, "probe scans");
-    let main = score_group(&gallery, &locators, &probes);
+    // Description times: the first gallery scans again, one at a time on one thread.
+    let first: Vec<(&TriMesh, Lm)> = gallery
+        .iter()
+        .filter_map(|g| {
+            let m = g.mesh.as_ref()?;
+            g.gt_lm.map(|lm| (m, lm))
+        })
+        .take(TIMED_FACES)
+        .collect();
+    let ms_desc = time_descriptions(&first, method, &dopt)?;
+    let main = score_group(&gallery, &locators, &probes, &elastic, &ms_desc)?;
     let mut fails = failures(&gallery, "gallery");
     fails.extend(failures(&probes, "probes"));
     // Sweeps.
@@ -345,7 +402,9 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         let mut per_value = Vec::new();
         for (v, specs) in sw.values.iter().zip(groups) {
             let faces = run(specs, false, &format!("sweep {} {v}", sw.name));
-            per_value.push(score_group(&gallery, &locators, &faces));
+            per_value.push(score_group(
+                &gallery, &locators, &faces, &elastic, &ms_desc,
+            )?);
             fails.extend(failures(&faces, &format!("sweep {} {v}", sw.name)));
             sweep_faces.extend(faces);
         }
@@ -359,17 +418,23 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         "Recognition benchmark on range scans of sampled ICT faces",
     )?;
     rep.para(&format!(
-        "{identities} identities x {expressions} faces (seed {}). Gallery: {} neutral frontal scans ({}). Probes: {} scans of the other expressions, each under a random yaw of 0-45 degrees to either side and a noise of {} mm (other settings as the gallery). Scans by `rangescan` (orthographic), cleaned by `scanprep` (spikes, holes up to 10 mm, small components, crop of {} mm around the true nose tip). Geodesics: {}. Bipolar descriptor: static area, N = {} levels between the outer eye corners; single pole: {} sectors around the nose tip; ICP: about {} probe vertices onto the gallery surface from the 3-landmark alignment, 10 % trimmed, score = RMS closest-point distance (mm). Ground-truth landmarks: the model's landmark vertices carried through the scanner, at the nearest vertex of the cleaned scan (a landmark the scanner does not see is a failure); detected: `landmarks::detect` on the cleaned scan.",
+        "{identities} identities x {expressions} faces (seed {}). Gallery: {} neutral frontal scans ({}). Probes: {} scans of the other expressions, each under a random yaw of 0-45 degrees to either side and a noise of {} mm (other settings as the gallery). Scans by `rangescan` (orthographic), cleaned by `scanprep` (spikes, holes up to 10 mm, small components, crop of {} mm around the true nose tip{}). Geodesics: {}. Bipolar descriptor: static area, N = {} levels between the outer eye corners; single pole: {} sectors around the nose tip; ICP: about {} probe vertices onto the gallery surface from the 3-landmark alignment, 10 % trimmed, score = RMS closest-point distance (mm); facial curves: N level curves of the nose-tip field up to D, elastic distance ({} segments per curve, one start-point candidate, one alternation), root sum of squares; iso-curvature: {} levels per principal field (quantiles of the first gallery scan) in the geodesic disc of radius D around the nose tip, normalised RMS closest-point distance after an ICP started from the 3-landmark alignment. Times, single thread (one-thread pool after the parallel work): per comparison the mean over up to 24 probe x gallery pairs per group and landmark set; per description the median over the first 6 gallery scans (ground truth) of the fields a representation needs plus its build. Ground-truth landmarks: the model's landmark vertices carried through the scanner, at the nearest vertex of the cleaned scan (a landmark the scanner does not see is a failure); detected: `landmarks::detect` on the cleaned scan.",
         args.seed,
         gallery.len(),
         base.label(),
         probes.len(),
         PROBE_NOISE.map(|x| x.to_string()).join(" / "),
         args.scan.crop_radius,
+        scan_opts
+            .target_edge_mm
+            .map(|e| format!(", then decimated to {e} mm edges"))
+            .unwrap_or_default(),
         method.name(),
         args.levels,
         args.sectors,
         args.icp_points,
+        args.curve_samples,
+        args.iso_levels,
     ));
     rep.heading(2, "Main run");
     results_table(&mut rep, &main, "results.csv")?;
@@ -386,7 +451,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
     ));
     let time_row = |k: usize| median(everyone.iter().map(|f| f.secs[k]).collect());
     rep.para(&format!(
-        "Per scan (median wall time, {} valid samples, {} vertices after cleaning): scan {:.2} s, clean {:.2} s, detect {:.2} s, two descriptions {:.2} s (faces in parallel on every core, so these are upper bounds of the single-scan times).",
+        "Per scan (median wall time, {} valid samples, {} vertices after cleaning): scan {:.2} s, clean {:.2} s, detect {:.2} s, the four representations with both landmark sets {:.2} s (faces in parallel on every core, so these are upper bounds of the single-scan times).",
         median(everyone.iter().map(|f| f.valid_samples as f64).collect()),
         median(everyone.iter().map(|f| f.vertices as f64).collect()),
         time_row(0), time_row(1), time_row(2), time_row(3)
@@ -506,6 +571,9 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         "geodesic_method": method.name(),
         "levels": args.levels,
         "sectors": args.sectors,
+        "iso_levels": args.iso_levels,
+        "curve_samples": args.curve_samples,
+        "scan_edge_mm": scan_opts.target_edge_mm,
         "results": main,
         "sweeps": sweep_defs.iter().zip(&sweep_results).map(|(sw, pv)| serde_json::json!({
             "name": sw.name,
@@ -521,12 +589,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         out.join("summary.json"),
         serde_json::to_string_pretty(&summary)?,
     )?;
-    for m in &main {
-        eprintln!(
-            "{:<14} {:<13} rank-1 {:.3}  EER {:.3}  failed pairs {}",
-            m.descriptor, m.landmarks, m.rank1, m.eer, m.failures
-        );
-    }
+    print_results(&main);
     eprintln!("{} failures; {secs:.1} s wall", fails.len());
     println!("{}", out.display());
     Ok(())
