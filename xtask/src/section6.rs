@@ -24,7 +24,7 @@ use crate::experiments::pipeline::{
 use crate::experiments::polar::{self, polar_descriptor, PolarOptions, Pole};
 use crate::experiments::report::{f4, Report};
 use crate::experiments::walk::Walker;
-use crate::paths::{default_out_dir, default_paper_set};
+use crate::paths::{FaceSetArgs, ResolutionArgs};
 use crate::robustness::pole::{rotate_rings, ROTATED};
 use crate::robustness::stats::{max, mean, Sep};
 use anyhow::{bail, Context, Result};
@@ -40,7 +40,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 use rayon::prelude::*;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 use viz::{Polyline, Scene, View};
@@ -48,19 +48,13 @@ use viz::{Polyline, Scene, View};
 /// Arguments of `cargo xtask section6`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
-    /// Folder of the face set (OBJ files + landmarks.json); default
-    /// `$BIPOLAR_SHARED/faces/ict-facekit/paper-set`.
-    #[arg(long)]
-    pub faces: Option<PathBuf>,
-    /// Report folder (default `target/section6`).
-    #[arg(long)]
-    pub out: Option<PathBuf>,
-    /// Levels N: bipolar levels between the corners; polar radii and facial curves at D / N.
-    #[arg(long, default_value_t = 10)]
-    pub levels: u32,
-    /// Angular sectors of the single pole.
-    #[arg(long, default_value_t = 16)]
-    pub sectors: u32,
+    /// Face set and report folder (default `target/section6`).
+    #[command(flatten)]
+    pub set: FaceSetArgs,
+    /// Resolution: bipolar levels N between the corners; polar radii and facial curves at
+    /// D / N; single-pole sectors.
+    #[command(flatten)]
+    pub res: ResolutionArgs,
     /// Levels per principal field of the iso-curvature network (between the 5 % and 95 %
     /// quantiles of the test face, the same levels for every face).
     #[arg(long = "iso-levels", default_value_t = 6)]
@@ -177,7 +171,7 @@ impl Ctx<'_> {
         name: &str,
         which: Which,
     ) -> Descs {
-        let n = self.args.levels;
+        let n = self.args.res.levels;
         let bip = which.bipolar.then(|| {
             self.ok(
                 bipolar(mesh, refs, n, Region::Static, DescriptorRule::CrateAll),
@@ -195,7 +189,7 @@ impl Ctx<'_> {
         let popts = PolarOptions {
             step: refs.d / f64::from(n),
             levels: n,
-            sectors: self.args.sectors,
+            sectors: self.args.res.sectors,
         };
         let polar = self
             .ok(
@@ -296,19 +290,16 @@ fn noisy(mesh: &TriMesh, sigma: f64, seed: u64) -> Result<TriMesh> {
 /// Runs the task; prints the report folder on the last line.
 pub fn run(args: Args) -> Result<()> {
     let t_start = Instant::now();
-    if args.levels < 2 || args.sectors < 3 || args.iso_levels == 0 {
+    if args.res.levels < 2 || args.res.sectors < 3 || args.iso_levels == 0 {
         bail!("--levels must be >= 2, --sectors >= 3 and --iso-levels >= 1");
     }
-    let dir = args.faces.clone().unwrap_or_else(default_paper_set);
+    let dir = args.set.faces_dir();
     let faces = load_face_set(&dir)?;
     let test = faces
         .iter()
         .position(|f| f.name == "id1_neutral")
         .unwrap_or(0);
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| default_out_dir("section6"));
+    let out = args.set.out_dir("section6");
     let mut rep = Report::new(&out, "Section 6: the four representations side by side")?;
     eprintln!(
         "{} faces from {}; test face {}",
@@ -536,7 +527,7 @@ pub fn run(args: Args) -> Result<()> {
             .context("the test face's single-pole descriptor")?,
         other.and_then(|j| base[j].polar.as_ref()),
         args.seed,
-        args.levels,
+        args.res.levels,
     )?;
 
     write_report(
@@ -727,8 +718,8 @@ fn write_report(
          `cargo xtask section6` (release); total {:.0} s.",
         faces.len(),
         tf.name,
-        args.levels,
-        args.sectors,
+        args.res.levels,
+        args.res.sectors,
         args.iso_levels,
         args.seed,
         t_start.elapsed().as_secs_f64()

@@ -24,7 +24,7 @@ use crate::experiments::polar::{self, polar_descriptor, PolarOptions, Pole};
 use crate::experiments::report::{f4, line_plot, Report, Series};
 use crate::experiments::scans::ScanArgs;
 use crate::experiments::walk::Walker;
-use crate::paths::{default_model_dir, default_out_dir};
+use crate::paths::{ModelArgs, ResolutionArgs};
 use anyhow::{bail, Context, Result};
 use bipolar::PolarDescriptor;
 use facecurves::{ElasticOptions, FacialCurvesDescriptor, IsoLevels};
@@ -39,7 +39,6 @@ use shapedist::{
     icp_to_target, Convergence, IcpLoopOptions, IcpOptions, IcpVariant, PreparedSet, TrimRounding,
     Which,
 };
-use std::path::PathBuf;
 use std::time::Instant;
 
 /// Arguments of `cargo xtask recognition`.
@@ -57,12 +56,9 @@ pub struct Args {
     /// Geodesic method (exact falls back to fmm, then heat, if unavailable).
     #[arg(long, default_value = "exact")]
     pub method: String,
-    /// Levels between the reference points.
-    #[arg(long, default_value_t = 10)]
-    pub levels: u32,
-    /// Sectors of the single-pole descriptor.
-    #[arg(long, default_value_t = 16)]
-    pub sectors: u32,
+    /// Descriptor resolution.
+    #[command(flatten)]
+    pub res: ResolutionArgs,
     /// Levels per principal field of the iso-curvature network (between the 5 % and 95 %
     /// quantiles of the first gallery face's curvatures, the same levels for every face).
     #[arg(long = "iso-levels", default_value_t = 6)]
@@ -73,12 +69,10 @@ pub struct Args {
     /// Probe vertices used by ICP (evenly strided).
     #[arg(long, default_value_t = 100)]
     pub icp_points: usize,
-    /// ICT model folder (default `$BIPOLAR_SHARED/faces/ict-facekit/model`).
-    #[arg(long)]
-    pub model: Option<PathBuf>,
-    /// Output folder (default `target/recognition`; with `--scans` `target/recognition-scans`).
-    #[arg(long)]
-    pub out: Option<PathBuf>,
+    /// ICT model folder and output folder (default `target/recognition`; with `--scans`
+    /// `target/recognition-scans`).
+    #[command(flatten)]
+    pub io: ModelArgs,
     /// Recognition on range scans (`rangescan`, cleaned by `scanprep`): neutral frontal scans
     /// (the `--scan-*` settings) as the gallery, expressions under yaw and noise as probes, and
     /// sweeps of noise, pitch and yaw.
@@ -717,7 +711,7 @@ fn roc_figure(rep: &mut Report, all: &[Metrics], file: &str, title: &str) -> Res
 /// Runs the benchmark; prints the output folder on the last line.
 pub fn run(args: Args) -> Result<()> {
     let t0 = Instant::now();
-    let model_dir = args.model.clone().unwrap_or_else(default_model_dir);
+    let model_dir = args.io.model_dir();
     let model = FaceModel::load(&model_dir)
         .with_context(|| format!("loading the ICT model from {}", model_dir.display()))?;
     if args.scans {
@@ -728,10 +722,7 @@ pub fn run(args: Args) -> Result<()> {
     if identities < 2 || expressions < 2 {
         bail!("need at least 2 identities and 2 expressions (one neutral gallery face + probes)");
     }
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| default_out_dir("recognition"));
+    let out = args.io.out_dir("recognition");
     let gt = Lm {
         r: model.landmark_id("right_eye_outer")?,
         q: model.landmark_id("left_eye_outer")?,
@@ -779,8 +770,8 @@ pub fn run(args: Args) -> Result<()> {
         iso_levels_of(&s.mesh, solver.as_ref(), gt, args.iso_levels)?
     };
     let desc_opts = DescribeOptions {
-        levels: args.levels,
-        sectors: args.sectors,
+        levels: args.res.levels,
+        sectors: args.res.sectors,
         iso_levels: Some(iso_levels),
     };
     let elastic = elastic_options(args.curve_samples);
@@ -888,8 +879,8 @@ pub fn run(args: Args) -> Result<()> {
         "{} identities x {} faces (seed {}): {} gallery faces (neutral), {} probes (random expressions: with probability 1/2 a recipe at strength 0.3-1, plus random blendshapes), every face under a random rigid motion. Geodesics: {}{}. Bipolar descriptor: static area, N = {} levels between the outer eye corners (grid reading, keyed distance); single pole: {} sectors x {} radius levels around the nose tip; ICP: {} probe vertices onto the gallery surface, started from the 3-landmark alignment, 10 % trimmed, score = RMS closest-point distance (cm); facial curves: N = {} level curves of the nose-tip field up to D, elastic distance ({} segments per curve, one start-point candidate, one rotation / reparametrisation alternation), root sum of squares; iso-curvature: {} levels per principal field (quantiles of the first gallery face) in the geodesic disc of radius D around the nose tip, ICP of the networks' points (thinned to at most {ISO_POINTS}, every k-th point) started from the 3-landmark alignment (10 iterations on a 500-point subsample, at most 10 on all points), score = normalised RMS closest-point distance. Times, single thread (a one-thread pool, after the parallel scoring; the machine is shared, so compare them as ratios): ms per comparison is the mean over {TIMED_PAIRS} probe x gallery pairs per landmark set; ms per description the median over the first {TIMED_FACES} gallery faces (ground-truth landmarks) of the fields a representation needs (both corners; the nose tip) plus its build.",
         identities, expressions, args.seed, gallery.len(), probes.len(), method.name(),
         method_note.as_ref().map(|n| format!(" (exact requested: {n})")).unwrap_or_default(),
-        args.levels, args.sectors, args.levels, icp_points(&samples[0].mesh, args.icp_points).len(),
-        args.levels, args.curve_samples, args.iso_levels
+        args.res.levels, args.res.sectors, args.res.levels, icp_points(&samples[0].mesh, args.icp_points).len(),
+        args.res.levels, args.curve_samples, args.iso_levels
     ));
     let n_det = detected.iter().filter(|d| d.is_some()).count();
     let mean_err =
@@ -909,8 +900,8 @@ pub fn run(args: Args) -> Result<()> {
         "probes": probes.len(),
         "geodesic_method": method.name(),
         "geodesic_note": method_note,
-        "levels": args.levels,
-        "sectors": args.sectors,
+        "levels": args.res.levels,
+        "sectors": args.res.sectors,
         "iso_levels": args.iso_levels,
         "curve_samples": args.curve_samples,
         "landmark_detection": { "detected": n_det, "faces": samples.len(), "mean_error_cm": { "right_eye_outer": mean_err(0), "left_eye_outer": mean_err(1), "nose_tip": mean_err(2) } },

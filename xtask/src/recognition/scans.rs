@@ -19,7 +19,6 @@ use crate::experiments::scans::{
     sample_weights, scan_face, scan_seed, FaceSpec, ScanSetOptions, ScanSettings,
 };
 use crate::experiments::walk::Walker;
-use crate::paths::default_out_dir;
 use anyhow::{bail, Context, Result};
 use facecurves::ElasticOptions;
 use facemodel::FaceModel;
@@ -255,10 +254,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
     if identities < 2 || expressions < 2 {
         bail!("need at least 2 identities and 2 expressions (one neutral gallery face + probes)");
     }
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| default_out_dir("recognition-scans"));
+    let out = args.io.out_dir("recognition-scans");
     let base = args.scan.settings();
     let generic =
         GenericModel::default_model().map_err(|e| anyhow::anyhow!("landmark model: {e}"))?;
@@ -274,8 +270,8 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         ..ScanSetOptions::default()
     };
     let mut dopt = DescribeOptions {
-        levels: args.levels,
-        sectors: args.sectors,
+        levels: args.res.levels,
+        sectors: args.res.sectors,
         iso_levels: None,
     };
     let elastic = elastic_options(args.curve_samples);
@@ -430,8 +426,8 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
             .map(|e| format!(", then decimated to {e} mm edges"))
             .unwrap_or_default(),
         method.name(),
-        args.levels,
-        args.sectors,
+        args.res.levels,
+        args.res.sectors,
         args.icp_points,
         args.curve_samples,
         args.iso_levels,
@@ -569,8 +565,8 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         "probes": probes.len(),
         "sweep_identities": sweep_ids,
         "geodesic_method": method.name(),
-        "levels": args.levels,
-        "sectors": args.sectors,
+        "levels": args.res.levels,
+        "sectors": args.res.sectors,
         "iso_levels": args.iso_levels,
         "curve_samples": args.curve_samples,
         "scan_edge_mm": scan_opts.target_edge_mm,
