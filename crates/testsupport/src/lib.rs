@@ -9,7 +9,7 @@
 //! * **Meshes**: [`read_mesh`] (through `mesh-io`, the project's one reader) and the generators
 //!   of [`meshcore::shapes`], re-exported as [`shapes`], plus [`jittered_grid`],
 //!   [`jittered_unit_plane`] (the plane of the straightest-geodesic, single-pole and face-frame
-//!   tests), [`height_field`], [`uv_sphere_y_up`] and [`triangle_soup`].
+//!   tests), [`height_field`], [`uv_sphere_y_up`] and [`renumbered`].
 //! * **Analytic distance fields** and the differences between two fields: [`fields`].
 //! * **End-to-end runs** of the command-line tools: [`cli`]; the check of a crate's option
 //!   names: [`check_choice_error`].
