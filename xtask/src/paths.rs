@@ -58,6 +58,24 @@ impl FaceSetArgs {
     pub fn out_dir(&self, task: &str) -> PathBuf {
         self.out.clone().unwrap_or_else(|| default_out_dir(task))
     }
+
+    /// Loads the face set and picks the test face (`id1_neutral`, else the first); prints
+    /// what was loaded. Returns the faces and the test face's index.
+    pub fn load(&self) -> anyhow::Result<(Vec<facemodel::Face>, usize)> {
+        let dir = self.faces_dir();
+        let faces = facemodel::load_face_set(&dir)?;
+        let test = faces
+            .iter()
+            .position(|f| f.name == "id1_neutral")
+            .unwrap_or(0);
+        eprintln!(
+            "{} faces from {}; test face {}",
+            faces.len(),
+            dir.display(),
+            faces[test].name
+        );
+        Ok((faces, test))
+    }
 }
 
 /// The resolution of the bipolar and single-pole descriptors.

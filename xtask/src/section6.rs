@@ -33,7 +33,7 @@ use facecurves::{
     elastic_distance, ElasticOptions, FacialCurvesDescriptor, IsoCurvatureDescriptor, IsoLevels,
     PrincipalField,
 };
-use facemodel::{face_frame, load_face_set, Face};
+use facemodel::{face_frame, Face};
 use geodesic::{GeodesicSolver, Method, Source};
 use meshcore::{DVec3, Surface, TriMesh};
 use rand::SeedableRng;
@@ -245,29 +245,8 @@ impl Ctx<'_> {
 
 fn prepare(f: &Face) -> Result<Prep> {
     let solver = geodesic::new_solver(&f.mesh, Method::Exact)?;
-    let lm = f.landmarks;
-    let ur = field(solver.as_ref(), Source::Vertex(lm.right_eye_outer))?;
-    let uq = field(solver.as_ref(), Source::Vertex(lm.left_eye_outer))?;
-    let un = field(solver.as_ref(), Source::Vertex(lm.nose_tip))?;
-    let d = 0.5 * (ur[lm.left_eye_outer as usize] + uq[lm.right_eye_outer as usize]);
-    let (r, q, nose) = (
-        f.mesh.position(lm.right_eye_outer),
-        f.mesh.position(lm.left_eye_outer),
-        f.mesh.position(lm.nose_tip),
-    );
-    Ok(Prep {
-        solver,
-        refs: Refs {
-            ur,
-            uq,
-            d,
-            r,
-            q,
-            nose,
-            frame: face_frame(&f.mesh, r, q, nose),
-        },
-        un,
-    })
+    let (refs, un) = Refs::of_face(f, solver.as_ref())?;
+    Ok(Prep { solver, refs, un })
 }
 
 /// `mesh` with Gaussian noise of standard deviation `sigma` (mesh units) along its vertex
@@ -293,20 +272,9 @@ pub fn run(args: Args) -> Result<()> {
     if args.res.levels < 2 || args.res.sectors < 3 || args.iso_levels == 0 {
         bail!("--levels must be >= 2, --sectors >= 3 and --iso-levels >= 1");
     }
-    let dir = args.set.faces_dir();
-    let faces = load_face_set(&dir)?;
-    let test = faces
-        .iter()
-        .position(|f| f.name == "id1_neutral")
-        .unwrap_or(0);
+    let (faces, test) = args.set.load()?;
     let out = args.set.out_dir("section6");
     let mut rep = Report::new(&out, "Section 6: the four representations side by side")?;
-    eprintln!(
-        "{} faces from {}; test face {}",
-        faces.len(),
-        dir.display(),
-        faces[test].name
-    );
     let walkers: Vec<Walker<'_>> = faces.par_iter().map(|f| Walker::new(&f.mesh)).collect();
     let pb = bar(faces.len(), "geodesic fields");
     let preps: Vec<Prep> = faces

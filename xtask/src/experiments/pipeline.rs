@@ -4,7 +4,7 @@
 
 use super::walk::Walker;
 use anyhow::{bail, Context, Result};
-use facemodel::{static_mask, FaceFrame};
+use facemodel::{face_frame, static_mask, Face, FaceFrame};
 use geodesic::{GeodesicSolver, Method, SolveOptions, Source};
 use indicatif::{ProgressBar, ProgressStyle};
 use meshcore::{DVec3, SurfacePoint, TriMesh};
@@ -37,6 +37,35 @@ pub struct Refs {
     pub nose: DVec3,
     /// Face frame from r, q and the nose tip (for the static-area mask).
     pub frame: FaceFrame,
+}
+
+impl Refs {
+    /// The reference configuration of a face from its landmark vertices, with `solver` (of
+    /// `face.mesh`), and the nose tip's distance field (the single pole's and the facial
+    /// curves' field).
+    pub fn of_face(face: &Face, solver: &dyn GeodesicSolver) -> Result<(Refs, Vec<f64>)> {
+        let (m, lm) = (&face.mesh, face.landmarks);
+        let ur = field(solver, Source::Vertex(lm.right_eye_outer))?;
+        let uq = field(solver, Source::Vertex(lm.left_eye_outer))?;
+        let un = field(solver, Source::Vertex(lm.nose_tip))?;
+        let d = 0.5 * (ur[lm.left_eye_outer as usize] + uq[lm.right_eye_outer as usize]);
+        let (r, q, nose) = (
+            m.position(lm.right_eye_outer),
+            m.position(lm.left_eye_outer),
+            m.position(lm.nose_tip),
+        );
+        let frame = face_frame(m, r, q, nose);
+        let refs = Refs {
+            ur,
+            uq,
+            d,
+            r,
+            q,
+            nose,
+            frame,
+        };
+        Ok((refs, un))
+    }
 }
 
 /// Distance field from one source.

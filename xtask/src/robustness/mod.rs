@@ -16,16 +16,14 @@ mod random;
 mod report;
 pub(crate) mod stats;
 
-use crate::experiments::pipeline::{
-    bipolar, dist, field, resolve_methods, DescriptorRule, Refs, Region,
-};
+use crate::experiments::pipeline::{bipolar, dist, resolve_methods, DescriptorRule, Refs, Region};
 use crate::experiments::polar::PolarOptions;
 use crate::experiments::walk::Walker;
 use crate::paths::{FaceSetArgs, ResolutionArgs};
 use anyhow::{bail, Result};
 use bipolar::PolarDescriptor;
-use facemodel::{face_frame, load_face_set, Face};
-use geodesic::{GeodesicSolver, Method, Source};
+use facemodel::Face;
+use geodesic::{GeodesicSolver, Method};
 use meshcore::{DVec3, TriMesh};
 use rayon::prelude::*;
 use shapedist::ShapeDistError;
@@ -250,22 +248,11 @@ fn n_keys(d: &Desc) -> usize {
 /// Runs the task; prints the report folder on the last line.
 pub fn run(args: Args) -> Result<()> {
     let t0 = Instant::now();
-    let dir = args.set.faces_dir();
-    let faces = load_face_set(&dir)?;
-    let test = faces
-        .iter()
-        .position(|f| f.name == "id1_neutral")
-        .unwrap_or(0);
+    let (faces, test) = args.set.load()?;
     if args.res.levels < 2 || args.res.sectors < 3 {
         bail!("--levels must be >= 2 and --sectors >= 3");
     }
     let out = args.set.out_dir("robustness");
-    eprintln!(
-        "{} faces from {}; test face {}",
-        faces.len(),
-        dir.display(),
-        faces[test].name
-    );
     let walkers: Vec<Walker<'_>> = faces.par_iter().map(|f| Walker::new(&f.mesh)).collect();
     let methods = resolve_methods(&args.methods, &faces[test].mesh)?;
     let failures = Failures::default();
@@ -313,31 +300,9 @@ fn prepare(ctx: &Ctx<'_>) -> Result<Prepared> {
         .par_iter()
         .map(|f| -> Result<_> {
             let solver = geodesic::new_solver(&f.mesh, ctx.method)?;
-            let lm = f.landmarks;
-            let ur = field(solver.as_ref(), Source::Vertex(lm.right_eye_outer))?;
-            let uq = field(solver.as_ref(), Source::Vertex(lm.left_eye_outer))?;
-            let un = field(solver.as_ref(), Source::Vertex(lm.nose_tip))?;
-            let d = 0.5 * (ur[lm.left_eye_outer as usize] + uq[lm.right_eye_outer as usize]);
-            let (r, q, nose) = (
-                f.mesh.position(lm.right_eye_outer),
-                f.mesh.position(lm.left_eye_outer),
-                f.mesh.position(lm.nose_tip),
-            );
-            let frame = face_frame(&f.mesh, r, q, nose);
+            let (refs, un) = Refs::of_face(f, solver.as_ref())?;
             pb.inc(1);
-            Ok((
-                solver,
-                Refs {
-                    ur,
-                    uq,
-                    d,
-                    r,
-                    q,
-                    nose,
-                    frame,
-                },
-                un,
-            ))
+            Ok((solver, refs, un))
         })
         .collect::<Result<_>>()?;
     pb.finish();
