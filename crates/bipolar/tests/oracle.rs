@@ -5,7 +5,6 @@
 //! face's bounding-box diagonal. Skipped when the shared data folder is absent.
 
 use bipolar::{describe, DescriptorOptions, Fields, LevelSpec, SelectionRule, Surface};
-use facemodel::load_face_set;
 use geodesic::Method;
 use testsupport::oracle::{bipolar_grid, grid_key_parts, GridOptions};
 
@@ -13,13 +12,11 @@ mod common;
 
 #[test]
 fn rule_all_equals_the_oracle_on_paper_faces() {
-    let dir = testsupport::require_shared!(testsupport::PAPER_SET);
-    let faces = load_face_set(&dir).unwrap();
+    let Some(faces) = testsupport::paper_faces(&["id1_neutral", "id1_anger", "id2_neutral"]) else {
+        return;
+    };
     let mut compared = 0;
-    for f in faces
-        .iter()
-        .filter(|f| ["id1_neutral", "id1_anger", "id2_neutral"].contains(&f.name.as_str()))
-    {
+    for f in &faces {
         let m = &f.mesh;
         let common::CornerFields { ur, uq, d, mask } = common::corner_fields(f, Method::Dijkstra);
         let surface = Surface::new(m.clone());

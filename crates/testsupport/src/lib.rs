@@ -145,6 +145,20 @@ macro_rules! require_shared {
     };
 }
 
+/// The faces of the paper set named in `names` (in the set's order), read with
+/// `facemodel::load_face_set`; `None` without the shared data (the skip rule of
+/// [`shared_path`]); panics if the set cannot be read or a name is missing.
+pub fn paper_faces(names: &[&str]) -> Option<Vec<facemodel::Face>> {
+    let dir = shared_path(PAPER_SET)?;
+    let faces: Vec<facemodel::Face> = facemodel::load_face_set(&dir)
+        .unwrap_or_else(|e| panic!("reading the paper set: {e}"))
+        .into_iter()
+        .filter(|f| names.contains(&f.name.as_str()))
+        .collect();
+    assert_eq!(faces.len(), names.len(), "paper faces {names:?}");
+    Some(faces)
+}
+
 /// [`meshcore::choice::check_choice`] of `T` with the rejected name `bad`, and that parsing
 /// `bad` gives the error `unknown` accepts (the crate's error for an unknown name).
 #[track_caller]
