@@ -367,16 +367,7 @@ fn icp_score(a: &Described, b: &Described, b_loc: &FaceLocator<'_>) -> f64 {
     let Ok(res) = icp_to_target(b_loc, &a.icp_probe, None, init, &opts) else {
         return f64::NAN;
     };
-    let ss: f64 = a
-        .icp_probe
-        .iter()
-        .map(|p| {
-            b_loc
-                .nearest(res.motion.transform_point3(*p))
-                .map_or(f64::NAN, |(_, d)| d * d)
-        })
-        .sum();
-    (ss / a.icp_probe.len().max(1) as f64).sqrt()
+    crate::experiments::pipeline::rms_to_surface(b_loc, &a.icp_probe, &res.motion)
 }
 
 /// Fraction of a descriptor's points whose key is ambiguous (NaN when refused).

@@ -7,7 +7,7 @@ use anyhow::{bail, Context, Result};
 use facemodel::{face_frame, static_mask, Face, FaceFrame};
 use geodesic::{GeodesicSolver, Method, SolveOptions, Source};
 use indicatif::{ProgressBar, ProgressStyle};
-use meshcore::{DVec3, SurfacePoint, TriMesh};
+use meshcore::{DAffine3, DVec3, FaceLocator, SurfacePoint, TriMesh};
 use shapedist::ShapeDistError;
 
 /// Which area a bipolar descriptor covers.
@@ -66,6 +66,20 @@ impl Refs {
         };
         Ok((refs, un))
     }
+}
+
+/// Root mean square distance of the `points` moved by `motion` to the surface of `target`
+/// (every point counted; NaN where a query fails): how ICP results are scored.
+pub fn rms_to_surface(target: &FaceLocator<'_>, points: &[DVec3], motion: &DAffine3) -> f64 {
+    let ss: f64 = points
+        .iter()
+        .map(|p| {
+            target
+                .nearest(motion.transform_point3(*p))
+                .map_or(f64::NAN, |(_, d)| d * d)
+        })
+        .sum();
+    (ss / points.len().max(1) as f64).sqrt()
 }
 
 /// Distance field from one source.

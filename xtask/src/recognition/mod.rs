@@ -428,15 +428,7 @@ fn icp_score(
     let Ok(res) = icp_to_target(gallery, probe, None, init, &icp_options()) else {
         return f64::NAN;
     };
-    let ss: f64 = probe
-        .iter()
-        .map(|p| {
-            gallery
-                .nearest(res.motion.transform_point3(*p))
-                .map_or(f64::NAN, |(_, d)| d * d)
-        })
-        .sum();
-    (ss / probe.len().max(1) as f64).sqrt()
+    crate::experiments::pipeline::rms_to_surface(gallery, probe, &res.motion)
 }
 
 /// About `n` vertices of a probe for ICP, evenly strided.
