@@ -45,6 +45,18 @@ use std::sync::Mutex;
 use std::time::{Duration, Instant};
 use viz::{Polyline, Scene, View};
 
+/// Table columns of the four representations' movements (relative to the distance between
+/// persons in brackets).
+const REL_COLUMNS: [&str; 4] = [
+    "bipolar mean (rel.)",
+    "single pole (rel.)",
+    "facial curves (rel.)",
+    "iso-curvature (rel.)",
+];
+
+/// CSV columns of the four representations.
+const CSV_COLUMNS: [&str; 4] = ["bipolar", "single_pole", "facial", "iso_curvature"];
+
 /// Arguments of `cargo xtask section6`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
@@ -762,16 +774,7 @@ fn write_report(
         all.push(format!("{} ({:.2})", fmt(max(&v)), max(&v) / scale[k]));
     }
     rows.push(all);
-    rep.table(
-        &[
-            "radius (% of D)",
-            "bipolar mean (rel.)",
-            "single pole (rel.)",
-            "facial curves (rel.)",
-            "iso-curvature (rel.)",
-        ],
-        &rows,
-    );
+    rep.table(&[&["radius (% of D)"][..], &REL_COLUMNS].concat(), &rows);
     for (c, g) in grid_cells.iter().zip(grid) {
         let mut r = vec![format!("{}", c.0), format!("{:.1}", c.1.to_degrees())];
         r.extend(g.iter().map(|v| format!("{v}")));
@@ -779,14 +782,7 @@ fn write_report(
     }
     rep.csv(
         "grid.csv",
-        &[
-            "radius_pct",
-            "angle_deg",
-            "bipolar",
-            "single_pole",
-            "facial",
-            "iso_curvature",
-        ],
+        &[&["radius_pct", "angle_deg"][..], &CSV_COLUMNS].concat(),
         &csv,
     )?;
 
@@ -813,26 +809,10 @@ fn write_report(
         r.extend(d.iter().map(|v| format!("{v}")));
         csv.push(r);
     }
-    rep.table(
-        &[
-            "sigma",
-            "bipolar mean (rel.)",
-            "single pole (rel.)",
-            "facial curves (rel.)",
-            "iso-curvature (rel.)",
-        ],
-        &rows,
-    );
+    rep.table(&[&["sigma"][..], &REL_COLUMNS].concat(), &rows);
     rep.csv(
         "noise.csv",
-        &[
-            "sigma_mm",
-            "draw",
-            "bipolar",
-            "single_pole",
-            "facial",
-            "iso_curvature",
-        ],
+        &[&["sigma_mm", "draw"][..], &CSV_COLUMNS].concat(),
         &csv,
     )?;
 
