@@ -2,7 +2,7 @@
 //! per region (built by the `bipolar` crate), keyed distances (`shapedist`), reference-point
 //! perturbation, geodesic method resolution and progress bars.
 
-use super::walk::Walker;
+use crate::walk::Walker;
 use anyhow::{bail, Context, Result};
 use facemodel::{face_frame, static_mask, Face, FaceFrame};
 use geodesic::{GeodesicSolver, Method, SolveOptions, Source};

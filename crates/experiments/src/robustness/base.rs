@@ -3,9 +3,9 @@
 //! the single-pole matrix).
 
 use super::{eye_mid, n_keys, Ctx, Desc, MethodResults, Prepared, RESOLUTIONS};
-use crate::experiments::pipeline::{bar, Region};
-use crate::experiments::polar::{polar_descriptor, Pole};
-use crate::experiments::report::markers;
+use crate::pipeline::{bar, Region};
+use crate::polar::{polar_descriptor, Pole};
+use crate::report::markers;
 use anyhow::{Context, Result};
 use bipolar::PolarDescriptor;
 use facemodel::static_mask;

@@ -15,9 +15,9 @@
 //! Only composes the libraries; deterministic (the scanner's seeds, rayon results collected in
 //! input order).
 
-use crate::experiments::pipeline::{bar, dist};
-use crate::experiments::polar::{polar_descriptor, PolarOptions, Pole};
 use crate::paths::{FaceSetArgs, ResolutionArgs};
+use crate::pipeline::{bar, dist};
+use crate::polar::{polar_descriptor, PolarOptions, Pole};
 use anyhow::{bail, Context, Result};
 use facemodel::{face_frame, load_face_set, static_mask, Face};
 use geodesic::{Method, SolveOptions, Source};
@@ -242,7 +242,7 @@ fn snap(
 }
 
 fn field_at(mesh: &TriMesh, u: &[f64], sp: &SurfacePoint) -> f64 {
-    crate::experiments::pipeline::field_at(mesh, u, sp)
+    crate::pipeline::field_at(mesh, u, sp)
 }
 
 fn describe_scan(face: &Face, setting: &Setting, args: &Args) -> Result<Described> {
@@ -367,7 +367,7 @@ fn icp_score(a: &Described, b: &Described, b_loc: &FaceLocator<'_>) -> f64 {
     let Ok(res) = icp_to_target(b_loc, &a.icp_probe, None, init, &opts) else {
         return f64::NAN;
     };
-    crate::experiments::pipeline::rms_to_surface(b_loc, &a.icp_probe, &res.motion)
+    crate::pipeline::rms_to_surface(b_loc, &a.icp_probe, &res.motion)
 }
 
 /// Fraction of a descriptor's points whose key is ambiguous (NaN when refused).

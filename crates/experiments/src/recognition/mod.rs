@@ -13,18 +13,18 @@
 
 mod scans;
 
-use crate::experiments::curves::{
+use crate::curves::{
     facial_curves, facial_distance, iso_curves, iso_distance_from, iso_point_set,
     reference_iso_levels,
 };
-use crate::experiments::pipeline::{
+use crate::paths::{ModelArgs, ResolutionArgs};
+use crate::pipeline::{
     bar, bipolar, dist, resolve_methods, single_thread, DescriptorRule, Refs, Region,
 };
-use crate::experiments::polar::{self, polar_descriptor, PolarOptions, Pole};
-use crate::experiments::report::{f4, line_plot, Report, Series};
-use crate::experiments::scans::ScanArgs;
-use crate::experiments::walk::Walker;
-use crate::paths::{ModelArgs, ResolutionArgs};
+use crate::polar::{self, polar_descriptor, PolarOptions, Pole};
+use crate::report::{f4, line_plot, Report, Series};
+use crate::scans::ScanArgs;
+use crate::walk::Walker;
 use anyhow::{bail, Context, Result};
 use bipolar::PolarDescriptor;
 use facecurves::{ElasticOptions, FacialCurvesDescriptor, IsoLevels};
@@ -428,7 +428,7 @@ fn icp_score(
     let Ok(res) = icp_to_target(gallery, probe, None, init, &icp_options()) else {
         return f64::NAN;
     };
-    crate::experiments::pipeline::rms_to_surface(gallery, probe, &res.motion)
+    crate::pipeline::rms_to_surface(gallery, probe, &res.motion)
 }
 
 /// About `n` vertices of a probe for ICP, evenly strided.

@@ -3,8 +3,8 @@
 use super::pole::Figure15;
 use super::stats::{matrix_rows, max, mean, min, Sep, SepColumn};
 use super::{Args, Failures, MethodResults, N_DIRS, RADII_PCT};
-use crate::experiments::pipeline::{DescriptorRule, MethodUse};
-use crate::experiments::report::{f4, line_plot, Report, Series};
+use crate::pipeline::{DescriptorRule, MethodUse};
+use crate::report::{f4, line_plot, Report, Series};
 use anyhow::Result;
 use facemodel::Face;
 use std::path::Path;

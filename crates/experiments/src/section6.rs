@@ -6,7 +6,7 @@
 //!   comparison).
 //! * **Reference-point errors** (the grid of figures 9-11): the left outer eye corner (bipolar)
 //!   or the nose tip (single pole, facial curves, and the centre of the iso-curvature region)
-//!   of the test face moved by 1-5 % of D in 8 directions (`experiments::pipeline::perturb`).
+//!   of the test face moved by 1-5 % of D in 8 directions (`crate::pipeline::perturb`).
 //! * **Depth noise**: Gaussian noise along the vertex normals of the test face.
 //! * **Figure 15**: polar rings 2, 4, 6 rotated about their centroids
 //!   (`robustness::pole::rotate_rings`), scored by each distance.
@@ -15,18 +15,18 @@
 //! other person), so the four distances, on different scales, can be compared. The report
 //! states for each claim of section 6 whether the numbers support it.
 
-use crate::experiments::curves::{
+use crate::curves::{
     facial_curves, facial_distance, iso_curves, iso_distance, reference_iso_levels,
 };
-use crate::experiments::pipeline::{
+use crate::paths::{FaceSetArgs, ResolutionArgs};
+use crate::pipeline::{
     bar, bipolar, dist, field, field_at, perturb, single_thread, DescriptorRule, Refs, Region,
 };
-use crate::experiments::polar::{self, polar_descriptor, PolarOptions, Pole};
-use crate::experiments::report::{f4, Report};
-use crate::experiments::walk::Walker;
-use crate::paths::{FaceSetArgs, ResolutionArgs};
+use crate::polar::{self, polar_descriptor, PolarOptions, Pole};
+use crate::report::{f4, Report};
 use crate::robustness::pole::{rotate_rings, ROTATED};
 use crate::robustness::stats::{max, mean, Sep};
+use crate::walk::Walker;
 use anyhow::{bail, Context, Result};
 use bipolar::PolarDescriptor;
 use facecurves::{

@@ -3,10 +3,10 @@
 
 use super::base::render;
 use super::Args;
-use crate::experiments::pipeline::{dist, field};
-use crate::experiments::polar::{polar_descriptor, PolarOptions, Pole};
-use crate::experiments::report::markers;
-use crate::experiments::walk::Walker;
+use crate::pipeline::{dist, field};
+use crate::polar::{polar_descriptor, PolarOptions, Pole};
+use crate::report::markers;
+use crate::walk::Walker;
 use anyhow::Result;
 use bipolar::PolarDescriptor;
 use facemodel::{face_frame, Face, FaceFrame};

@@ -16,10 +16,10 @@ mod random;
 mod report;
 pub(crate) mod stats;
 
-use crate::experiments::pipeline::{bipolar, dist, resolve_methods, DescriptorRule, Refs, Region};
-use crate::experiments::polar::PolarOptions;
-use crate::experiments::walk::Walker;
 use crate::paths::{FaceSetArgs, ResolutionArgs};
+use crate::pipeline::{bipolar, dist, resolve_methods, DescriptorRule, Refs, Region};
+use crate::polar::PolarOptions;
+use crate::walk::Walker;
 use anyhow::{bail, Result};
 use bipolar::PolarDescriptor;
 use facemodel::Face;
@@ -291,10 +291,7 @@ struct Prepared {
 }
 
 fn prepare(ctx: &Ctx<'_>) -> Result<Prepared> {
-    let pb = crate::experiments::pipeline::bar(
-        ctx.faces.len(),
-        &format!("{}: base fields", ctx.mname()),
-    );
+    let pb = crate::pipeline::bar(ctx.faces.len(), &format!("{}: base fields", ctx.mname()));
     let prepared: Vec<(Box<dyn GeodesicSolver>, Refs, Vec<f64>)> = ctx
         .faces
         .par_iter()
@@ -339,11 +336,11 @@ fn run_method(ctx: &Ctx<'_>, out: &Path) -> Result<MethodResults> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::experiments::pipeline::{field_at, perturb};
+    use crate::pipeline::{field_at, perturb};
 
     #[test]
     fn perturbation_moves_by_the_radius_on_a_plane() {
-        let m = crate::experiments::walk::tests::plane(20, 0.2, 5);
+        let m = crate::walk::tests::plane(20, 0.2, 5);
         let w = Walker::new(&m);
         let v = 10 * 21 + 10;
         let p = m.position(v);

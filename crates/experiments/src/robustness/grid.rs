@@ -5,8 +5,8 @@
 use super::base::Base;
 use super::stats::{max, mean, min};
 use super::{eye_mid, Ctx, MethodResults, Prepared, N_DIRS, RADII_PCT, RESOLUTIONS};
-use crate::experiments::pipeline::{bar, field, field_at, perturb, Refs, Region};
-use crate::experiments::polar::{polar_descriptor, Pole};
+use crate::pipeline::{bar, field, field_at, perturb, Refs, Region};
+use crate::polar::{polar_descriptor, Pole};
 use anyhow::Result;
 use bipolar::PolarDescriptor;
 use facemodel::face_frame;

@@ -15,7 +15,7 @@
 //! Reported: the normalised keyed shape distance `min_R ||A - R B|| / sqrt(|A|^2 + |B|^2)`
 //! (common keys, centred, rotation only), mean position error and mean angle (cosine) error.
 
-use crate::experiments::report::markers;
+use crate::report::markers;
 use anyhow::Context;
 use bipolar::{
     Descriptor, DescriptorOptions, Key, LevelSpec, SelectionRule, Source, TangentMethod,
@@ -25,7 +25,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use meshcore::{FaceLocator, TriMesh};
 use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 const ALPHA: f64 = 0.95;
@@ -326,12 +326,9 @@ pub struct Args {
 /// Runs the experiment, writing into the output folder.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let t_start = Instant::now();
-    let out_dir = args.out.unwrap_or_else(|| {
-        Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("..")
-            .join("target")
-            .join("sphere-validate")
-    });
+    let out_dir = args
+        .out
+        .unwrap_or_else(|| crate::paths::default_out_dir("sphere-validate"));
     std::fs::create_dir_all(&out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
     let meshes = meshes()?;
     let rules: [(SelectionRule, &'static str); 3] = [

@@ -13,12 +13,10 @@ use super::{
     results_table, roc_figure, score_row, summarize, time_comparisons, time_descriptions,
     timed_pairs, Args, DescribeOptions, Described, Lm, Metrics, Row, TIMED_FACES,
 };
-use crate::experiments::pipeline::{bar, resolve_methods};
-use crate::experiments::report::{line_plot, Report, Series};
-use crate::experiments::scans::{
-    sample_weights, scan_face, scan_seed, FaceSpec, ScanSetOptions, ScanSettings,
-};
-use crate::experiments::walk::Walker;
+use crate::pipeline::{bar, resolve_methods};
+use crate::report::{line_plot, Report, Series};
+use crate::scans::{sample_weights, scan_face, scan_seed, FaceSpec, ScanSetOptions, ScanSettings};
+use crate::walk::Walker;
 use anyhow::{bail, Context, Result};
 use facecurves::ElasticOptions;
 use facemodel::FaceModel;
