@@ -16,17 +16,16 @@
 //! input order).
 
 use crate::paths::{FaceSetArgs, ResolutionArgs};
-use crate::pipeline::{bar, dist};
+use crate::pipeline::{bar, dist, landmark_icp_rms};
 use crate::polar::{polar_descriptor, PolarOptions, Pole};
+use crate::report::joined;
 use anyhow::{bail, Context, Result};
 use facemodel::{face_frame, load_face_set, static_mask, Face};
 use geodesic::{Method, SolveOptions, Source};
-use meshcore::linalg::fit_rigid;
 use meshcore::{DVec3, FaceLocator, SurfacePoint, TriMesh};
 use rangescan::{Artifacts, DepthNoise, HeadPose, Quantisation, ScanOptions};
 use rayon::prelude::*;
 use scanprep::{CleanOptions, Crop, Input};
-use shapedist::{icp_to_target, Convergence, IcpLoopOptions, IcpVariant, TrimRounding};
 use std::fmt::Write as _;
 use std::time::Instant;
 
@@ -348,26 +347,10 @@ fn describe_scan(face: &Face, setting: &Setting, args: &Args) -> Result<Describe
 }
 
 /// ICP of `a`'s probe points onto `b`'s surface from the landmark alignment: RMS closest-point
-/// distance (mm) over all probe points at the final pose (point-to-point, 10 % trimmed, at most
-/// 10 iterations).
+/// distance (mm) over all probe points at the final pose (`pipeline::landmark_icp_rms`, at
+/// most 10 iterations).
 fn icp_score(a: &Described, b: &Described, b_loc: &FaceLocator<'_>) -> f64 {
-    let Some(init) = fit_rigid(&a.landmarks, &b.landmarks, None) else {
-        return f64::NAN;
-    };
-    let opts = IcpLoopOptions {
-        variant: IcpVariant::PointToPoint,
-        max_iterations: 10,
-        translation: true,
-        trim: 0.1,
-        trim_rounding: TrimRounding::Down,
-        convergence: Convergence::RelativeRmseAfterStep { tolerance: 1e-6 },
-        evaluate_final: false,
-        ..IcpLoopOptions::default()
-    };
-    let Ok(res) = icp_to_target(b_loc, &a.icp_probe, None, init, &opts) else {
-        return f64::NAN;
-    };
-    crate::pipeline::rms_to_surface(b_loc, &a.icp_probe, &res.motion)
+    landmark_icp_rms(&a.icp_probe, &a.landmarks, b_loc, &b.landmarks, 10)
 }
 
 /// Fraction of a descriptor's points whose key is ambiguous (NaN when refused).
@@ -401,12 +384,27 @@ impl Relation {
 /// A bipolar descriptor variant of the study: the library's options by name.
 struct Variant {
     name: &'static str,
-    options: fn() -> bipolar::DescriptorOptions,
+    /// `None`: rule `All`; else the iso-angle rule with these crossings and repeats.
+    isoangle: Option<(bipolar::IsoCrossings, bipolar::IsoRepeats)>,
 }
 
 impl Variant {
     fn options(&self) -> bipolar::DescriptorOptions {
-        (self.options)()
+        match self.isoangle {
+            None => bipolar::DescriptorOptions {
+                rule: bipolar::SelectionRule::All,
+                ..Default::default()
+            },
+            Some((crossings, repeats)) => bipolar::DescriptorOptions {
+                rule: bipolar::SelectionRule::IsoAngle,
+                isoangle: bipolar::IsoAngleOptions {
+                    crossings,
+                    repeats,
+                    ..Default::default()
+                },
+                ..Default::default()
+            },
+        }
     }
 }
 
@@ -414,51 +412,27 @@ impl Variant {
 /// every crossing (the first behaviour), with the monotone fit keeping repeated keys as ambiguous
 /// (the second) and with the monotone fit and repeated keys resolved to the place nearest the
 /// geodesic between the references (the library's default).
-const VARIANTS: [Variant; 4] = [
-    Variant {
-        name: "bipolar All",
-        options: || bipolar::DescriptorOptions {
-            rule: bipolar::SelectionRule::All,
-            ..Default::default()
+const VARIANTS: [Variant; 4] = {
+    use bipolar::{IsoCrossings::*, IsoRepeats::*};
+    [
+        Variant {
+            name: "bipolar All",
+            isoangle: None,
         },
-    },
-    Variant {
-        name: "bipolar iso-angle, every crossing",
-        options: || bipolar::DescriptorOptions {
-            rule: bipolar::SelectionRule::IsoAngle,
-            isoangle: bipolar::IsoAngleOptions {
-                crossings: bipolar::IsoCrossings::Every,
-                repeats: bipolar::IsoRepeats::Ambiguous,
-                ..Default::default()
-            },
-            ..Default::default()
+        Variant {
+            name: "bipolar iso-angle, every crossing",
+            isoangle: Some((Every, Ambiguous)),
         },
-    },
-    Variant {
-        name: "bipolar iso-angle, monotone, repeats ambiguous",
-        options: || bipolar::DescriptorOptions {
-            rule: bipolar::SelectionRule::IsoAngle,
-            isoangle: bipolar::IsoAngleOptions {
-                crossings: bipolar::IsoCrossings::Monotone,
-                repeats: bipolar::IsoRepeats::Ambiguous,
-                ..Default::default()
-            },
-            ..Default::default()
+        Variant {
+            name: "bipolar iso-angle, monotone, repeats ambiguous",
+            isoangle: Some((Monotone, Ambiguous)),
         },
-    },
-    Variant {
-        name: "bipolar iso-angle, monotone, nearest",
-        options: || bipolar::DescriptorOptions {
-            rule: bipolar::SelectionRule::IsoAngle,
-            isoangle: bipolar::IsoAngleOptions {
-                crossings: bipolar::IsoCrossings::Monotone,
-                repeats: bipolar::IsoRepeats::Nearest,
-                ..Default::default()
-            },
-            ..Default::default()
+        Variant {
+            name: "bipolar iso-angle, monotone, nearest",
+            isoangle: Some((Monotone, Nearest)),
         },
-    },
-];
+    ]
+};
 
 /// Names of the distances: the bipolar variants, then the single pole and ICP.
 fn methods() -> Vec<&'static str> {
@@ -683,7 +657,7 @@ fn write_outputs(
             .as_ref()
             .map_or("paper-set".to_string(), |p| p.display().to_string()),
         sets.len(),
-        sets.iter().map(|s| s.name).collect::<Vec<_>>().join(", "),
+        joined(sets, ", ", |s| s.name.to_string()),
         args.landmark_tolerance_mm,
         args.res.levels,
         args.res.sectors,
@@ -843,20 +817,18 @@ fn write_outputs(
     let _ = writeln!(
         md,
         "| setting | mean edge mm | {} | polar points |",
-        VARIANTS
-            .iter()
-            .map(|v| format!("{}: ambiguous median / max (points)", v.name))
-            .collect::<Vec<_>>()
-            .join(" | ")
+        joined(&VARIANTS, " | ", |v| format!(
+            "{}: ambiguous median / max (points)",
+            v.name
+        ))
     );
     let _ = writeln!(md, "|---|---|{}---|", "---|".repeat(VARIANTS.len()));
     let mut csv = format!(
         "setting,{}\n",
-        VARIANTS
-            .iter()
-            .map(|v| format!("ambiguous median {0},ambiguous max {0}", v.name))
-            .collect::<Vec<_>>()
-            .join(",")
+        joined(&VARIANTS, ",", |v| format!(
+            "ambiguous median {0},ambiguous max {0}",
+            v.name
+        ))
     );
     for (si, s) in sets.iter().enumerate() {
         let ds: Vec<&Described> = scans

@@ -53,10 +53,6 @@ pub struct Args {
 
 /// Resolutions of the sweeps (levels between the references).
 const RESOLUTIONS: [u32; 9] = [3, 4, 5, 6, 8, 10, 12, 15, 20];
-/// Perturbation radii in percent of the corner-to-corner geodesic.
-const RADII_PCT: [f64; 5] = [1.0, 2.0, 3.0, 4.0, 5.0];
-/// Number of perturbation directions.
-const N_DIRS: usize = 8;
 
 /// A face descriptor, `None` where `bipolar` refused it (the refusal is in [`Failures`]).
 type Desc = Option<bipolar::Descriptor>;
