@@ -202,7 +202,7 @@ def unpack_polar_key(key: int) -> Tuple[int, int]: ...
 
 class FacialCurves:
     """Facial curves: one level curve of the geodesic distance from the nose tip per level
-    (``curves``: dicts with ``level``, ``closed``, ``pieces``, ``points`` (k, 3))."""
+    (``curves``: dicts with ``pieces``, ``level``, ``closed``, ``points`` (k, 3))."""
 
     @property
     def curves(self) -> List[Dict[str, Any]]: ...

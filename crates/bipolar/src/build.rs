@@ -237,24 +237,7 @@ fn describe_fields(
         return Err(BipolarError::ReferenceCount(fields.len()));
     }
     for (fi, f) in fields.iter().enumerate() {
-        if f.len() != n {
-            return Err(BipolarError::FieldLength {
-                field: fi,
-                expected: n,
-                got: f.len(),
-            });
-        }
-        if let Some((v, &value)) = f
-            .iter()
-            .enumerate()
-            .find(|(_, x)| x.is_nan() || **x == f64::NEG_INFINITY)
-        {
-            return Err(BipolarError::NonFiniteField {
-                field: fi,
-                vertex: v,
-                value,
-            });
-        }
+        check_field(fi, f, n)?;
     }
     check_options(opts, n)?;
     let diag = mesh.bbox().diagonal();
@@ -428,6 +411,30 @@ pub(crate) fn sort_points(points: &mut [DescriptorPoint]) {
             .then(p.position.y.total_cmp(&q.position.y))
             .then(p.position.z.total_cmp(&q.position.z))
     });
+}
+
+/// Checks that field number `field` has one value per vertex of a mesh of `n` vertices, none
+/// NaN or `-inf` (`+inf`, unreachable, is allowed).
+pub(crate) fn check_field(field: usize, values: &[f64], n: usize) -> Result<(), BipolarError> {
+    if values.len() != n {
+        return Err(BipolarError::FieldLength {
+            field,
+            expected: n,
+            got: values.len(),
+        });
+    }
+    match values
+        .iter()
+        .enumerate()
+        .find(|(_, x)| x.is_nan() || **x == f64::NEG_INFINITY)
+    {
+        Some((vertex, &value)) => Err(BipolarError::NonFiniteField {
+            field,
+            vertex,
+            value,
+        }),
+        None => Ok(()),
+    }
 }
 
 fn check_options(opts: &DescriptorOptions, n: usize) -> Result<(), BipolarError> {

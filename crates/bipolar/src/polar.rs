@@ -94,24 +94,7 @@ fn check_polar_input(
     towards: DVec3,
     opts: &PolarOptions,
 ) -> Result<(), BipolarError> {
-    if field.len() != n_vertices {
-        return Err(BipolarError::FieldLength {
-            field: 0,
-            expected: n_vertices,
-            got: field.len(),
-        });
-    }
-    if let Some((v, &value)) = field
-        .iter()
-        .enumerate()
-        .find(|(_, x)| x.is_nan() || **x == f64::NEG_INFINITY)
-    {
-        return Err(BipolarError::NonFiniteField {
-            field: 0,
-            vertex: v,
-            value,
-        });
-    }
+    crate::build::check_field(0, field, n_vertices)?;
     let bad = |m: String| Err(BipolarError::InvalidOption(m));
     if !(opts.step.is_finite() && opts.step > 0.0) {
         return bad(format!(
@@ -237,6 +220,15 @@ mod tests {
     use meshcore::shapes::icosphere;
     use meshcore::TriMesh;
 
+    /// `PolarOptions` from its three fields.
+    pub(super) fn options(step: f64, levels: u32, sectors: u32) -> PolarOptions {
+        PolarOptions {
+            step,
+            levels,
+            sectors,
+        }
+    }
+
     /// The shared jittered unit plane of `n` cells a side ([`testsupport::jittered_unit_plane`],
     /// `n` even), its centre vertex, that vertex's position and the Euclidean distance from it.
     fn centred_plane(n: usize, jitter: f64, seed: u64) -> (TriMesh, u32, DVec3, Vec<f64>) {
@@ -269,11 +261,7 @@ mod tests {
     fn bad_input_is_an_error() {
         let (m, v, c, u) = centred_plane(6, 0.0, 1);
         let w = Walker::new(&m);
-        let opts = PolarOptions {
-            step: 0.1,
-            levels: 2,
-            sectors: 4,
-        };
+        let opts = options(0.1, 2, 4);
         let run =
             |u: &[f64], pole, towards, o: &PolarOptions| describe_polar(&w, u, pole, towards, o);
         let towards = c + DVec3::Y;
@@ -323,11 +311,7 @@ mod tests {
     fn plane_polar_points_are_on_circles_at_their_angles() {
         let (m, v, c, u) = centred_plane(30, 0.3, 2);
         let w = Walker::new(&m);
-        let opts = PolarOptions {
-            step: 0.08,
-            levels: 4,
-            sectors: 8,
-        };
+        let opts = options(0.08, 4, 8);
         let d = describe_polar(&w, &u, Source::Vertex(v), c + DVec3::Y, &opts).unwrap();
         assert_eq!(d.points.len(), 32);
         let (keys, points) = (d.keys(), d.positions());
@@ -356,11 +340,7 @@ mod tests {
             .iter()
             .map(|p| p.dot(c).clamp(-1.0, 1.0).acos())
             .collect();
-        let opts = PolarOptions {
-            step: 0.25,
-            levels: 4,
-            sectors: 6,
-        };
+        let opts = options(0.25, 4, 6);
         let towards = DVec3::new(0.0, 0.0, 1.0);
         let d = describe_polar(&w, &u, Source::Vertex(pole), towards, &opts).unwrap();
         assert_eq!(d.points.len(), 24);
@@ -402,11 +382,7 @@ mod face_tests {
         let w = Walker::new(m);
         let towards = 0.5
             * (m.position(f.landmarks.right_eye_outer) + m.position(f.landmarks.left_eye_outer));
-        let opts = PolarOptions {
-            step: 1.0,
-            levels: 10,
-            sectors: 16,
-        };
+        let opts = super::tests::options(1.0, 10, 16);
         let u1 = s
             .distances(&[Source::Vertex(v)], &SolveOptions::default())
             .unwrap();

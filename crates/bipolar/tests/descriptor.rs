@@ -9,6 +9,7 @@ use glam::{DAffine3, DQuat, DVec3};
 use meshcore::{Surface, TriMesh};
 use proptest::prelude::*;
 use testsupport::fields::{euclidean, sphere_geodesic};
+use testsupport::nearest_vertex;
 use testsupport::shapes::{grid_plane, icosphere};
 
 /// The descriptor of precomputed `fields` (of the `references`, if given).
@@ -29,17 +30,6 @@ fn describe_solved(
     o: &DescriptorOptions,
 ) -> Result<Descriptor, BipolarError> {
     describe(surface, Fields::Solve { solver, references }, o)
-}
-
-/// The vertex nearest to `p` (the first on ties).
-fn nearest(mesh: &TriMesh, p: DVec3) -> u32 {
-    (0..mesh.n_vertices() as u32)
-        .min_by(|&a, &b| {
-            (mesh.position(a) - p)
-                .length()
-                .total_cmp(&(mesh.position(b) - p).length())
-        })
-        .unwrap()
 }
 
 /// Options with every intersection kept and gradient tangents.
@@ -90,8 +80,8 @@ fn plane_setup(n: usize, jitter: f64) -> Setup {
     let h = 3.0 / n as f64;
     let mesh = grid_plane(n, h, -1.5, jitter, 5, |_| false);
     let refs = [
-        nearest(&mesh, DVec3::new(-0.5, 0.0, 0.0)),
-        nearest(&mesh, DVec3::new(0.5, 0.0, 0.0)),
+        nearest_vertex(&mesh, DVec3::new(-0.5, 0.0, 0.0)),
+        nearest_vertex(&mesh, DVec3::new(0.5, 0.0, 0.0)),
     ];
     Setup::new(mesh, &refs, euclidean)
 }
@@ -673,8 +663,8 @@ fn a_region_limit_cuts_the_fields_off_without_changing_the_descriptor() {
         let surface = Surface::new(mesh.clone());
         let sp = meshcore::FaceLocator::new(mesh).nearest(c).unwrap().0;
         let refs = [
-            Source::Vertex(nearest(mesh, a)),
-            Source::Vertex(nearest(mesh, b)),
+            Source::Vertex(nearest_vertex(mesh, a)),
+            Source::Vertex(nearest_vertex(mesh, b)),
             Source::Point(sp),
         ];
         for method in [geodesic::Method::Exact, geodesic::Method::Dijkstra] {

@@ -12,6 +12,7 @@ use glam::{DAffine3, DQuat, DVec3};
 use meshcore::{Surface, TriMesh};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use testsupport::nearest_vertex;
 
 /// Plane grid on [-1.5, 1.5]^2, `n` cells a side, jittered in the plane, with uniform height
 /// noise of amplitude `noise` (as a fraction of the cell size); references at the vertices
@@ -26,15 +27,7 @@ fn noisy_plane(n: usize, noise: f64, seed: u64) -> (TriMesh, [u32; 2]) {
         .map(|p| *p + DVec3::Z * noise * h * rng.random_range(-1.0..1.0))
         .collect();
     let mesh = TriMesh::new(pos, m.triangles().to_vec()).unwrap();
-    let near = |p: DVec3| {
-        (0..mesh.n_vertices() as u32)
-            .min_by(|&a, &b| {
-                (mesh.position(a) - p)
-                    .length()
-                    .total_cmp(&(mesh.position(b) - p).length())
-            })
-            .unwrap()
-    };
+    let near = |p: DVec3| nearest_vertex(&mesh, p);
     let refs = [
         near(DVec3::new(-0.5, 0.0, 0.0)),
         near(DVec3::new(0.5, 0.0, 0.0)),
@@ -198,15 +191,7 @@ fn monotone_equals_every_crossing_where_the_opening_is_monotone() {
     // Exact Euclidean fields on an unjittered flat grid: the opening along each level arc is
     // monotone (law of cosines), so both rules give the same keys at nearly the same places.
     let m = grid_plane(60, 0.05, -1.5, 0.0, 1, |_| false);
-    let near = |p: DVec3| {
-        (0..m.n_vertices() as u32)
-            .min_by(|&a, &b| {
-                (m.position(a) - p)
-                    .length()
-                    .total_cmp(&(m.position(b) - p).length())
-            })
-            .unwrap()
-    };
+    let near = |p: DVec3| nearest_vertex(&m, p);
     let refs = [
         near(DVec3::new(-0.5, 0.0, 0.0)),
         near(DVec3::new(0.5, 0.0, 0.0)),

@@ -95,7 +95,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             mesh_io::read_bnt_grid(&args.input).with_context(|| format!("cannot load {name}"))?;
         clean(Input::Grid(&g), &opts)
     } else {
-        let m = mesh_io::read_mesh(&args.input).with_context(|| format!("cannot load {name}"))?;
+        let m = crate::load::mesh(&args.input)?;
         clean(Input::Mesh(&m.mesh), &opts)
     }
     .with_context(|| format!("cleaning {name}"))?;

@@ -1,6 +1,5 @@
 //! `bipolar convert`: convert a mesh between formats (chosen by file extension).
 
-use anyhow::Context;
 use std::path::PathBuf;
 
 /// Arguments of `bipolar convert`.
@@ -30,8 +29,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             "--weld must be a finite tolerance >= 0, got {t}"
         );
     }
-    let mut m = mesh_io::read_mesh(&args.input)
-        .with_context(|| format!("cannot load {}", args.input.display()))?;
+    let mut m = crate::load::mesh(&args.input)?;
     for w in &m.warnings {
         eprintln!("warning: {}: {w}", args.input.display());
     }

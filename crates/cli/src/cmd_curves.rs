@@ -84,8 +84,7 @@ pub struct Args {
 
 /// Runs `bipolar curves`.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let loaded = mesh_io::read_mesh(&args.mesh)
-        .with_context(|| format!("reading {}", args.mesh.display()))?;
+    let loaded = crate::load::mesh(&args.mesh)?;
     let mesh = loaded.mesh;
     let t0 = Instant::now();
     let needs_field = args.kind == Kind::Facial || args.radius.is_some();

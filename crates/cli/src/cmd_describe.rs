@@ -86,8 +86,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let opts = options(&args)?;
     let method = args.method;
     let _: bipolar::io::Format = from_extension(&args.out)?;
-    let loaded = mesh_io::read_mesh(&args.mesh)
-        .with_context(|| format!("reading {}", args.mesh.display()))?;
+    let loaded = crate::load::mesh(&args.mesh)?;
     let mesh = loaded.mesh;
     let resolver = Resolver::new(&mesh, &args.mesh, &args.refs)?;
     let mut refs = vec![

@@ -63,8 +63,7 @@ fn out_format(path: &Path) -> anyhow::Result<OutFormat> {
 /// Runs the command.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let fmt = out_format(&args.out)?;
-    let loaded = mesh_io::read_mesh(&args.mesh)
-        .with_context(|| format!("reading {}", args.mesh.display()))?;
+    let loaded = crate::load::mesh(&args.mesh)?;
     let mesh = loaded.mesh;
     let resolver = Resolver::new(&mesh, &args.mesh, &args.refs)?;
     let mut sources: Vec<Source> = Vec::new();

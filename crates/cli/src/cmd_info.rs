@@ -1,6 +1,5 @@
 //! `bipolar info`: statistics and checks of a mesh.
 
-use anyhow::Context;
 use meshcore::Topology;
 use std::path::PathBuf;
 
@@ -16,8 +15,7 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let loaded = mesh_io::read_mesh(&args.mesh)
-        .with_context(|| format!("cannot load {}", args.mesh.display()))?;
+    let loaded = crate::load::mesh(&args.mesh)?;
     let report = info_json(&loaded, &args.mesh.display().to_string());
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

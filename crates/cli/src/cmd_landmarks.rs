@@ -31,8 +31,7 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let loaded = mesh_io::read_mesh(&args.mesh)
-        .with_context(|| format!("cannot load {}", args.mesh.display()))?;
+    let loaded = crate::load::mesh(&args.mesh)?;
     let model = match &args.model {
         Some(p) => GenericModel::load(p)?,
         None => GenericModel::default_model()?,

@@ -177,8 +177,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if !(args.point_radius.is_finite() && args.point_radius > 0.0) {
         bail!("--point-radius must be positive");
     }
-    let loaded = mesh_io::read_mesh(&args.mesh)
-        .with_context(|| format!("reading {}", args.mesh.display()))?;
+    let loaded = crate::load::mesh(&args.mesh)?;
     let mesh = loaded.mesh;
     let mut scene = Scene::new(&mesh);
     let mut topo: Option<Topology> = None;

@@ -123,8 +123,7 @@ fn artifacts(a: &Args) -> anyhow::Result<Artifacts> {
 
 /// Runs the command.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let loaded = mesh_io::read_mesh(&args.mesh)
-        .with_context(|| format!("cannot load {}", args.mesh.display()))?;
+    let loaded = crate::load::mesh(&args.mesh)?;
     let mesh = &loaded.mesh;
     let units = match args.units {
         Some(u) => {

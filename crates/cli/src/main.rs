@@ -14,6 +14,7 @@ mod cmd_landmarks;
 mod cmd_matrix;
 mod cmd_render;
 mod cmd_scan;
+mod load;
 mod refpoint;
 
 /// Bipolar invariant representation of 3D surfaces: inspect meshes, compute geodesic fields and

@@ -45,6 +45,14 @@ fn bipolar(args: &[&str]) -> (bool, String, String) {
     (r.ok, r.stdout, r.stderr)
 }
 
+/// Runs `bipolar curves MESH --kind KIND ARGS... --out OUT`: (success, stdout, stderr).
+fn curves(mesh: &Path, kind: &str, args: &[&str], out: &Path) -> (bool, String, String) {
+    let mut all = vec!["curves", mesh.to_str().unwrap(), "--kind", kind];
+    all.extend_from_slice(args);
+    all.extend(["--out", out.to_str().unwrap()]);
+    bipolar(&all)
+}
+
 fn distance(a: &Path, b: &Path) -> f64 {
     let (ok, out, err) = bipolar(&["curve-distance", a.to_str().unwrap(), b.to_str().unwrap()]);
     assert!(ok, "{err}");
@@ -64,20 +72,13 @@ fn facial_and_iso_curvature_curves_are_invariant_and_discriminate() {
     for (name, (text, top)) in &shapes {
         let mesh = write(dir.path(), name, text);
         let f = dir.path().join(format!("{name}.facial.json"));
-        let (ok, _, err) = bipolar(&[
-            "curves",
-            mesh.to_str().unwrap(),
-            "--kind",
+        let nose = top.to_string();
+        let (ok, _, err) = curves(
+            &mesh,
             "facial",
-            "--nose",
-            &top.to_string(),
-            "--radius",
-            "1.8",
-            "--levels",
-            "6",
-            "--out",
-            f.to_str().unwrap(),
-        ]);
+            &["--nose", &nose, "--radius", "1.8", "--levels", "6"],
+            &f,
+        );
         assert!(ok, "{err}");
         assert!(err.contains("6 curves"), "{err}");
         match facecurves::io::read_json(&f).unwrap() {
@@ -86,18 +87,12 @@ fn facial_and_iso_curvature_curves_are_invariant_and_discriminate() {
         }
         facial.push(f);
         let i = dir.path().join(format!("{name}.iso.json"));
-        let (ok, _, err) = bipolar(&[
-            "curves",
-            mesh.to_str().unwrap(),
-            "--kind",
+        let (ok, _, err) = curves(
+            &mesh,
             "iso-curvature",
-            "--k1-levels",
-            "0.6,0.9",
-            "--k2-levels",
-            "0.3,0.45",
-            "--out",
-            i.to_str().unwrap(),
-        ]);
+            &["--k1-levels", "0.6,0.9", "--k2-levels", "0.3,0.45"],
+            &i,
+        );
         assert!(ok, "{err}");
         iso.push(i);
     }
@@ -126,20 +121,9 @@ fn facial_curves_need_a_radius_and_bad_kinds_are_listed() {
     let (text, top) = ellipsoid_obj([1.0, 1.0, 1.0], 0.0, false);
     let mesh = write(dir.path(), "s.obj", &text);
     let out = dir.path().join("c.json");
-    let m = mesh.to_str().unwrap();
-    let o = out.to_str().unwrap();
-    let (ok, _, err) = bipolar(&[
-        "curves",
-        m,
-        "--kind",
-        "facial",
-        "--nose",
-        &top.to_string(),
-        "--out",
-        o,
-    ]);
+    let (ok, _, err) = curves(&mesh, "facial", &["--nose", &top.to_string()], &out);
     assert!(!ok && err.contains("--radius"), "{err}");
-    let (ok, _, err) = bipolar(&["curves", m, "--kind", "spiral", "--out", o]);
+    let (ok, _, err) = curves(&mesh, "spiral", &[], &out);
     assert!(
         !ok && err.contains("iso-curvature") && err.contains("facial"),
         "{err}"

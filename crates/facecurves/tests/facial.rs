@@ -6,7 +6,7 @@ mod common;
 use common::{ellipsoid, moved_and_renumbered};
 use facecurves::{
     describe_facial_curves, describe_facial_curves_from, facial_curves_distance, Aggregate,
-    ElasticOptions, FaceCurvesError, FacialCurvesOptions,
+    ElasticOptions, FaceCurvesError, FacialCurvesDescriptor, FacialCurvesOptions,
 };
 use geodesic::{new_solver, Method, Source};
 use glam::DVec3;
@@ -22,14 +22,23 @@ fn top_vertex(mesh: &TriMesh, dir: DVec3) -> u32 {
         .unwrap()
 }
 
-fn describe(
-    mesh: &TriMesh,
-    pole: u32,
-    opts: &FacialCurvesOptions,
-) -> facecurves::FacialCurvesDescriptor {
+fn describe(mesh: &TriMesh, pole: u32, opts: &FacialCurvesOptions) -> FacialCurvesDescriptor {
     let s = Surface::new(mesh.clone());
     let solver = new_solver(mesh, Method::Exact).unwrap();
     describe_facial_curves_from(&s, solver.as_ref(), Source::Vertex(pole), opts).unwrap()
+}
+
+/// The facial curves of `mesh` from `pole`, and those of its moved and renumbered copy
+/// ([`moved_and_renumbered`] with `seed`) from the same vertex.
+fn with_moved_copy(
+    mesh: &TriMesh,
+    pole: u32,
+    opts: &FacialCurvesOptions,
+    seed: u64,
+) -> (FacialCurvesDescriptor, FacialCurvesDescriptor) {
+    let (moved, perm) = moved_and_renumbered(mesh, seed);
+    let a = describe(mesh, pole, opts);
+    (a, describe(&moved, perm[pole as usize], opts))
 }
 
 fn curve_length(points: &[DVec3], closed: bool) -> f64 {
@@ -45,13 +54,11 @@ fn ellipsoid_curves_are_invariant_under_rigid_motion_and_renumbering() {
     let axes = DVec3::new(3.0, 2.0, 1.5);
     let mesh = ellipsoid(axes, 4);
     let pole = top_vertex(&mesh, DVec3::Z);
-    let (moved, perm) = moved_and_renumbered(&mesh, 3);
     let opts = FacialCurvesOptions {
         step: 0.3,
         levels: 6,
     };
-    let a = describe(&mesh, pole, &opts);
-    let b = describe(&moved, perm[pole as usize], &opts);
+    let (a, b) = with_moved_copy(&mesh, pole, &opts, 3);
     assert_eq!(a.curves.len(), 6);
     assert_eq!(b.curves.len(), 6);
     for (x, y) in a.curves.iter().zip(&b.curves) {
@@ -160,23 +167,18 @@ fn levels_beyond_the_surface_are_missing_and_errors_are_named() {
 
 #[test]
 fn face_curves_are_invariant_under_rigid_motion_and_renumbering() {
-    let Some(path) = testsupport::paper_face("id1_neutral.obj") else {
-        return;
-    };
-    let Some(other) = testsupport::paper_face("id2_neutral.obj") else {
+    let Some([mesh, other]) = testsupport::paper_meshes(["id1_neutral.obj", "id2_neutral.obj"])
+    else {
         return;
     };
     const NOSE: u32 = 4857;
-    let mesh = testsupport::read_mesh(path);
-    let (moved, perm) = moved_and_renumbered(&mesh, 9);
     // ICT faces are in cm: 8 curves 0.6 cm apart.
     let opts = FacialCurvesOptions {
         step: 0.6,
         levels: 8,
     };
-    let a = describe(&mesh, NOSE, &opts);
-    let b = describe(&moved, perm[NOSE as usize], &opts);
-    let c = describe(&testsupport::read_mesh(other), NOSE, &opts);
+    let (a, b) = with_moved_copy(&mesh, NOSE, &opts, 9);
+    let c = describe(&other, NOSE, &opts);
     assert_eq!(a.curves.len(), 8);
     assert_eq!(
         a.curves

@@ -151,13 +151,10 @@ fn network_is_invariant_under_rigid_motion_and_renumbering() {
 
 #[test]
 fn face_network_is_invariant_under_rigid_motion_and_renumbering() {
-    let Some(path) = testsupport::paper_face("id1_neutral.obj") else {
+    let Some([mesh, o_mesh]) = testsupport::paper_meshes(["id1_neutral.obj", "id2_neutral.obj"])
+    else {
         return;
     };
-    let Some(other) = testsupport::paper_face("id2_neutral.obj") else {
-        return;
-    };
-    let mesh = testsupport::read_mesh(path);
     let (moved, perm) = moved_and_renumbered(&mesh, 5);
     // Central part: within 5 cm (ICT faces are in cm) of the nose tip (vertex 4857).
     let nose = mesh.position(4857);
@@ -173,7 +170,6 @@ fn face_network_is_invariant_under_rigid_motion_and_renumbering() {
     let a = describe_iso_curvature(&Surface::new(mesh), Some(&mask), &Default::default()).unwrap();
     let same = explicit(a.levels_k1.clone(), a.levels_k2.clone());
     let b = describe_iso_curvature(&Surface::new(moved), Some(&mask_moved), &same).unwrap();
-    let o_mesh = testsupport::read_mesh(other);
     let o_mask: Vec<bool> = o_mesh
         .positions()
         .iter()

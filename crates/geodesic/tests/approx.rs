@@ -11,7 +11,9 @@ use geodesic::{
 use glam::{DAffine3, DQuat, DVec3};
 use proptest::prelude::*;
 use std::f64::consts::PI;
-use testsupport::fields::{euclidean, max_abs_diff, max_rel_err, mean_abs_diff, sphere_geodesic};
+use testsupport::fields::{
+    euclidean, icosphere_errors, max_abs_diff, max_rel_err, mean_abs_diff, sphere_geodesic,
+};
 use testsupport::shapes::{self, cylinder, icosphere, uv_sphere, Diagonals};
 
 const APPROX: [Method; 3] = [Method::Fmm, Method::Heat, Method::Dijkstra];
@@ -157,13 +159,7 @@ fn obtuse_triangles_are_split_by_unfolding() {
 #[test]
 fn sphere_great_circle_and_fmm_convergence() {
     let mut prev = f64::INFINITY;
-    for level in 2..=4 {
-        let m = icosphere(level);
-        let g = great_circle(&m, 0);
-        let h = m.mean_edge_length();
-        let d = solve(&m, Method::Fmm, &[Source::Vertex(0)]);
-        let e = mean_abs_diff(&d, &g);
-        let emax = max_abs_diff(&d, &g);
+    for (level, h, e, emax) in icosphere_errors(|m| solve(m, Method::Fmm, &[Source::Vertex(0)])) {
         assert!(emax < 0.75 * h, "level {level}: fmm max {emax}, h {h}");
         assert!(
             e < 0.7 * prev,

@@ -5,7 +5,9 @@
 
 use geodesic::{FastMarching, FmmUpdate, GeodesicSolver, SolveOptions, Source, TriMesh};
 use glam::DVec3;
-use testsupport::fields::{max_abs_diff, mean_abs_diff, prism_geodesic, sphere_geodesic};
+use testsupport::fields::{
+    icosphere_errors, max_abs_diff, mean_abs_diff, prism_geodesic, sphere_geodesic,
+};
 use testsupport::shapes::{self, icosphere, uv_sphere, Diagonals};
 
 fn solve(mesh: &TriMesh, rule: FmmUpdate, src: &[Source]) -> Vec<f64> {
@@ -106,10 +108,8 @@ fn cylinder_unrolled_is_nearly_exact() {
 fn curved_front_converges_on_icospheres() {
     // Max error shrinks with refinement (roughly quadratically away from the antipode).
     let mut prev = f64::INFINITY;
-    for level in 2..=4 {
-        let m = icosphere(level);
-        let g = great_circle(&m, 0);
-        let (mae, _) = errors(&solve(&m, FmmUpdate::CurvedFront, &[Source::Vertex(0)]), &g);
+    let curved_front = |m: &TriMesh| solve(m, FmmUpdate::CurvedFront, &[Source::Vertex(0)]);
+    for (level, _, mae, _) in icosphere_errors(curved_front) {
         assert!(mae < 0.4 * prev, "level {level}: MAE {mae} after {prev}");
         prev = mae;
     }

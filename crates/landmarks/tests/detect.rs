@@ -16,6 +16,15 @@ fn paper_set() -> Option<PathBuf> {
     json.parent().map(PathBuf::from)
 }
 
+/// The paper-set face `name` (e.g. `"id2_neutral"`), its five ground-truth landmarks and the
+/// default model; `None` without the shared data.
+fn face_with_truth(name: &str) -> Option<(TriMesh, [DVec3; 5], GenericModel)> {
+    let dir = paper_set()?;
+    let truth = ict_truth(&dir)[name];
+    let mesh = read_mesh(dir.join(format!("{name}.obj")));
+    Some((mesh, truth, GenericModel::default_model().unwrap()))
+}
+
 fn flipped(m: &TriMesh) -> TriMesh {
     TriMesh::new(
         m.positions().to_vec(),
@@ -169,9 +178,9 @@ fn non_faces_are_not_found() {
 
 #[test]
 fn units_are_recognised_from_the_face_size() {
-    let Some(dir) = paper_set() else { return };
-    let model = GenericModel::default_model().unwrap();
-    let mesh = read_mesh(dir.join("id2_neutral.obj"));
+    let Some((mesh, _, model)) = face_with_truth("id2_neutral") else {
+        return;
+    };
     let cm = detect(&mesh, &model).unwrap();
     for (units, f) in [("mm", 10.0), ("m", 0.01)] {
         let scaled = mesh.transformed(&DAffine3::from_scale(DVec3::splat(f)));
@@ -214,9 +223,9 @@ fn part(m: &TriMesh, keep: impl Fn(DVec3) -> bool) -> TriMesh {
 
 #[test]
 fn each_verification_rejects_with_its_reason() {
-    let Some(dir) = paper_set() else { return };
-    let model = GenericModel::default_model().unwrap();
-    let mesh = read_mesh(dir.join("id2_neutral.obj"));
+    let Some((mesh, _, model)) = face_with_truth("id2_neutral") else {
+        return;
+    };
     let defaults = DetectOptions::default();
     let lm = detect(&mesh, &model).unwrap();
     // A correct detection on a neutral face is mirror-symmetric and agrees with every template.
@@ -262,11 +271,9 @@ fn each_verification_rejects_with_its_reason() {
 
 #[test]
 fn partial_faces_are_found_right_or_not_at_all() {
-    let Some(dir) = paper_set() else { return };
-    let truth = ict_truth(&dir);
-    let model = GenericModel::default_model().unwrap();
-    let mesh = read_mesh(dir.join("id4_neutral.obj"));
-    let gt = truth["id4_neutral"];
+    let Some((mesh, gt, model)) = face_with_truth("id4_neutral") else {
+        return;
+    };
     // Below the eyes (mouth, chin and nose only): there are no eye corners to find.
     let lower = part(&mesh, |p| p.y < 1.5);
     for t in motions() {
@@ -370,11 +377,10 @@ fn ict_truth(dir: &std::path::Path) -> std::collections::BTreeMap<String, [meshc
 
 #[test]
 fn a_landmark_without_surface_is_not_found_with_its_name() {
-    let Some(dir) = paper_set() else { return };
-    let truth = ict_truth(&dir);
-    let model = GenericModel::default_model().unwrap();
-    let mesh = read_mesh(dir.join("id2_neutral.obj"));
-    let corner = truth["id2_neutral"][LandmarkName::OuterEyeRight as usize];
+    let Some((mesh, truth, model)) = face_with_truth("id2_neutral") else {
+        return;
+    };
+    let corner = truth[LandmarkName::OuterEyeRight as usize];
     // The whole face is found.
     detect(&mesh, &model).unwrap();
     // No surface within 1.2 cm of the right outer eye corner (a landmark the scanner did not

@@ -5,13 +5,14 @@
 use crate::convert::{self, points_out};
 use crate::describe::{given_landmarks, references};
 use crate::errors;
-use crate::geodesic::PyGeodesicSolver;
+use crate::geodesic::{PyGeodesicSolver, SolverChoice};
 use crate::mesh::mesh_arg;
 use facecurves::{
     Aggregate, ElasticOptions, FacialCurvesDescriptor, FacialCurvesOptions, IsoCurvatureDescriptor,
     IsoCurvatureOptions, IsoLevels, Resampling,
 };
-use geodesic::{GeodesicSolver, Method, SolveOptions};
+use geodesic::SolveOptions;
+use glam::DVec3;
 use meshcore::Surface;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -20,7 +21,7 @@ use std::time::Duration;
 /// Facial curves of a face: one curve per level ``i`` at geodesic distance ``i * step`` from
 /// the nose tip (the longest piece of the level set).
 ///
-/// ``curves``: a list of dicts ``{"level", "closed", "pieces", "points" (k, 3)}``; ``step`` and
+/// ``curves``: a list of dicts ``{"pieces", "level", "closed", "points" (k, 3)}``; ``step`` and
 /// ``n_levels`` are the options.
 #[pyclass(module = "bipolar._bipolar", name = "FacialCurves", frozen)]
 #[derive(Debug, Clone)]
@@ -28,48 +29,25 @@ pub struct PyFacialCurves {
     pub d: FacialCurvesDescriptor,
 }
 
-#[pymethods]
-impl PyFacialCurves {
-    /// The curves, sorted by level.
-    #[getter]
-    fn curves<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
-        self.d
-            .curves
-            .iter()
-            .map(|c| {
-                let d = PyDict::new(py);
-                d.set_item("level", c.level)?;
-                d.set_item("closed", c.closed)?;
-                d.set_item("pieces", c.pieces)?;
-                d.set_item("points", points_out(py, &c.points))?;
-                Ok(d)
+descriptor_pymethods! {
+    PyFacialCurves,
+    levels {
+        /// Geodesic distance between consecutive curves.
+        step,
+        /// Number of levels asked for.
+        n_levels
+    }
+    summary {
+        "FacialCurves", curves "curves", step = options.step, levels = options.levels
+    }
+    {
+        /// The curves, sorted by level.
+        #[getter]
+        fn curves<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
+            curve_dicts(py, &self.d.curves, "pieces", |c| {
+                (c.pieces, c.level, c.closed, &c.points)
             })
-            .collect()
-    }
-
-    /// Geodesic distance between consecutive curves.
-    #[getter]
-    fn step(&self) -> f64 {
-        self.d.options.step
-    }
-
-    /// Number of levels asked for.
-    #[getter]
-    fn n_levels(&self) -> u32 {
-        self.d.options.levels
-    }
-
-    fn __len__(&self) -> usize {
-        self.d.curves.len()
-    }
-
-    fn __repr__(&self) -> String {
-        format!(
-            "FacialCurves({} curves, step={}, levels={})",
-            self.d.curves.len(),
-            self.d.options.step,
-            self.d.options.levels
-        )
+        }
     }
 }
 
@@ -89,18 +67,14 @@ impl PyIsoCurvatureCurves {
     /// The curves: k1 levels first, then k2.
     #[getter]
     fn curves<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyDict>>> {
-        self.d
-            .curves
-            .iter()
-            .map(|c| {
-                let d = PyDict::new(py);
-                d.set_item("field", meshcore::Choice::name(c.field))?;
-                d.set_item("level", c.level)?;
-                d.set_item("closed", c.closed)?;
-                d.set_item("points", points_out(py, &c.points))?;
-                Ok(d)
-            })
-            .collect()
+        curve_dicts(py, &self.d.curves, "field", |c| {
+            (
+                meshcore::Choice::name(c.field),
+                c.level,
+                c.closed,
+                &c.points,
+            )
+        })
     }
 
     /// Levels of k1 used.
@@ -141,6 +115,28 @@ impl PyIsoCurvatureCurves {
     }
 }
 
+/// The curves of a set as dicts: the entry of their kind (``kind``: the value `parts` gives
+/// first), then ``level``, ``closed`` and ``points`` (k, 3).
+fn curve_dicts<'py, C, V: IntoPyObject<'py>, L: IntoPyObject<'py>>(
+    py: Python<'py>,
+    curves: &[C],
+    kind: &str,
+    parts: impl Fn(&C) -> (V, L, bool, &Vec<DVec3>),
+) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    curves
+        .iter()
+        .map(|c| {
+            let (value, level, closed, points) = parts(c);
+            let d = PyDict::new(py);
+            d.set_item(kind, value)?;
+            d.set_item("level", level)?;
+            d.set_item("closed", closed)?;
+            d.set_item("points", points_out(py, points))?;
+            Ok(d)
+        })
+        .collect()
+}
+
 /// The geodesic distance field from `centre` (a reference as in ``describe``), cut off just
 /// beyond `radius`.
 fn centre_field(
@@ -166,27 +162,17 @@ fn centre_field(
         given.as_deref(),
         &mut in_library,
     )?[0];
-    let method: Method = match solver {
-        Some(_) => Method::Exact,
-        None => method.parse().map_err(errors::geodesic)?,
-    };
-    let prepared = solver.map(|s| s.get());
+    let choice = SolverChoice::of(method, solver)?;
     let longest = mesh.longest_edge();
     py.detach(|| {
-        let owned;
-        let solver: &dyn GeodesicSolver = match prepared {
-            Some(s) => s.solver.as_ref(),
-            None => {
-                owned = geodesic::new_solver(mesh, method)?;
-                owned.as_ref()
-            }
-        };
-        solver.distances(
-            &[src],
-            &SolveOptions {
-                max_distance: Some(radius + longest),
-            },
-        )
+        choice.run(mesh, |solver| {
+            solver.distances(
+                &[src],
+                &SolveOptions {
+                    max_distance: Some(radius + longest),
+                },
+            )
+        })
     })
     .map_err(errors::geodesic)
 }

@@ -3,10 +3,9 @@
 use crate::convert;
 use crate::descriptor::PyDescriptor;
 use crate::errors;
-use crate::geodesic::PyGeodesicSolver;
+use crate::geodesic::{PyGeodesicSolver, SolverChoice};
 use crate::mesh::mesh_arg;
 use bipolar::{DescriptorOptions, LevelSpec, Source};
-use geodesic::Method;
 use glam::DVec3;
 use meshcore::{FaceLocator, TriMesh};
 use pyo3::prelude::*;
@@ -197,36 +196,18 @@ pub fn describe(
     }
     let mut in_library = Duration::ZERO;
     let sources = references(py, mesh, &specs, given.as_deref(), &mut in_library)?;
-    let (d, t) = match solver {
-        Some(s) => {
-            let s = s.get();
-            py.detach(|| {
-                let t = Instant::now();
-                let surface = bipolar::Surface::new(mesh.clone());
-                let fields = bipolar::Fields::Solve {
-                    solver: s.solver.as_ref(),
-                    references: &sources,
-                };
-                (bipolar::describe(&surface, fields, &opts), t.elapsed())
-            })
-        }
-        None => {
-            let method: Method = method.parse().map_err(errors::geodesic)?;
-            py.detach(|| {
-                let t = Instant::now();
-                let d = geodesic::new_solver(mesh, method)
-                    .map_err(bipolar::BipolarError::from)
-                    .and_then(|solver| {
-                        let fields = bipolar::Fields::Solve {
-                            solver: solver.as_ref(),
-                            references: &sources,
-                        };
-                        bipolar::describe(&bipolar::Surface::new(mesh.clone()), fields, &opts)
-                    });
-                (d, t.elapsed())
-            })
-        }
-    };
+    let choice = SolverChoice::of(method, solver)?;
+    let (d, t) = py.detach(|| {
+        let t = Instant::now();
+        let d = choice.run(mesh, |solver| {
+            let fields = bipolar::Fields::Solve {
+                solver,
+                references: &sources,
+            };
+            bipolar::describe(&bipolar::Surface::new(mesh.clone()), fields, &opts)
+        });
+        (d, t.elapsed())
+    });
     in_library += t;
     LIBRARY_SECONDS.set(in_library.as_secs_f64());
     Ok(PyDescriptor {

@@ -25,236 +25,206 @@ fn json_to_py<'py>(py: Python<'py>, text: &str) -> PyResult<Bound<'py, PyAny>> {
     py.import("json")?.call_method1("loads", (text,))
 }
 
-#[pymethods]
-impl PyDescriptor {
-    /// A descriptor from user arrays (e.g. any keyed point set): ``points`` (n, 3), ``keys``
-    /// (n,) packed keys (``Descriptor.keys``, ``pack_key``, or any multiple of 16 below 2**26);
-    /// ``cos`` (n,) and ``ambiguous`` (n,) default to 0 and False.
-    /// Points stay in the given order (distances pair them by key, whatever the order).
-    #[staticmethod]
-    #[pyo3(signature = (points, keys, cos=None, ambiguous=None))]
-    fn from_arrays(
-        points: &Bound<'_, PyAny>,
-        keys: &Bound<'_, PyAny>,
-        cos: Option<&Bound<'_, PyAny>>,
-        ambiguous: Option<&Bound<'_, PyAny>>,
-    ) -> PyResult<Self> {
-        let p = convert::points(points, "points")?;
-        let k = convert::u64_vec(keys, "keys")?;
-        let n = p.len();
-        if k.len() != n {
-            return Err(errors::input(format!(
-                "keys has {} entries for {n} points",
-                k.len()
-            )));
-        }
-        if let Some((i, &key)) = k
-            .iter()
-            .enumerate()
-            .find(|(_, &x)| Key::unpack(x).pack() != x)
-        {
-            return Err(errors::input(format!(
-                "keys[{i}] = {key} is not a packed bipolar key (the side and sign fields, bits \
-                 0-3, hold 0, 1 or 2 each; make keys with bipolar.pack_key or use multiples of 16)"
-            )));
-        }
-        if let Some((i, q)) = p.iter().enumerate().find(|(_, q)| !q.is_finite()) {
-            return Err(errors::input(format!(
-                "points[{i}] = {:?} is not finite",
-                q.to_array()
-            )));
-        }
-        let c = match cos {
-            Some(c) => convert::f64_vec(c, "cos")?,
-            None => vec![0.0; n],
-        };
-        let a: Vec<bool> = match ambiguous {
-            Some(a) => convert::bool_vec(a, "ambiguous")?,
-            None => vec![false; n],
-        };
-        if c.len() != n || a.len() != n {
-            return Err(errors::input(format!(
-                "cos and ambiguous must have {n} entries, got {} and {}",
-                c.len(),
-                a.len()
-            )));
-        }
-        let pts: Vec<DescriptorPoint> = (0..n)
-            .map(|i| DescriptorPoint {
-                position: p[i],
-                key: Key::unpack(k[i]),
-                cos: c[i],
-                face: u32::MAX,
-                bary: DVec3::ZERO,
-                ambiguous: a[i],
+descriptor_pymethods! {
+    PyDescriptor,
+    surface_points {
+        keys: packed_keys,
+        /// Face of each point, shape (n,), uint32 (2**32 - 1 when unknown).
+        faces
+    }
+    summary {
+        "Descriptor", points "points", step = step, max_level = max_level,
+        reference_distance = reference_distance
+    }
+    {
+        /// A descriptor from user arrays (e.g. any keyed point set): ``points`` (n, 3), ``keys``
+        /// (n,) packed keys (``Descriptor.keys``, ``pack_key``, or any multiple of 16 below 2**26);
+        /// ``cos`` (n,) and ``ambiguous`` (n,) default to 0 and False.
+        /// Points stay in the given order (distances pair them by key, whatever the order).
+        #[staticmethod]
+        #[pyo3(signature = (points, keys, cos=None, ambiguous=None))]
+        fn from_arrays(
+            points: &Bound<'_, PyAny>,
+            keys: &Bound<'_, PyAny>,
+            cos: Option<&Bound<'_, PyAny>>,
+            ambiguous: Option<&Bound<'_, PyAny>>,
+        ) -> PyResult<Self> {
+            let p = convert::points(points, "points")?;
+            let k = convert::u64_vec(keys, "keys")?;
+            let n = p.len();
+            if k.len() != n {
+                return Err(errors::input(format!(
+                    "keys has {} entries for {n} points",
+                    k.len()
+                )));
+            }
+            if let Some((i, &key)) = k
+                .iter()
+                .enumerate()
+                .find(|(_, &x)| Key::unpack(x).pack() != x)
+            {
+                return Err(errors::input(format!(
+                    "keys[{i}] = {key} is not a packed bipolar key (the side and sign fields, bits \
+                     0-3, hold 0, 1 or 2 each; make keys with bipolar.pack_key or use multiples of 16)"
+                )));
+            }
+            if let Some((i, q)) = p.iter().enumerate().find(|(_, q)| !q.is_finite()) {
+                return Err(errors::input(format!(
+                    "points[{i}] = {:?} is not finite",
+                    q.to_array()
+                )));
+            }
+            let c = match cos {
+                Some(c) => convert::f64_vec(c, "cos")?,
+                None => vec![0.0; n],
+            };
+            let a: Vec<bool> = match ambiguous {
+                Some(a) => convert::bool_vec(a, "ambiguous")?,
+                None => vec![false; n],
+            };
+            if c.len() != n || a.len() != n {
+                return Err(errors::input(format!(
+                    "cos and ambiguous must have {n} entries, got {} and {}",
+                    c.len(),
+                    a.len()
+                )));
+            }
+            let pts: Vec<DescriptorPoint> = (0..n)
+                .map(|i| DescriptorPoint {
+                    position: p[i],
+                    key: Key::unpack(k[i]),
+                    cos: c[i],
+                    face: u32::MAX,
+                    bary: DVec3::ZERO,
+                    ambiguous: a[i],
+                })
+                .collect();
+            Ok(Self {
+                d: Descriptor {
+                    points: pts,
+                    step: f64::NAN,
+                    max_level: 0,
+                    reference_distance: f64::NAN,
+                    references: Vec::new(),
+                    options: bipolar::DescriptorOptions::default(),
+                    stats: bipolar::DescriptorStats::default(),
+                },
             })
-            .collect();
-        Ok(Self {
-            d: Descriptor {
-                points: pts,
-                step: f64::NAN,
-                max_level: 0,
-                reference_distance: f64::NAN,
-                references: Vec::new(),
-                options: bipolar::DescriptorOptions::default(),
-                stats: bipolar::DescriptorStats::default(),
-            },
-        })
-    }
+        }
 
-    /// Point positions, shape (n, 3).
-    #[getter]
-    fn points<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray2<f64>> {
-        points_out(py, &self.d.positions())
-    }
+        /// Signed cosine of the opening between the two level curves at each point, shape (n,).
+        #[getter]
+        fn cos<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray1<f64>> {
+            vec_out(py, self.d.points.iter().map(|p| p.cos).collect())
+        }
 
-    /// Packed keys, shape (n,), uint64.
-    #[getter]
-    fn keys<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray1<u64>> {
-        vec_out(py, self.d.packed_keys())
-    }
+        /// True where several points share the key, shape (n,), bool.
+        #[getter]
+        fn ambiguous<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray1<bool>> {
+            vec_out(py, self.d.points.iter().map(|p| p.ambiguous).collect())
+        }
 
-    /// Signed cosine of the opening between the two level curves at each point, shape (n,).
-    #[getter]
-    fn cos<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray1<f64>> {
-        vec_out(py, self.d.points.iter().map(|p| p.cos).collect())
-    }
+        /// The unpacked key fields as a dict of (n,) arrays: ``a``, ``b`` (reference pair), ``i``,
+        /// ``j`` (levels, or angle level for the iso-angle rule), ``side``, ``sign``.
+        fn key_fields<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+            let k: Vec<Key> = self.d.points.iter().map(|p| p.key).collect();
+            let d = PyDict::new(py);
+            d.set_item("a", vec_out(py, k.iter().map(|k| k.a).collect()))?;
+            d.set_item("b", vec_out(py, k.iter().map(|k| k.b).collect()))?;
+            d.set_item("i", vec_out(py, k.iter().map(|k| k.i).collect()))?;
+            d.set_item("j", vec_out(py, k.iter().map(|k| k.j).collect()))?;
+            d.set_item("side", vec_out(py, k.iter().map(|k| k.side).collect()))?;
+            d.set_item("sign", vec_out(py, k.iter().map(|k| k.sign).collect()))?;
+            Ok(d)
+        }
 
-    /// True where several points share the key, shape (n,), bool.
-    #[getter]
-    fn ambiguous<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray1<bool>> {
-        vec_out(py, self.d.points.iter().map(|p| p.ambiguous).collect())
-    }
+        /// Geodesic step between levels (NaN when unknown).
+        #[getter]
+        fn step(&self) -> f64 {
+            self.d.step
+        }
 
-    /// Face of each point, shape (n,), uint32 (2**32 - 1 when unknown).
-    #[getter]
-    fn faces<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray1<u32>> {
-        vec_out(py, self.d.points.iter().map(|p| p.face).collect())
-    }
+        /// Highest level used.
+        #[getter]
+        fn max_level(&self) -> u32 {
+            self.d.max_level
+        }
 
-    /// Barycentric coordinates of each point in its face, shape (n, 3).
-    #[getter]
-    fn bary<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray2<f64>> {
-        points_out(
-            py,
-            &self.d.points.iter().map(|p| p.bary).collect::<Vec<_>>(),
-        )
-    }
-
-    /// The unpacked key fields as a dict of (n,) arrays: ``a``, ``b`` (reference pair), ``i``,
-    /// ``j`` (levels, or angle level for the iso-angle rule), ``side``, ``sign``.
-    fn key_fields<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let k: Vec<Key> = self.d.points.iter().map(|p| p.key).collect();
-        let d = PyDict::new(py);
-        d.set_item("a", vec_out(py, k.iter().map(|k| k.a).collect()))?;
-        d.set_item("b", vec_out(py, k.iter().map(|k| k.b).collect()))?;
-        d.set_item("i", vec_out(py, k.iter().map(|k| k.i).collect()))?;
-        d.set_item("j", vec_out(py, k.iter().map(|k| k.j).collect()))?;
-        d.set_item("side", vec_out(py, k.iter().map(|k| k.side).collect()))?;
-        d.set_item("sign", vec_out(py, k.iter().map(|k| k.sign).collect()))?;
-        Ok(d)
-    }
-
-    /// Geodesic step between levels (NaN when unknown).
-    #[getter]
-    fn step(&self) -> f64 {
-        self.d.step
-    }
-
-    /// Highest level used.
-    #[getter]
-    fn max_level(&self) -> u32 {
-        self.d.max_level
-    }
-
-    /// Geodesic distance between the first two reference points (NaN when unknown).
-    #[getter]
-    fn reference_distance(&self) -> f64 {
-        self.d.reference_distance
-    }
-
-    /// Reference point positions, shape (r, 3) (empty when unknown).
-    #[getter]
-    fn references<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray2<f64>> {
-        points_out(py, &self.d.references)
-    }
-
-    /// The options the descriptor was built with, as a dict (the JSON file's ``options``).
-    #[getter]
-    fn options<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let s = serde_json::to_string(&self.d.options)
-            .map_err(|e| errors::err(errors::Kind::Computation, e.to_string()))?;
-        json_to_py(py, &s)
-    }
-
-    /// Build counters (intersections, ill-conditioned, tangent fallbacks, ambiguous,
-    /// degenerate faces) as a dict.
-    #[getter]
-    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        let s = serde_json::to_string(&self.d.stats)
-            .map_err(|e| errors::err(errors::Kind::Computation, e.to_string()))?;
-        json_to_py(py, &s)
-    }
-
-    /// Writes the descriptor: ``.csv`` (points and keys), ``.json`` (everything, lossless) or
-    /// ``.ply`` (points with key fields, for viewers), by extension.
-    fn save(&self, py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<()> {
-        let p = convert::path(path, "path")?;
-        py.detach(|| bipolar::io::write_auto(&p, &self.d))
-            .map_err(errors::descriptor)
-    }
-
-    /// The JSON text of the descriptor (lossless).
-    fn to_json(&self) -> String {
-        bipolar::io::to_json_string(&self.d)
-    }
-
-    /// Parses the JSON text written by ``to_json`` / ``save(".json")``.
-    #[staticmethod]
-    fn from_json(text: &str) -> PyResult<Self> {
-        let d = bipolar::io::parse_json(text, std::path::Path::new("<string>"))
-            .map_err(errors::descriptor)?;
-        Ok(Self { d })
-    }
-
-    fn __len__(&self) -> usize {
-        self.d.len()
-    }
-
-    fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
-        other
-            .cast::<PyDescriptor>()
-            .is_ok_and(|o| descriptors_equal(&self.d, &o.get().d))
-    }
-
-    fn __repr__(&self) -> String {
-        format!(
-            "Descriptor({} points, step={}, max_level={}, reference_distance={})",
-            self.d.len(),
-            self.d.step,
-            self.d.max_level,
+        /// Geodesic distance between the first two reference points (NaN when unknown).
+        #[getter]
+        fn reference_distance(&self) -> f64 {
             self.d.reference_distance
-        )
-    }
+        }
 
-    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<convert::Reduced<'py>> {
-        let mut meta = self.d.clone();
-        meta.points.clear();
-        convert::reduced(
-            py,
-            "_descriptor_from_state",
-            [
-                self.points(py).into_any(),
-                self.keys(py).into_any(),
-                self.cos(py).into_any(),
-                self.ambiguous(py).into_any(),
-                self.faces(py).into_any(),
-                self.bary(py).into_any(),
-                bipolar::io::to_json_string(&meta)
-                    .into_pyobject(py)?
-                    .into_any(),
-            ],
-        )
+        /// Reference point positions, shape (r, 3) (empty when unknown).
+        #[getter]
+        fn references<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray2<f64>> {
+            points_out(py, &self.d.references)
+        }
+
+        /// The options the descriptor was built with, as a dict (the JSON file's ``options``).
+        #[getter]
+        fn options<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+            let s = serde_json::to_string(&self.d.options)
+                .map_err(|e| errors::err(errors::Kind::Computation, e.to_string()))?;
+            json_to_py(py, &s)
+        }
+
+        /// Build counters (intersections, ill-conditioned, tangent fallbacks, ambiguous,
+        /// degenerate faces) as a dict.
+        #[getter]
+        fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+            let s = serde_json::to_string(&self.d.stats)
+                .map_err(|e| errors::err(errors::Kind::Computation, e.to_string()))?;
+            json_to_py(py, &s)
+        }
+
+        /// Writes the descriptor: ``.csv`` (points and keys), ``.json`` (everything, lossless) or
+        /// ``.ply`` (points with key fields, for viewers), by extension.
+        fn save(&self, py: Python<'_>, path: &Bound<'_, PyAny>) -> PyResult<()> {
+            let p = convert::path(path, "path")?;
+            py.detach(|| bipolar::io::write_auto(&p, &self.d))
+                .map_err(errors::descriptor)
+        }
+
+        /// The JSON text of the descriptor (lossless).
+        fn to_json(&self) -> String {
+            bipolar::io::to_json_string(&self.d)
+        }
+
+        /// Parses the JSON text written by ``to_json`` / ``save(".json")``.
+        #[staticmethod]
+        fn from_json(text: &str) -> PyResult<Self> {
+            let d = bipolar::io::parse_json(text, std::path::Path::new("<string>"))
+                .map_err(errors::descriptor)?;
+            Ok(Self { d })
+        }
+
+        fn __eq__(&self, other: &Bound<'_, PyAny>) -> bool {
+            other
+                .cast::<PyDescriptor>()
+                .is_ok_and(|o| descriptors_equal(&self.d, &o.get().d))
+        }
+
+        fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<convert::Reduced<'py>> {
+            let mut meta = self.d.clone();
+            meta.points.clear();
+            convert::reduced(
+                py,
+                "_descriptor_from_state",
+                [
+                    self.points(py).into_any(),
+                    self.keys(py).into_any(),
+                    self.cos(py).into_any(),
+                    self.ambiguous(py).into_any(),
+                    self.faces(py).into_any(),
+                    self.bary(py).into_any(),
+                    bipolar::io::to_json_string(&meta)
+                        .into_pyobject(py)?
+                        .into_any(),
+                ],
+            )
+        }
     }
 }
 

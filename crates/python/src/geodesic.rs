@@ -224,3 +224,39 @@ fn source_sets(obj: &Bound<'_, PyAny>) -> PyResult<Vec<Vec<Source>>> {
     }
     Ok(out)
 }
+
+/// The solver a binding call computes with: a prepared ``solver`` argument, or else a new solver
+/// of the ``method`` argument, built when [`SolverChoice::run`] runs (inside `py.detach`).
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum SolverChoice<'a> {
+    /// The caller's prepared solver (its method wins; the ``method`` argument is not read).
+    Prepared(&'a dyn GeodesicSolver),
+    /// A solver of this method, built for the call.
+    New(Method),
+}
+
+impl<'a> SolverChoice<'a> {
+    /// Reads the ``method`` / ``solver`` argument pair of a binding (``method`` is parsed only
+    /// when no solver is given).
+    pub(crate) fn of(
+        method: &str,
+        solver: Option<&'a Bound<'_, PyGeodesicSolver>>,
+    ) -> PyResult<Self> {
+        Ok(match solver {
+            Some(s) => SolverChoice::Prepared(s.get().solver.as_ref()),
+            None => SolverChoice::New(method.parse().map_err(errors::geodesic)?),
+        })
+    }
+
+    /// Calls `f` with the chosen solver for `mesh` (building it first when it is new).
+    pub(crate) fn run<T, E: From<geodesic::GeodesicError>>(
+        self,
+        mesh: &meshcore::TriMesh,
+        f: impl FnOnce(&dyn GeodesicSolver) -> Result<T, E>,
+    ) -> Result<T, E> {
+        match self {
+            SolverChoice::Prepared(s) => f(s),
+            SolverChoice::New(method) => f(geodesic::new_solver(mesh, method)?.as_ref()),
+        }
+    }
+}

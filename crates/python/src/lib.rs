@@ -7,6 +7,10 @@
 //! Every call that computes releases the GIL. Nothing panics on user input: arrays are checked
 //! for type, dtype, shape and index range here, values by the libraries.
 
+// First: the macros of the modules below.
+#[macro_use]
+mod wrapper;
+
 mod convert;
 mod curves;
 mod describe;

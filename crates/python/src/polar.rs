@@ -1,14 +1,13 @@
 //! `describe_polar`: the single-pole (geodesic polar) descriptor of `bipolar::polar`, and its
 //! keyed distance.
 
-use crate::convert::{self, points_out, vec_out};
+use crate::convert::{self, vec_out};
 use crate::describe::{given_landmarks, references};
 use crate::errors;
-use crate::geodesic::PyGeodesicSolver;
+use crate::geodesic::{PyGeodesicSolver, SolverChoice};
 use crate::mesh::mesh_arg;
 use bipolar::{PolarDescriptor, PolarKey, PolarOptions, Source};
-use geodesic::{GeodesicSolver, Method, SolveOptions, Walker};
-use glam::DVec3;
+use geodesic::{SolveOptions, Walker};
 use pyo3::prelude::*;
 use pyo3::types::PyString;
 use std::time::Duration;
@@ -25,75 +24,41 @@ pub struct PyPolarDescriptor {
     pub d: PolarDescriptor,
 }
 
-#[pymethods]
-impl PyPolarDescriptor {
-    /// Point positions, shape (n, 3).
-    #[getter]
-    fn points<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray2<f64>> {
-        points_out(py, &self.d.positions())
+descriptor_pymethods! {
+    PyPolarDescriptor,
+    surface_points {
+        keys: keys,
+        /// Face of each point, shape (n,), uint32.
+        faces
     }
-
-    /// Packed keys, shape (n,), uint64.
-    #[getter]
-    fn keys<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray1<u64>> {
-        vec_out(py, self.d.keys())
+    levels {
+        /// Geodesic step between radius levels.
+        step,
+        /// Number of radius levels asked for.
+        n_levels
     }
-
-    /// Radius level of each point (1-based), shape (n,), uint32.
-    #[getter]
-    fn levels<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray1<u32>> {
-        vec_out(py, self.d.points.iter().map(|p| p.key.level).collect())
+    summary {
+        "PolarDescriptor", points "points", step = options.step, levels = options.levels,
+        sectors = options.sectors
     }
+    {
+        /// Radius level of each point (1-based), shape (n,), uint32.
+        #[getter]
+        fn levels<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray1<u32>> {
+            vec_out(py, self.d.points.iter().map(|p| p.key.level).collect())
+        }
 
-    /// Angular sector of each point, shape (n,), uint32.
-    #[getter]
-    fn sectors<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray1<u32>> {
-        vec_out(py, self.d.points.iter().map(|p| p.key.sector).collect())
-    }
+        /// Angular sector of each point, shape (n,), uint32.
+        #[getter]
+        fn sectors<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray1<u32>> {
+            vec_out(py, self.d.points.iter().map(|p| p.key.sector).collect())
+        }
 
-    /// Face of each point, shape (n,), uint32.
-    #[getter]
-    fn faces<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray1<u32>> {
-        vec_out(py, self.d.points.iter().map(|p| p.face).collect())
-    }
-
-    /// Barycentric coordinates of each point in its face, shape (n, 3).
-    #[getter]
-    fn bary<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray2<f64>> {
-        let b: Vec<DVec3> = self.d.points.iter().map(|p| p.bary).collect();
-        points_out(py, &b)
-    }
-
-    /// Geodesic step between radius levels.
-    #[getter]
-    fn step(&self) -> f64 {
-        self.d.options.step
-    }
-
-    /// Number of radius levels asked for.
-    #[getter]
-    fn n_levels(&self) -> u32 {
-        self.d.options.levels
-    }
-
-    /// Number of rays.
-    #[getter]
-    fn n_sectors(&self) -> u32 {
-        self.d.options.sectors
-    }
-
-    fn __len__(&self) -> usize {
-        self.d.points.len()
-    }
-
-    fn __repr__(&self) -> String {
-        format!(
-            "PolarDescriptor({} points, step={}, levels={}, sectors={})",
-            self.d.points.len(),
-            self.d.options.step,
-            self.d.options.levels,
+        /// Number of rays.
+        #[getter]
+        fn n_sectors(&self) -> u32 {
             self.d.options.sectors
-        )
+        }
     }
 }
 
@@ -146,24 +111,13 @@ pub fn describe_polar(
         levels,
         sectors,
     };
-    // The method is read only when no prepared solver is given (as in `describe`).
-    let method: Method = match solver {
-        Some(_) => Method::Exact,
-        None => method.parse().map_err(errors::geodesic)?,
-    };
-    let prepared = solver.map(|s| s.get());
+    let choice = SolverChoice::of(method, solver)?;
     let d = py.detach(|| {
-        let owned;
-        let solver: &dyn GeodesicSolver = match prepared {
-            Some(s) => s.solver.as_ref(),
-            None => {
-                owned = geodesic::new_solver(mesh, method)?;
-                owned.as_ref()
-            }
-        };
-        let field = solver.distances(&[pole], &SolveOptions::default())?;
-        let walker = Walker::new(mesh);
-        bipolar::describe_polar(&walker, &field, pole, towards, &opts)
+        choice.run(mesh, |solver| {
+            let field = solver.distances(&[pole], &SolveOptions::default())?;
+            let walker = Walker::new(mesh);
+            bipolar::describe_polar(&walker, &field, pole, towards, &opts)
+        })
     });
     Ok(PyPolarDescriptor {
         d: d.map_err(errors::descriptor)?,

@@ -356,8 +356,7 @@ fn clean_is_deterministic_and_reports() {
 }
 
 fn ict_face() -> Option<TriMesh> {
-    let p = testsupport::paper_face("id1_neutral.obj")?;
-    Some(testsupport::read_mesh(p))
+    testsupport::paper_meshes(["id1_neutral.obj"]).map(|[m]| m)
 }
 
 #[test]

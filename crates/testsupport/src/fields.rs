@@ -107,6 +107,21 @@ pub fn assert_close(got: &[f64], want: &[f64], rel: f64, what: &str) {
     }
 }
 
+/// A refinement study on the unit icosphere: for levels 2, 3 and 4, `(level, mean edge length,
+/// mean absolute error, max absolute error)` of `field(mesh)` (the distance from vertex 0)
+/// against the great-circle distance [`sphere_geodesic`].
+pub fn icosphere_errors(field: impl Fn(&TriMesh) -> Vec<f64>) -> Vec<(u32, f64, f64, f64)> {
+    (2..=4)
+        .map(|level| {
+            let m = meshcore::shapes::icosphere(level);
+            let g = sphere_geodesic(&m, m.position(0), 1.0);
+            let d = field(&m);
+            let h = m.mean_edge_length();
+            (level, h, mean_abs_diff(&d, &g), max_abs_diff(&d, &g))
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -5,11 +5,12 @@
 //!   prints one `skipped: ...` line and returns `None` when the folder (or the file inside it)
 //!   is absent. A `BIPOLAR_SHARED` that names no folder is a user error, not a reason to skip:
 //!   the test panics with the lookup's message.
-//! * **Paths**: [`PAPER_SET`], [`MODEL`], [`paper_face`].
+//! * **Paths**: [`PAPER_SET`], [`MODEL`], [`paper_face`] (and [`paper_meshes`], read).
 //! * **Meshes**: [`read_mesh`] (through `mesh-io`, the project's one reader) and the generators
 //!   of [`meshcore::shapes`], re-exported as [`shapes`], plus [`jittered_grid`],
 //!   [`jittered_unit_plane`] (the plane of the straightest-geodesic, single-pole and face-frame
-//!   tests), [`height_field`], [`uv_sphere_y_up`] and [`renumbered`].
+//!   tests), [`height_field`], [`uv_sphere_y_up`] and [`renumbered`]; [`nearest_vertex`] by brute
+//!   force.
 //! * **Analytic distance fields** and the differences between two fields: [`fields`].
 //! * **End-to-end runs** of the command-line tools: [`cli`]; the check of a crate's option
 //!   names: [`check_choice_error`].
@@ -24,7 +25,7 @@ pub use facemodel::{MODEL, PAPER_SET};
 pub use meshcore::shapes;
 
 use facemodel::FaceModelError;
-use meshcore::TriMesh;
+use meshcore::{DVec3, TriMesh};
 use std::path::{Path, PathBuf};
 
 /// Planar grid on [0, 1]^2 (z = 0) of `n` cells a side, uniform diagonals, interior vertices
@@ -125,6 +126,16 @@ pub fn paper_face(name: &str) -> Option<PathBuf> {
     shared_path(Path::new(PAPER_SET).join(name))
 }
 
+/// The meshes of the paper-set faces `names` ([`paper_face`], read with [`read_mesh`]); `None`
+/// when one is absent (the skip rule of [`shared_path`]).
+pub fn paper_meshes<const N: usize>(names: [&str; N]) -> Option<[TriMesh; N]> {
+    let paths = names.map(paper_face);
+    if paths.iter().any(Option::is_none) {
+        return None;
+    }
+    Some(paths.map(|p| read_mesh(p.expect("checked above"))))
+}
+
 /// The path `rel` inside the shared data folder, or a `return` from the calling function (with
 /// `Default::default()`, so `()` in a test) after the skip line of [`shared_path`].
 ///
@@ -192,6 +203,18 @@ pub fn read_mesh(path: impl AsRef<Path>) -> TriMesh {
         Ok(m) => m.mesh,
         Err(e) => panic!("reading {}: {e}", path.display()),
     }
+}
+
+/// The vertex of `mesh` nearest to `p` by brute force (the lowest index on ties); panics on a
+/// mesh without vertices (test code).
+pub fn nearest_vertex(mesh: &TriMesh, p: DVec3) -> u32 {
+    (0..mesh.n_vertices() as u32)
+        .min_by(|&a, &b| {
+            (mesh.position(a) - p)
+                .length()
+                .total_cmp(&(mesh.position(b) - p).length())
+        })
+        .expect("a mesh with vertices")
 }
 
 /// `mesh` with its vertices renumbered by the permutation `v -> (7919 v + 13) mod n`, its faces

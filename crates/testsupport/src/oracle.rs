@@ -7,7 +7,8 @@
 //! The descriptor is the grid reading of the paper (selection rule A without angle filter:
 //! every intersection of level `i` of `U_r` with level `j` of `U_q`, key `(i, j, side)`, one
 //! 2x2 solve per face), and the distance is the keyed L2 distance after the optimal rotation
-//! (Horn's quaternion closed form with its own 4x4 Jacobi solver), normalised to [0, 1]:
+//! (the singular values of the correlation matrix in closed form: no Horn or Kabsch
+//! solver), normalised to [0, 1]:
 //! `d = sqrt((|A|^2 + |B|^2 - 2 max_R sum a.Rb) / (|A|^2 + |B|^2))` on centred paired points.
 //! Written apart from the crates on purpose: it shares no code with `bipolar`, `levelcurves`
 //! or `shapedist`.
@@ -253,80 +254,58 @@ pub fn paired_distance(a: &[DVec3], b: &[DVec3]) -> Option<f64> {
     Some(((na + nb - 2.0 * lmax).max(0.0) / (na + nb)).sqrt())
 }
 
-/// `max_R sum a_i . R b_i` from `S = sum b_i a_i^T` (largest eigenvalue of Horn's matrix).
+/// `max_R sum a_i . R b_i` over rotations, from `S = sum b_i a_i^T`: `s1 + s2 + sign(det S) s3`
+/// with `s1 >= s2 >= s3` the singular values of `S` (Umeyama's reflection-guarded trace).
+///
+/// Independent of the library's Horn and Kabsch solvers (both Jacobi iterations): `s1^2`, `s2^2`
+/// are the two largest eigenvalues of `S^T S` in closed form (the trigonometric solution of its
+/// characteristic cubic), and the signed `s3` is `det S / (s1 s2)`, which keeps it accurate when
+/// it is small (planar point sets). Near rank 1 (`s2` tiny) the result loses precision
+/// (`sqrt(eps) s1`), which no test here relies on.
 fn max_rotation_correlation(s: &[[f64; 3]; 3]) -> f64 {
-    horn_eigen(s).0
+    let mut sts = [[0.0f64; 3]; 3];
+    for (r, row) in sts.iter_mut().enumerate() {
+        for (c, v) in row.iter_mut().enumerate() {
+            *v = (0..3).map(|k| s[k][r] * s[k][c]).sum();
+        }
+    }
+    let [l1, l2, _] = sym3_eigenvalues(&sts);
+    let (s1, s2) = (l1.max(0.0).sqrt(), l2.max(0.0).sqrt());
+    if s1 * s2 <= 0.0 {
+        return s1;
+    }
+    s1 + s2 + det3(s) / (s1 * s2)
 }
 
-fn horn_eigen(s: &[[f64; 3]; 3]) -> (f64, [f64; 4]) {
-    let (sxx, sxy, sxz) = (s[0][0], s[0][1], s[0][2]);
-    let (syx, syy, syz) = (s[1][0], s[1][1], s[1][2]);
-    let (szx, szy, szz) = (s[2][0], s[2][1], s[2][2]);
-    let n = [
-        [sxx + syy + szz, syz - szy, szx - sxz, sxy - syx],
-        [syz - szy, sxx - syy - szz, sxy + syx, szx + sxz],
-        [szx - sxz, sxy + syx, -sxx + syy - szz, syz + szy],
-        [sxy - syx, szx + sxz, syz + szy, -sxx - syy + szz],
-    ];
-    let (vals, vecs) = jacobi4(n);
-    let mut best = 0;
-    for k in 1..4 {
-        if vals[k] > vals[best] {
-            best = k;
-        }
-    }
-    (
-        vals[best],
-        [vecs[0][best], vecs[1][best], vecs[2][best], vecs[3][best]],
-    )
+fn det3(m: &[[f64; 3]; 3]) -> f64 {
+    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
 }
 
-#[allow(clippy::needless_range_loop)]
-/// Cyclic Jacobi eigen-decomposition of a symmetric 4x4 matrix: (eigenvalues, eigenvectors as
-/// columns).
-fn jacobi4(mut a: [[f64; 4]; 4]) -> ([f64; 4], [[f64; 4]; 4]) {
-    let mut v = [[0.0; 4]; 4];
-    for (i, row) in v.iter_mut().enumerate() {
-        row[i] = 1.0;
+/// Eigenvalues of a symmetric 3x3 matrix, descending, in closed form: with `q = tr(A) / 3`,
+/// `p^2 = |A - qI|_F^2 / 6` and `B = (A - qI) / p`, they are `q + 2p cos(phi + 2 pi k / 3)`,
+/// `phi = acos(det(B) / 2) / 3` (Smith, CACM 1961).
+fn sym3_eigenvalues(a: &[[f64; 3]; 3]) -> [f64; 3] {
+    let off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+    let q = (a[0][0] + a[1][1] + a[2][2]) / 3.0;
+    let d = [a[0][0] - q, a[1][1] - q, a[2][2] - q];
+    let p2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + 2.0 * off;
+    if p2 <= 0.0 {
+        return [q; 3];
     }
-    for _ in 0..100 {
-        let off: f64 = (0..4)
-            .flat_map(|i| (0..4).filter(move |&j| j != i).map(move |j| (i, j)))
-            .map(|(i, j)| a[i][j] * a[i][j])
-            .sum();
-        let diag: f64 = (0..4).map(|i| a[i][i] * a[i][i]).sum();
-        if off <= 1e-30 * diag.max(1e-300) {
-            break;
-        }
-        for p in 0..3 {
-            for q in p + 1..4 {
-                if a[p][q].abs() < 1e-300 {
-                    continue;
-                }
-                let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
-                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
-                let t = if theta == 0.0 { 1.0 } else { t };
-                let c = 1.0 / (t * t + 1.0).sqrt();
-                let s = t * c;
-                for k in 0..4 {
-                    let (akp, akq) = (a[k][p], a[k][q]);
-                    a[k][p] = c * akp - s * akq;
-                    a[k][q] = s * akp + c * akq;
-                }
-                for k in 0..4 {
-                    let (apk, aqk) = (a[p][k], a[q][k]);
-                    a[p][k] = c * apk - s * aqk;
-                    a[q][k] = s * apk + c * aqk;
-                }
-                for row in v.iter_mut() {
-                    let (vkp, vkq) = (row[p], row[q]);
-                    row[p] = c * vkp - s * vkq;
-                    row[q] = s * vkp + c * vkq;
-                }
-            }
+    let p = (p2 / 6.0).sqrt();
+    let mut b = *a;
+    for (i, row) in b.iter_mut().enumerate() {
+        for (j, v) in row.iter_mut().enumerate() {
+            *v = (*v - if i == j { q } else { 0.0 }) / p;
         }
     }
-    ([a[0][0], a[1][1], a[2][2], a[3][3]], v)
+    let phi = (0.5 * det3(&b)).clamp(-1.0, 1.0).acos() / 3.0;
+    let third = 2.0 * std::f64::consts::PI / 3.0;
+    let hi = q + 2.0 * p * phi.cos();
+    let lo = q + 2.0 * p * (phi + third).cos();
+    [hi, 3.0 * q - hi - lo, lo]
 }
 
 #[cfg(test)]
@@ -372,6 +351,37 @@ mod tests {
         assert!(d > 1e-4 && d < 0.05, "{d}");
         let d2 = paired_distance(&noisy, &a).unwrap();
         assert!((d - d2).abs() < 1e-12);
+    }
+
+    /// The closed form agrees with the library's Horn and Kabsch solvers on the maximum, for
+    /// rotations, reflections (negative determinant) and rank-2 (planar) correlations.
+    #[test]
+    fn rotation_maximum_matches_horn_and_kabsch() {
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        for case in 0..40 {
+            let mut s = [[0.0f64; 3]; 3];
+            for row in s.iter_mut() {
+                for v in row.iter_mut() {
+                    *v = rng.random::<f64>() * 2.0 - 1.0;
+                }
+            }
+            if case % 4 == 3 {
+                // Rank 2: the third row a combination of the first two.
+                s[2] = [0, 1, 2].map(|c| 0.3 * s[0][c] - 0.7 * s[1][c]);
+            }
+            let ours = max_rotation_correlation(&s);
+            // The library's K = sum a b^T is S^T.
+            let k = DMat3::from_cols_array_2d(&s);
+            for (what, theirs) in [
+                ("kabsch", meshcore::linalg::kabsch_rotation(k).1),
+                ("horn", meshcore::linalg::horn_rotation(k).1),
+            ] {
+                assert!(
+                    (ours - theirs).abs() < 1e-9 * (1.0 + theirs.abs()),
+                    "case {case}: {what} {theirs} vs {ours}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -32,32 +32,18 @@ impl Ctx<'_> {
                     .map(|r| {
                         let f = r.face as usize;
                         let nf = self.mesh.face_normal(r.face);
-                        let ta = strip
-                            .tangent(
-                                pair.fa,
-                                r.i as f64 * self.step,
-                                r.pos,
-                                r.face,
-                                nf,
-                                pair.ga[f],
-                            )
-                            .unwrap_or_else(|| {
-                                stats.tangent_fallbacks += 1;
-                                nf.cross(pair.ga[f]).normalize_or_zero()
-                            });
-                        let tb = strip
-                            .tangent(
-                                pair.fb,
-                                r.j as f64 * self.step,
-                                r.pos,
-                                r.face,
-                                nf,
-                                pair.gb[f],
-                            )
-                            .unwrap_or_else(|| {
-                                stats.tangent_fallbacks += 1;
-                                nf.cross(pair.gb[f]).normalize_or_zero()
-                            });
+                        // The strip tangent of one field's level curve at the point, or the
+                        // tangent across the face gradient when the strip has none.
+                        let mut tangent = |field: &[f64], level: u32, grad: DVec3| {
+                            strip
+                                .tangent(field, level as f64 * self.step, r.pos, r.face, nf, grad)
+                                .unwrap_or_else(|| {
+                                    stats.tangent_fallbacks += 1;
+                                    nf.cross(grad).normalize_or_zero()
+                                })
+                        };
+                        let ta = tangent(pair.fa, r.i, pair.ga[f]);
+                        let tb = tangent(pair.fb, r.j, pair.gb[f]);
                         ta.dot(tb)
                     })
                     .collect()
