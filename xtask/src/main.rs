@@ -1,16 +1,10 @@
-//! Project tasks, run as `cargo xtask <task>` (the alias lives in `.cargo/config.toml`).
+//! Project tasks, run as `cargo xtask <task>` (the alias lives in `.cargo/config.toml`): the
+//! command line of the `experiments` crate, one subcommand per task.
 
 use clap::Parser;
-
-mod experiments;
-mod landmarks_eval;
-mod paths;
-mod recognition;
-mod robustness;
-mod scan_path;
-mod scan_study;
-mod section6;
-mod sphere_validate;
+use experiments::{
+    landmarks_eval, recognition, robustness, scan_path, scan_study, section6, sphere_validate,
+};
 
 /// Experiments and evaluations of the bipolar workspace.
 #[derive(Debug, Parser)]

@@ -6,7 +6,7 @@
 //!   comparison).
 //! * **Reference-point errors** (the grid of figures 9-11): the left outer eye corner (bipolar)
 //!   or the nose tip (single pole, facial curves, and the centre of the iso-curvature region)
-//!   of the test face moved by 1-5 % of D in 8 directions (`experiments::pipeline::perturb`).
+//!   of the test face moved by 1-5 % of D in 8 directions (`crate::pipeline::perturb`).
 //! * **Depth noise**: Gaussian noise along the vertex normals of the test face.
 //! * **Figure 15**: polar rings 2, 4, 6 rotated about their centroids
 //!   (`robustness::pole::rotate_rings`), scored by each distance.
@@ -15,18 +15,19 @@
 //! other person), so the four distances, on different scales, can be compared. The report
 //! states for each claim of section 6 whether the numbers support it.
 
-use crate::experiments::curves::{
+use crate::curves::{
     facial_curves, facial_distance, iso_curves, iso_distance, reference_iso_levels,
 };
-use crate::experiments::pipeline::{
-    bar, bipolar, dist, field, field_at, perturb, single_thread, DescriptorRule, Refs, Region,
-};
-use crate::experiments::polar::{self, polar_descriptor, PolarOptions, Pole};
-use crate::experiments::report::{f4, Report};
-use crate::experiments::walk::Walker;
 use crate::paths::{FaceSetArgs, ResolutionArgs};
+use crate::pipeline::{
+    bar, bipolar, dist, error_grid, field, field_at, perturb, single_thread, DescriptorRule, Refs,
+    Region, RADII_PCT,
+};
+use crate::polar::{self, polar_descriptor, PolarOptions, Pole};
+use crate::report::{f4, joined, polylines, render_face, Report};
 use crate::robustness::pole::{rotate_rings, ROTATED};
 use crate::robustness::stats::{max, mean, Sep};
+use crate::walk::Walker;
 use anyhow::{bail, Context, Result};
 use bipolar::PolarDescriptor;
 use facecurves::{
@@ -43,7 +44,7 @@ use rayon::prelude::*;
 use std::path::Path;
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
-use viz::{Polyline, Scene, View};
+use viz::{Polyline, Scene};
 
 /// Table columns of the four representations' movements (relative to the distance between
 /// persons in brackets).
@@ -88,10 +89,6 @@ pub struct Args {
 
 /// The four representations, in report order.
 const REPS: [&str; 4] = ["bipolar", "single pole", "facial curves", "iso-curvature"];
-/// Perturbation radii in percent of D (as figures 9-11).
-const RADII_PCT: [f64; 5] = [1.0, 2.0, 3.0, 4.0, 5.0];
-/// Perturbation directions.
-const N_DIRS: usize = 8;
 
 /// The four descriptors of one face configuration (`None`: not asked for, or refused and
 /// listed in the failures; a single pole whose rays reach no level is the empty set).
@@ -392,12 +389,7 @@ pub fn run(args: Args) -> Result<()> {
     let scale: Vec<f64> = seps.iter().map(|s| s.row_min_diff).collect();
 
     // Reference-point errors.
-    let grid_cells: Vec<(f64, f64)> = RADII_PCT
-        .iter()
-        .flat_map(|&p| {
-            (0..N_DIRS).map(move |k| (p, std::f64::consts::TAU * k as f64 / N_DIRS as f64))
-        })
-        .collect();
+    let grid_cells = error_grid();
     let pb = bar(grid_cells.len(), "reference-point grid");
     let w = &walkers[test];
     let lm = tf.landmarks;
@@ -618,7 +610,8 @@ const RED: [u8; 3] = [0xc0, 0x39, 0x2b];
 const BLUE: [u8; 3] = [0x24, 0x71, 0xa3];
 const GREEN: [u8; 3] = [0x27, 0xae, 0x60];
 
-fn render(path: &Path, scene: &Scene<'_>, face: &Face) -> Result<()> {
+/// Renders `lines` on `face` into `path`, seen from the front of its landmark frame.
+fn render(path: &Path, face: &Face, lines: Vec<Polyline>) -> Result<()> {
     let lm = face.landmarks;
     let frame = face_frame(
         &face.mesh,
@@ -626,49 +619,84 @@ fn render(path: &Path, scene: &Scene<'_>, face: &Face) -> Result<()> {
         face.mesh.position(lm.left_eye_outer),
         face.mesh.position(lm.nose_tip),
     );
-    viz::render_to_file(path, scene, &View::new(-frame.forward, frame.up), 560, 640)
-        .with_context(|| format!("rendering {}", path.display()))
+    let mut scene = Scene::new(&face.mesh);
+    scene.polylines = lines;
+    render_face(path, &scene, frame.up, frame.forward)
 }
 
 /// Figure 14 style: the iso-curvature network (k1 red, k2 blue); the facial curves (green).
 fn renders(out: &Path, face: &Face, d: &Descs) -> Result<()> {
     if let Some(iso) = &d.iso {
-        let mut scene = Scene::new(&face.mesh);
-        scene.polylines = iso
+        let color = |f| if f == PrincipalField::K1 { RED } else { BLUE };
+        let lines = iso
             .curves
             .iter()
-            .map(|c| Polyline {
-                points: c.points.clone(),
-                closed: c.closed,
-                color: if c.field == PrincipalField::K1 {
-                    RED
-                } else {
-                    BLUE
-                },
-                width: 1.4,
-            })
-            .collect();
-        render(&out.join("iso_curvature.svg"), &scene, face)?;
+            .map(|c| (c.points.clone(), c.closed, color(c.field)));
+        render(&out.join("iso_curvature.svg"), face, polylines(lines, 1.4))?;
     }
     if let Some(f) = &d.facial {
-        let mut scene = Scene::new(&face.mesh);
-        scene.polylines = f
-            .curves
-            .iter()
-            .map(|c| Polyline {
-                points: c.points.clone(),
-                closed: c.closed,
-                color: GREEN,
-                width: 1.6,
-            })
-            .collect();
-        render(&out.join("facial_curves.svg"), &scene, face)?;
+        let lines = f.curves.iter().map(|c| (c.points.clone(), c.closed, GREEN));
+        render(&out.join("facial_curves.svg"), face, polylines(lines, 1.6))?;
     }
     Ok(())
 }
 
 fn fmt(x: f64) -> String {
     f4(x)
+}
+
+/// A table row of movements: `label`, then per representation `agg` of the distances `d` with,
+/// in brackets, its value relative to `scale` (the distance between persons).
+fn rel_row<'a>(
+    label: String,
+    d: impl Iterator<Item = &'a [f64; 4]>,
+    agg: fn(&[f64]) -> f64,
+    scale: &[f64],
+) -> Vec<String> {
+    let d: Vec<&[f64; 4]> = d.collect();
+    std::iter::once(label)
+        .chain((0..4).map(|k| {
+            let v: Vec<f64> = d.iter().map(|x| x[k]).collect();
+            let a = agg(&v);
+            format!("{} ({:.2})", fmt(a), a / scale[k])
+        }))
+        .collect()
+}
+
+/// The [`rel_row`] of the mean movement at each of `levels` (labelled by `label`): over the
+/// cells whose first coordinate is that level, with their distances `d`.
+fn level_rows<T: PartialEq + Copy, U>(
+    levels: &[T],
+    cells: &[(T, U)],
+    d: &[[f64; 4]],
+    label: impl Fn(T) -> String,
+    scale: &[f64],
+) -> Vec<Vec<String>> {
+    levels
+        .iter()
+        .map(|&l| {
+            let at = cells
+                .iter()
+                .zip(d)
+                .filter(|(c, _)| c.0 == l)
+                .map(|(_, v)| v);
+            rel_row(label(l), at, mean, scale)
+        })
+        .collect()
+}
+
+/// CSV rows, one per cell: its two leading columns (`lead`), then its four distances.
+fn cell_rows<C>(cells: &[C], d: &[[f64; 4]], lead: impl Fn(&C) -> [String; 2]) -> Vec<Vec<String>> {
+    cells
+        .iter()
+        .zip(d)
+        .map(|(c, v)| {
+            lead(c)
+                .into_iter()
+                .chain(v.iter().map(|x| format!("{x}")))
+                .collect()
+        })
+        .collect()
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -762,35 +790,15 @@ fn write_report(
 
     rep.heading(2, "Reference-point errors (the grid of figures 9-11)");
     rep.para("Bipolar: the left outer eye corner moved; single pole, facial curves and iso-curvature: the nose tip moved (the iso-curvature network depends on it only through its region). Walks stopped by a hole are left out.");
-    let mut rows = Vec::new();
-    let mut csv = Vec::new();
-    for &pct in &RADII_PCT {
-        let idx: Vec<usize> = (0..grid_cells.len())
-            .filter(|&i| grid_cells[i].0 == pct)
-            .collect();
-        let mut row = vec![format!("{pct} %")];
-        for k in 0..4 {
-            let v: Vec<f64> = idx.iter().map(|&i| grid[i][k]).collect();
-            row.push(format!("{} ({:.2})", fmt(mean(&v)), mean(&v) / scale[k]));
-        }
-        rows.push(row);
-    }
-    let mut all = vec!["all (max)".to_string()];
-    for k in 0..4 {
-        let v: Vec<f64> = grid.iter().map(|g| g[k]).collect();
-        all.push(format!("{} ({:.2})", fmt(max(&v)), max(&v) / scale[k]));
-    }
-    rows.push(all);
+    let mut rows = level_rows(&RADII_PCT, grid_cells, grid, |p| format!("{p} %"), scale);
+    rows.push(rel_row("all (max)".to_string(), grid.iter(), max, scale));
     rep.table(&[&["radius (% of D)"][..], &REL_COLUMNS].concat(), &rows);
-    for (c, g) in grid_cells.iter().zip(grid) {
-        let mut r = vec![format!("{}", c.0), format!("{:.1}", c.1.to_degrees())];
-        r.extend(g.iter().map(|v| format!("{v}")));
-        csv.push(r);
-    }
     rep.csv(
         "grid.csv",
         &[&["radius_pct", "angle_deg"][..], &CSV_COLUMNS].concat(),
-        &csv,
+        &cell_rows(grid_cells, grid, |c| {
+            [format!("{}", c.0), format!("{:.1}", c.1.to_degrees())]
+        }),
     )?;
 
     rep.heading(2, "Depth noise on the test face");
@@ -798,29 +806,20 @@ fn write_report(
         "Gaussian noise along the vertex normals ({} draws per level; the face is in units of {mm} mm); every field, curvature and descriptor recomputed on the noisy mesh, compared with the clean one.",
         args.noise_draws
     ));
-    let mut rows = Vec::new();
-    let mut csv = Vec::new();
-    for &s in &args.noise_mm {
-        let idx: Vec<usize> = (0..noise_cells.len())
-            .filter(|&i| noise_cells[i].0 == s)
-            .collect();
-        let mut row = vec![format!("{s} mm")];
-        for k in 0..4 {
-            let v: Vec<f64> = idx.iter().map(|&i| noise[i][k]).collect();
-            row.push(format!("{} ({:.2})", fmt(mean(&v)), mean(&v) / scale[k]));
-        }
-        rows.push(row);
-    }
-    for (c, d) in noise_cells.iter().zip(noise) {
-        let mut r = vec![format!("{}", c.0), format!("{}", c.1)];
-        r.extend(d.iter().map(|v| format!("{v}")));
-        csv.push(r);
-    }
+    let rows = level_rows(
+        &args.noise_mm,
+        noise_cells,
+        noise,
+        |s| format!("{s} mm"),
+        scale,
+    );
     rep.table(&[&["sigma"][..], &REL_COLUMNS].concat(), &rows);
     rep.csv(
         "noise.csv",
         &[&["sigma_mm", "draw"][..], &CSV_COLUMNS].concat(),
-        &csv,
+        &cell_rows(noise_cells, noise, |c| {
+            [format!("{}", c.0), format!("{}", c.1)]
+        }),
     )?;
 
     rep.heading(2, "Figure 15: polar rings rotated one by one");
@@ -837,11 +836,7 @@ fn write_report(
     );
     rep.para(&format!(
         "Elastic distance of each ring to its copy in the rotated descriptor: {}.",
-        fig15_rings
-            .iter()
-            .map(|(l, d)| format!("ring {l} {d:.4}"))
-            .collect::<Vec<_>>()
-            .join(", ")
+        joined(fig15_rings, ", ", |(l, d)| format!("ring {l} {d:.4}"))
     ));
 
     rep.heading(2, "The paper's section-6 claims against these numbers");
@@ -902,13 +897,7 @@ fn write_report(
             "{} descriptors or distances refused (their cells are NaN):",
             failures.len()
         ));
-        rep.para(
-            &failures
-                .iter()
-                .map(|f| format!("- {f}"))
-                .collect::<Vec<_>>()
-                .join("\n"),
-        );
+        rep.list(failures);
     }
     Ok(())
 }

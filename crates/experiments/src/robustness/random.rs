@@ -3,9 +3,9 @@
 //! between the perturbed descriptors.
 
 use super::{eye_mid, Ctx, Desc, MethodResults, Prepared};
-use crate::experiments::pipeline::{bar, field, field_at, perturb, Refs, Region};
-use crate::experiments::polar::{polar_descriptor, Pole};
-use crate::experiments::walk::Walker;
+use crate::pipeline::{bar, field, field_at, perturb, Refs, Region};
+use crate::polar::{polar_descriptor, Pole};
+use crate::walk::Walker;
 use anyhow::Result;
 use bipolar::PolarDescriptor;
 use facemodel::face_frame;

@@ -15,7 +15,7 @@
 //! Reported: the normalised keyed shape distance `min_R ||A - R B|| / sqrt(|A|^2 + |B|^2)`
 //! (common keys, centred, rotation only), mean position error and mean angle (cosine) error.
 
-use crate::experiments::report::markers;
+use crate::report::{self, joined, markers};
 use anyhow::Context;
 use bipolar::{
     Descriptor, DescriptorOptions, Key, LevelSpec, SelectionRule, Source, TangentMethod,
@@ -25,7 +25,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use meshcore::{FaceLocator, TriMesh};
 use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 const ALPHA: f64 = 0.95;
@@ -326,12 +326,9 @@ pub struct Args {
 /// Runs the experiment, writing into the output folder.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let t_start = Instant::now();
-    let out_dir = args.out.unwrap_or_else(|| {
-        Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("..")
-            .join("target")
-            .join("sphere-validate")
-    });
+    let out_dir = args
+        .out
+        .unwrap_or_else(|| crate::paths::default_out_dir("sphere-validate"));
     std::fs::create_dir_all(&out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
     let meshes = meshes()?;
     let rules: [(SelectionRule, &'static str); 3] = [
@@ -512,16 +509,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 step,
                 2 * n - 1,
             )?;
-            for pieces in lv {
-                for iso in pieces {
-                    polylines.push(viz::Polyline {
-                        points: iso.points.iter().map(|p| *p * 1.002).collect(),
-                        closed: iso.closed,
-                        color,
-                        width: 1.0,
-                    });
-                }
-            }
+            let lifted = lv.into_iter().flatten().map(|iso| {
+                let points = iso.points.iter().map(|p| *p * 1.002).collect();
+                (points, iso.closed, color)
+            });
+            polylines.extend(report::polylines(lifted, 1.0));
         }
         let view = viz::View::new(-DVec3::new(1.0, 0.6, 1.0).normalize(), DVec3::Z);
         let truth = analytic(SelectionRule::IsoAngle, n, 2 * n - 1);
@@ -561,11 +553,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let _ = writeln!(
         md,
         "Geodesic time per mesh (both fields): {}\n",
-        geodesic_ms
-            .iter()
-            .map(|(n, t)| format!("{n}: {t:.0} ms"))
-            .collect::<Vec<_>>()
-            .join(", ")
+        joined(&geodesic_ms, ", ", |(n, t)| format!("{n}: {t:.0} ms"))
     );
     // Verdict.
     let mut better = 0;

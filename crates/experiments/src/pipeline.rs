@@ -2,13 +2,16 @@
 //! per region (built by the `bipolar` crate), keyed distances (`shapedist`), reference-point
 //! perturbation, geodesic method resolution and progress bars.
 
-use super::walk::Walker;
+use crate::walk::Walker;
 use anyhow::{bail, Context, Result};
 use facemodel::{face_frame, static_mask, Face, FaceFrame};
 use geodesic::{GeodesicSolver, Method, SolveOptions, Source};
 use indicatif::{ProgressBar, ProgressStyle};
+use meshcore::linalg::fit_rigid;
 use meshcore::{DAffine3, DVec3, FaceLocator, SurfacePoint, TriMesh};
-use shapedist::ShapeDistError;
+use shapedist::{
+    icp_to_target, Convergence, IcpLoopOptions, IcpVariant, ShapeDistError, TrimRounding,
+};
 
 /// Which area a bipolar descriptor covers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -66,6 +69,42 @@ impl Refs {
         };
         Ok((refs, un))
     }
+}
+
+/// The experiments' ICP of points onto a surface: point-to-point with translation onto the
+/// closest surface points, the worst 10 % of pairs trimmed (kept count rounded down), at most
+/// `max_iterations`, stop after a step when the trimmed RMS changed by at most `1e-6` relative.
+pub fn trimmed_icp(max_iterations: usize) -> IcpLoopOptions {
+    IcpLoopOptions {
+        variant: IcpVariant::PointToPoint,
+        max_iterations,
+        translation: true,
+        trim: 0.1,
+        trim_rounding: TrimRounding::Down,
+        convergence: Convergence::RelativeRmseAfterStep { tolerance: 1e-6 },
+        evaluate_final: false,
+        ..IcpLoopOptions::default()
+    }
+}
+
+/// ICP of `probe` onto the surface of `target` ([`shapedist::icp_to_target`] with
+/// [`trimmed_icp`]`(max_iterations)`), started from the rigid fit of `probe_lm` onto
+/// `target_lm` (the same landmarks on both faces): the [`rms_to_surface`] of all probe points
+/// at the final pose, NaN when the fit or a step fails.
+pub fn landmark_icp_rms(
+    probe: &[DVec3],
+    probe_lm: &[DVec3],
+    target: &FaceLocator<'_>,
+    target_lm: &[DVec3],
+    max_iterations: usize,
+) -> f64 {
+    let Some(init) = fit_rigid(probe_lm, target_lm, None) else {
+        return f64::NAN;
+    };
+    let Ok(res) = icp_to_target(target, probe, None, init, &trimmed_icp(max_iterations)) else {
+        return f64::NAN;
+    };
+    rms_to_surface(target, probe, &res.motion)
 }
 
 /// Root mean square distance of the `points` moved by `motion` to the surface of `target`
@@ -196,6 +235,22 @@ pub fn dist<A: Keyed + ?Sized, B: Keyed + ?Sized>(a: &A, b: &B) -> Result<f64, S
     let (kb, pb) = b.unambiguous();
     shapedist::keyed_distance(&ka, &pa, &kb, &pb, &shapedist::KeyedOptions::default())
         .map(|k| k.distance)
+}
+
+/// Perturbation radii of the reference-point error grid (figures 9-11), in percent of D.
+pub const RADII_PCT: [f64; 5] = [1.0, 2.0, 3.0, 4.0, 5.0];
+/// Directions of the reference-point error grid (evenly spaced angles).
+pub const N_DIRS: usize = 8;
+
+/// The cells `(radius in % of D, angle in radians)` of the reference-point error grid: every
+/// radius of [`RADII_PCT`] with each of the [`N_DIRS`] directions, radius by radius.
+pub fn error_grid() -> Vec<(f64, f64)> {
+    RADII_PCT
+        .iter()
+        .flat_map(|&p| {
+            (0..N_DIRS).map(move |k| (p, std::f64::consts::TAU * k as f64 / N_DIRS as f64))
+        })
+        .collect()
 }
 
 /// Moves vertex `v` by `radius` along a straightest geodesic leaving at angle `theta` from the

@@ -2,9 +2,9 @@
 
 use super::pole::Figure15;
 use super::stats::{matrix_rows, max, mean, min, Sep, SepColumn};
-use super::{Args, Failures, MethodResults, N_DIRS, RADII_PCT};
-use crate::experiments::pipeline::{DescriptorRule, MethodUse};
-use crate::experiments::report::{f4, line_plot, Report, Series};
+use super::{Args, Failures, MethodResults};
+use crate::pipeline::{DescriptorRule, MethodUse, N_DIRS, RADII_PCT};
+use crate::report::{f4, joined, line_plot, Report, Series};
 use anyhow::Result;
 use facemodel::Face;
 use std::path::Path;
@@ -67,6 +67,18 @@ fn matrix_figure(
     )?;
     rep.figure(&fname, caption);
     Ok(())
+}
+
+impl Input<'_> {
+    /// A row of a separation table ([`sep_table`]): the method, the matrix's `label` and the
+    /// [`Sep`] of the matrix `m`.
+    fn sep_row(&self, method: &str, label: &str, m: &[Vec<f64>]) -> (String, String, Sep) {
+        (
+            method.to_string(),
+            label.to_string(),
+            Sep::of(m, self.faces, self.test),
+        )
+    }
 }
 
 /// A separation table (Markdown and the CSV `file`): the two `lead` columns of each row, then
@@ -190,13 +202,7 @@ fn introduction(rep: &mut Report, inp: &Input<'_>, failures: &Failures) {
         }
     }
     rep.heading(2, "What was available");
-    rep.para(
-        &notes
-            .iter()
-            .map(|s| format!("- {s}"))
-            .collect::<Vec<_>>()
-            .join("\n"),
-    );
+    rep.list(&notes);
 }
 
 /// Reference distances and point counts per face.
@@ -319,11 +325,7 @@ fn resolution(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
                 &format!("pairwise distances, {label}, N = {n} ({})", res.name),
                 &format!("12 x 12 matrix, {label} ({})", res.name),
             )?;
-            sep_rows.push((
-                res.name.clone(),
-                label.to_string(),
-                Sep::of(m, inp.faces, inp.test),
-            ));
+            sep_rows.push(inp.sep_row(&res.name, label, m));
         }
     }
     rep.para("Separation: the largest distance between two inp.faces of the same person, the smallest between inp.faces of different persons, and their ratio (> 1 means every same-person pair is closer than every different-person pair). 'Test row' restricts this to the pairs involving the neutral inp.test face, which is what the paper's figure 6 shows.");
@@ -341,7 +343,7 @@ fn robustness(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
     let n = inp.n;
     // 3. Robustness.
     rep.heading(2, "3. Robustness to reference-point errors (figures 9-13)");
-    rep.para(&format!("The left outer eye corner q of `{}` is moved along a straightest geodesic of length {}% of D, leaving at angle theta from the direction towards r (counter-clockwise about the outward normal); its distance field is recomputed from the moved surface point, D is recomputed, and the static descriptor at N = {n} is compared with the original one.", inp.faces[inp.test].name, RADII_PCT.iter().map(|p| format!("{p}")).collect::<Vec<_>>().join(", ")));
+    rep.para(&format!("The left outer eye corner q of `{}` is moved along a straightest geodesic of length {}% of D, leaving at angle theta from the direction towards r (counter-clockwise about the outward normal); its distance field is recomputed from the moved surface point, D is recomputed, and the static descriptor at N = {n} is compared with the original one.", inp.faces[inp.test].name, joined(RADII_PCT, ", ", |p| format!("{p}"))));
     for res in inp.results {
         rep.para(&format!("{}: {} of {} corner walks and {} nose-tip walks met the mesh boundary (the eye opening) before the full radius; those cells are left out (blank in the plots, NaN in the CSV).", res.name, res.truncated.0, RADII_PCT.len() * N_DIRS, res.truncated.1));
         let series: Vec<Series> = RADII_PCT
@@ -497,11 +499,7 @@ fn random_errors(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
                 &format!("{label}, static area, N = {n} ({})", res.name),
                 &format!("{label} ({})", res.name),
             )?;
-            rows.push((
-                res.name.clone(),
-                label.to_string(),
-                Sep::of(m, inp.faces, inp.test),
-            ));
+            rows.push(inp.sep_row(&res.name, label, m));
         }
     }
     use SepColumn::*;
@@ -561,11 +559,7 @@ fn single_pole(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
                 let title = format!("{label} ({})", res.name);
                 matrix_figure(rep, inp, m, (file, &res.name), &title, &title)?;
             }
-            rows.push((
-                res.name.clone(),
-                label.to_string(),
-                Sep::of(m, inp.faces, inp.test),
-            ));
+            rows.push(inp.sep_row(&res.name, label, m));
         }
         let gb: Vec<f64> = res.grid_bip.iter().map(|g| g.2).collect();
         let gp: Vec<f64> = res.grid_pol.iter().map(|g| g.2).collect();

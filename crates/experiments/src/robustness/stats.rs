@@ -1,6 +1,6 @@
 //! Separation figures and finite-value reductions of distance matrices and rows.
 
-use crate::experiments::report::f4;
+use crate::report::f4;
 use facemodel::Face;
 
 /// Separation figures of a distance matrix.
@@ -159,7 +159,7 @@ mod tests {
             name: name.into(),
             person: name.split('_').next().unwrap().into(),
             expression: String::new(),
-            mesh: crate::experiments::walk::tests::plane(1, 0.0, 0),
+            mesh: crate::walk::tests::plane(1, 0.0, 0),
             landmarks: facemodel::FaceLandmarks::ground_truth(),
         };
         let faces = vec![mk("a_n"), mk("a_x"), mk("b_n"), mk("c_n")];

@@ -16,10 +16,10 @@ mod random;
 mod report;
 pub(crate) mod stats;
 
-use crate::experiments::pipeline::{bipolar, dist, resolve_methods, DescriptorRule, Refs, Region};
-use crate::experiments::polar::PolarOptions;
-use crate::experiments::walk::Walker;
 use crate::paths::{FaceSetArgs, ResolutionArgs};
+use crate::pipeline::{bipolar, dist, resolve_methods, DescriptorRule, Refs, Region};
+use crate::polar::PolarOptions;
+use crate::walk::Walker;
 use anyhow::{bail, Result};
 use bipolar::PolarDescriptor;
 use facemodel::Face;
@@ -53,10 +53,6 @@ pub struct Args {
 
 /// Resolutions of the sweeps (levels between the references).
 const RESOLUTIONS: [u32; 9] = [3, 4, 5, 6, 8, 10, 12, 15, 20];
-/// Perturbation radii in percent of the corner-to-corner geodesic.
-const RADII_PCT: [f64; 5] = [1.0, 2.0, 3.0, 4.0, 5.0];
-/// Number of perturbation directions.
-const N_DIRS: usize = 8;
 
 /// A face descriptor, `None` where `bipolar` refused it (the refusal is in [`Failures`]).
 type Desc = Option<bipolar::Descriptor>;
@@ -291,10 +287,7 @@ struct Prepared {
 }
 
 fn prepare(ctx: &Ctx<'_>) -> Result<Prepared> {
-    let pb = crate::experiments::pipeline::bar(
-        ctx.faces.len(),
-        &format!("{}: base fields", ctx.mname()),
-    );
+    let pb = crate::pipeline::bar(ctx.faces.len(), &format!("{}: base fields", ctx.mname()));
     let prepared: Vec<(Box<dyn GeodesicSolver>, Refs, Vec<f64>)> = ctx
         .faces
         .par_iter()
@@ -339,11 +332,11 @@ fn run_method(ctx: &Ctx<'_>, out: &Path) -> Result<MethodResults> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::experiments::pipeline::{field_at, perturb};
+    use crate::pipeline::{field_at, perturb};
 
     #[test]
     fn perturbation_moves_by_the_radius_on_a_plane() {
-        let m = crate::experiments::walk::tests::plane(20, 0.2, 5);
+        let m = crate::walk::tests::plane(20, 0.2, 5);
         let w = Walker::new(&m);
         let v = 10 * 21 + 10;
         let p = m.position(v);

@@ -2,11 +2,9 @@
 //! ICT face model (random identities, expressions and rigid motions), against the model's
 //! landmark vertices.
 
-use crate::experiments::pipeline::bar;
-use crate::experiments::scans::{
-    sample_weights, scan_faces, scan_seed, FaceSpec, ScanArgs, ScanSetOptions,
-};
 use crate::paths::ModelArgs;
+use crate::pipeline::bar;
+use crate::scans::{sample_weights, scan_faces, scan_seed, FaceSpec, ScanArgs, ScanSetOptions};
 use anyhow::{Context, Result};
 use facemodel::{FaceModel, LANDMARK_NAMES};
 use indicatif::{ProgressBar, ProgressStyle};

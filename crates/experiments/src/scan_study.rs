@@ -15,18 +15,17 @@
 //! Only composes the libraries; deterministic (the scanner's seeds, rayon results collected in
 //! input order).
 
-use crate::experiments::pipeline::{bar, dist};
-use crate::experiments::polar::{polar_descriptor, PolarOptions, Pole};
 use crate::paths::{FaceSetArgs, ResolutionArgs};
+use crate::pipeline::{bar, dist, landmark_icp_rms};
+use crate::polar::{polar_descriptor, PolarOptions, Pole};
+use crate::report::joined;
 use anyhow::{bail, Context, Result};
 use facemodel::{face_frame, load_face_set, static_mask, Face};
 use geodesic::{Method, SolveOptions, Source};
-use meshcore::linalg::fit_rigid;
 use meshcore::{DVec3, FaceLocator, SurfacePoint, TriMesh};
 use rangescan::{Artifacts, DepthNoise, HeadPose, Quantisation, ScanOptions};
 use rayon::prelude::*;
 use scanprep::{CleanOptions, Crop, Input};
-use shapedist::{icp_to_target, Convergence, IcpLoopOptions, IcpVariant, TrimRounding};
 use std::fmt::Write as _;
 use std::time::Instant;
 
@@ -242,7 +241,7 @@ fn snap(
 }
 
 fn field_at(mesh: &TriMesh, u: &[f64], sp: &SurfacePoint) -> f64 {
-    crate::experiments::pipeline::field_at(mesh, u, sp)
+    crate::pipeline::field_at(mesh, u, sp)
 }
 
 fn describe_scan(face: &Face, setting: &Setting, args: &Args) -> Result<Described> {
@@ -348,26 +347,10 @@ fn describe_scan(face: &Face, setting: &Setting, args: &Args) -> Result<Describe
 }
 
 /// ICP of `a`'s probe points onto `b`'s surface from the landmark alignment: RMS closest-point
-/// distance (mm) over all probe points at the final pose (point-to-point, 10 % trimmed, at most
-/// 10 iterations).
+/// distance (mm) over all probe points at the final pose (`pipeline::landmark_icp_rms`, at
+/// most 10 iterations).
 fn icp_score(a: &Described, b: &Described, b_loc: &FaceLocator<'_>) -> f64 {
-    let Some(init) = fit_rigid(&a.landmarks, &b.landmarks, None) else {
-        return f64::NAN;
-    };
-    let opts = IcpLoopOptions {
-        variant: IcpVariant::PointToPoint,
-        max_iterations: 10,
-        translation: true,
-        trim: 0.1,
-        trim_rounding: TrimRounding::Down,
-        convergence: Convergence::RelativeRmseAfterStep { tolerance: 1e-6 },
-        evaluate_final: false,
-        ..IcpLoopOptions::default()
-    };
-    let Ok(res) = icp_to_target(b_loc, &a.icp_probe, None, init, &opts) else {
-        return f64::NAN;
-    };
-    crate::experiments::pipeline::rms_to_surface(b_loc, &a.icp_probe, &res.motion)
+    landmark_icp_rms(&a.icp_probe, &a.landmarks, b_loc, &b.landmarks, 10)
 }
 
 /// Fraction of a descriptor's points whose key is ambiguous (NaN when refused).
@@ -401,12 +384,33 @@ impl Relation {
 /// A bipolar descriptor variant of the study: the library's options by name.
 struct Variant {
     name: &'static str,
-    options: fn() -> bipolar::DescriptorOptions,
+    /// `None`: rule `All`; else the iso-angle rule with these crossings and repeats.
+    isoangle: Option<(bipolar::IsoCrossings, bipolar::IsoRepeats)>,
+    /// Band along the scan's boundary left out (`DescriptorOptions::boundary_margin`, mm).
+    margin_mm: Option<f64>,
 }
 
 impl Variant {
     fn options(&self) -> bipolar::DescriptorOptions {
-        (self.options)()
+        let opts = match self.isoangle {
+            None => bipolar::DescriptorOptions {
+                rule: bipolar::SelectionRule::All,
+                ..Default::default()
+            },
+            Some((crossings, repeats)) => bipolar::DescriptorOptions {
+                rule: bipolar::SelectionRule::IsoAngle,
+                isoangle: bipolar::IsoAngleOptions {
+                    crossings,
+                    repeats,
+                    ..Default::default()
+                },
+                ..Default::default()
+            },
+        };
+        bipolar::DescriptorOptions {
+            boundary_margin: self.margin_mm,
+            ..opts
+        }
     }
 }
 
@@ -416,59 +420,36 @@ impl Variant {
 /// geodesic between the references (the library's default); and rule `All` without the 6 mm
 /// band along the holes and the border of each scan (the scans' choice in the recognition
 /// benchmark).
-const VARIANTS: [Variant; 5] = [
-    Variant {
-        name: "bipolar All",
-        options: || bipolar::DescriptorOptions {
-            rule: bipolar::SelectionRule::All,
-            ..Default::default()
+const VARIANTS: [Variant; 5] = {
+    use bipolar::{IsoCrossings::*, IsoRepeats::*};
+    [
+        Variant {
+            name: "bipolar All",
+            isoangle: None,
+            margin_mm: None,
         },
-    },
-    Variant {
-        name: "bipolar iso-angle, every crossing",
-        options: || bipolar::DescriptorOptions {
-            rule: bipolar::SelectionRule::IsoAngle,
-            isoangle: bipolar::IsoAngleOptions {
-                crossings: bipolar::IsoCrossings::Every,
-                repeats: bipolar::IsoRepeats::Ambiguous,
-                ..Default::default()
-            },
-            ..Default::default()
+        Variant {
+            name: "bipolar iso-angle, every crossing",
+            isoangle: Some((Every, Ambiguous)),
+            margin_mm: None,
         },
-    },
-    Variant {
-        name: "bipolar iso-angle, monotone, repeats ambiguous",
-        options: || bipolar::DescriptorOptions {
-            rule: bipolar::SelectionRule::IsoAngle,
-            isoangle: bipolar::IsoAngleOptions {
-                crossings: bipolar::IsoCrossings::Monotone,
-                repeats: bipolar::IsoRepeats::Ambiguous,
-                ..Default::default()
-            },
-            ..Default::default()
+        Variant {
+            name: "bipolar iso-angle, monotone, repeats ambiguous",
+            isoangle: Some((Monotone, Ambiguous)),
+            margin_mm: None,
         },
-    },
-    Variant {
-        name: "bipolar iso-angle, monotone, nearest",
-        options: || bipolar::DescriptorOptions {
-            rule: bipolar::SelectionRule::IsoAngle,
-            isoangle: bipolar::IsoAngleOptions {
-                crossings: bipolar::IsoCrossings::Monotone,
-                repeats: bipolar::IsoRepeats::Nearest,
-                ..Default::default()
-            },
-            ..Default::default()
+        Variant {
+            name: "bipolar iso-angle, monotone, nearest",
+            isoangle: Some((Monotone, Nearest)),
+            margin_mm: None,
         },
-    },
-    Variant {
-        name: "bipolar All, 6 mm band left out",
-        options: || bipolar::DescriptorOptions {
-            rule: bipolar::SelectionRule::All,
-            boundary_margin: Some(6.0),
-            ..Default::default()
+        Variant {
+            name: "bipolar All, 6 mm band left out",
+            isoangle: None,
+            margin_mm: Some(6.0),
         },
-    },
-];
+    ]
+};
 
 /// Names of the distances: the bipolar variants, then the single pole and ICP.
 fn methods() -> Vec<&'static str> {
@@ -693,7 +674,7 @@ fn write_outputs(
             .as_ref()
             .map_or("paper-set".to_string(), |p| p.display().to_string()),
         sets.len(),
-        sets.iter().map(|s| s.name).collect::<Vec<_>>().join(", "),
+        joined(sets, ", ", |s| s.name.to_string()),
         args.landmark_tolerance_mm,
         args.res.levels,
         args.res.sectors,
@@ -853,20 +834,18 @@ fn write_outputs(
     let _ = writeln!(
         md,
         "| setting | mean edge mm | {} | polar points |",
-        VARIANTS
-            .iter()
-            .map(|v| format!("{}: ambiguous median / max (points)", v.name))
-            .collect::<Vec<_>>()
-            .join(" | ")
+        joined(&VARIANTS, " | ", |v| format!(
+            "{}: ambiguous median / max (points)",
+            v.name
+        ))
     );
     let _ = writeln!(md, "|---|---|{}---|", "---|".repeat(VARIANTS.len()));
     let mut csv = format!(
         "setting,{}\n",
-        VARIANTS
-            .iter()
-            .map(|v| format!("ambiguous median {0},ambiguous max {0}", v.name))
-            .collect::<Vec<_>>()
-            .join(",")
+        joined(&VARIANTS, ",", |v| format!(
+            "ambiguous median {0},ambiguous max {0}",
+            v.name
+        ))
     );
     for (si, s) in sets.iter().enumerate() {
         let ds: Vec<&Described> = scans

@@ -14,10 +14,7 @@ use landmarks::{DetectOptions, GenericModel, LandmarkName, Landmarks};
 use meshcore::{DVec3, TriMesh};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use rangescan::{
-    Artifacts, DepthNoise, GrazingDropout, HeadPose, Holes, Outliers, Quantisation, ScanOptions,
-    Spikes, Visibility,
-};
+use rangescan::{Artifacts, DepthNoise, HeadPose, Quantisation, ScanOptions, Visibility};
 use rayon::prelude::*;
 use scanprep::{CleanOptions, Crop, Input};
 use std::time::{Duration, Instant};
@@ -55,37 +52,10 @@ impl ScanSettings {
             quantisation: (self.quantisation_mm > 0.0).then_some(Quantisation {
                 step_mm: self.quantisation_mm,
             }),
-            spikes: if self.spikes {
-                sl.spikes.or(Some(Spikes {
-                    fraction: 0.001,
-                    min_mm: 2.0,
-                    max_mm: 10.0,
-                }))
-            } else {
-                None
-            },
-            outliers: if self.spikes {
-                sl.outliers.or(Some(Outliers { count: 50 }))
-            } else {
-                None
-            },
-            grazing: if self.holes {
-                sl.grazing.or(Some(GrazingDropout {
-                    start_deg: 70.0,
-                    full_deg: 80.0,
-                }))
-            } else {
-                None
-            },
-            holes: if self.holes {
-                sl.holes.or(Some(Holes {
-                    count: 4,
-                    min_radius_mm: 1.0,
-                    max_radius_mm: 4.0,
-                }))
-            } else {
-                None
-            },
+            spikes: sl.spikes.filter(|_| self.spikes),
+            outliers: sl.outliers.filter(|_| self.spikes),
+            grazing: sl.grazing.filter(|_| self.holes),
+            holes: sl.holes.filter(|_| self.holes),
             border: None,
         }
     }

@@ -3,16 +3,16 @@
 //! the single-pole matrix).
 
 use super::{eye_mid, n_keys, Ctx, Desc, MethodResults, Prepared, RESOLUTIONS};
-use crate::experiments::pipeline::{bar, Region};
-use crate::experiments::polar::{polar_descriptor, Pole};
-use crate::experiments::report::markers;
-use anyhow::{Context, Result};
+use crate::pipeline::{bar, Region};
+use crate::polar::{polar_descriptor, Pole};
+use crate::report::{markers, polylines, render_face as render};
+use anyhow::Result;
 use bipolar::PolarDescriptor;
 use facemodel::static_mask;
 use meshcore::{DVec3, Topology, TriMesh};
 use rayon::prelude::*;
 use std::path::Path;
-use viz::{Polyline, Scene, View};
+use viz::{Polyline, Scene};
 
 /// The descriptors the later parts compare against.
 pub(super) struct Base {
@@ -41,12 +41,6 @@ fn positions(d: &Desc) -> Vec<DVec3> {
         .unwrap_or_default()
 }
 
-/// Renders a scene seen from the front of the face frame (looking along -forward) as SVG.
-pub(super) fn render(path: &Path, scene: &Scene<'_>, up: DVec3, forward: DVec3) -> Result<()> {
-    viz::render_to_file(path, scene, &View::new(-forward, up), 560, 640)
-        .with_context(|| format!("rendering {}", path.display()))
-}
-
 /// Level curves of `u` at `levels` (`levelcurves`), as polylines of one colour.
 fn curves(
     mesh: &TriMesh,
@@ -55,16 +49,14 @@ fn curves(
     levels: &[f64],
     color: [u8; 3],
 ) -> Result<Vec<Polyline>> {
-    Ok(levelcurves::isolines(mesh, topo, u, levels)?
-        .into_iter()
-        .flatten()
-        .map(|c| Polyline {
-            points: c.points,
-            closed: c.closed,
-            color,
-            width: 1.1,
-        })
-        .collect())
+    let lines = levelcurves::isolines(mesh, topo, u, levels)?;
+    Ok(polylines(
+        lines
+            .into_iter()
+            .flatten()
+            .map(|c| (c.points, c.closed, color)),
+        1.1,
+    ))
 }
 
 /// Figures 4 and 5 on the test face: level curves at 5, 10 and 30 levels between the corners

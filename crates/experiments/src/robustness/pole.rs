@@ -1,12 +1,11 @@
 //! Figure 15: rotating some polar rings of the test face individually keeps every per-ring
 //! distance ~0 while the global distance becomes large.
 
-use super::base::render;
 use super::Args;
-use crate::experiments::pipeline::{dist, field};
-use crate::experiments::polar::{polar_descriptor, PolarOptions, Pole};
-use crate::experiments::report::markers;
-use crate::experiments::walk::Walker;
+use crate::pipeline::{dist, field};
+use crate::polar::{polar_descriptor, PolarOptions, Pole};
+use crate::report::{markers, render_face};
+use crate::walk::Walker;
 use anyhow::Result;
 use bipolar::PolarDescriptor;
 use facemodel::{face_frame, Face, FaceFrame};
@@ -134,7 +133,7 @@ pub(super) fn figure15(
     let mut scene = Scene::new(&faces[test].mesh);
     scene.points = markers(s.positions(), [0x24, 0x71, 0xa3], 2.2);
     scene.points.extend(markers(moved, [0xc0, 0x39, 0x2b], 2.6));
-    render(&out.join("figure15.svg"), &scene, frame.up, frame.forward)?;
+    render_face(&out.join("figure15.svg"), &scene, frame.up, frame.forward)?;
     Ok(Figure15 {
         other,
         per_ring,

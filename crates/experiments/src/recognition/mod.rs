@@ -13,18 +13,18 @@
 
 mod scans;
 
-use crate::experiments::curves::{
+use crate::curves::{
     facial_curves, facial_distance, iso_curves, iso_distance_from, iso_point_set,
     reference_iso_levels,
 };
-use crate::experiments::pipeline::{
+use crate::paths::{ModelArgs, ResolutionArgs};
+use crate::pipeline::{
     bar, bipolar, dist, resolve_methods, single_thread, DescriptorRule, Refs, Region,
 };
-use crate::experiments::polar::{self, polar_descriptor, PolarOptions, Pole};
-use crate::experiments::report::{f4, line_plot, Report, Series};
-use crate::experiments::scans::ScanArgs;
-use crate::experiments::walk::Walker;
-use crate::paths::{ModelArgs, ResolutionArgs};
+use crate::polar::{self, polar_descriptor, PolarOptions, Pole};
+use crate::report::{f4, line_plot, Report, Series};
+use crate::scans::ScanArgs;
+use crate::walk::Walker;
 use anyhow::{bail, Context, Result};
 use bipolar::PolarDescriptor;
 use facecurves::{ElasticOptions, FacialCurvesDescriptor, IsoLevels};
@@ -35,10 +35,7 @@ use meshcore::{DVec3, FaceLocator, Surface, TriMesh};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
-use shapedist::{
-    icp_to_target, Convergence, IcpLoopOptions, IcpOptions, IcpVariant, PreparedSet, TrimRounding,
-    Which,
-};
+use shapedist::{IcpOptions, IcpVariant, PreparedSet, Which};
 use std::time::Instant;
 
 /// Arguments of `cargo xtask recognition`.
@@ -407,39 +404,19 @@ fn eer_roc(gen: &[f64], imp: &[f64]) -> (f64, Vec<(f64, f64)>) {
     (eer, roc)
 }
 
-/// The recognition ICP: point-to-point with translation onto the closest surface points,
-/// the worst 10 % of pairs trimmed (kept count rounded down), at most 6 iterations, stop
-/// after a step when the trimmed RMS changed by at most `1e-6` relative.
-fn icp_options() -> IcpLoopOptions {
-    IcpLoopOptions {
-        variant: IcpVariant::PointToPoint,
-        max_iterations: 6,
-        translation: true,
-        trim: 0.1,
-        trim_rounding: TrimRounding::Down,
-        convergence: Convergence::RelativeRmseAfterStep { tolerance: 1e-6 },
-        evaluate_final: false,
-        ..IcpLoopOptions::default()
-    }
-}
+/// Iterations of the recognition ICP ([`crate::pipeline::trimmed_icp`]).
+const ICP_ITERATIONS: usize = 6;
 
-/// ICP of the probe points onto the gallery surface ([`shapedist::icp_to_target`] on the
-/// [`FaceLocator`], options [`icp_options`]), started from the landmark alignment; returns
-/// the RMS closest-point distance of all probe points at the final pose (cm), NaN when a
-/// step fails.
+/// ICP of the probe points onto the gallery surface, started from the landmark alignment
+/// ([`crate::pipeline::landmark_icp_rms`]); returns the RMS closest-point distance of all probe
+/// points at the final pose (cm), NaN when a step fails.
 fn icp_score(
     probe: &[DVec3],
     probe_lm: &[DVec3; 3],
     gallery: &FaceLocator<'_>,
     gallery_lm: &[DVec3; 3],
 ) -> f64 {
-    let Some(init) = fit_rigid(probe_lm, gallery_lm, None) else {
-        return f64::NAN;
-    };
-    let Ok(res) = icp_to_target(gallery, probe, None, init, &icp_options()) else {
-        return f64::NAN;
-    };
-    crate::experiments::pipeline::rms_to_surface(gallery, probe, &res.motion)
+    crate::pipeline::landmark_icp_rms(probe, probe_lm, gallery, gallery_lm, ICP_ITERATIONS)
 }
 
 /// About `n` vertices of a probe for ICP, evenly strided.
@@ -680,6 +657,43 @@ fn results_table(rep: &mut Report, all: &[Metrics], csv: &str) -> Result<()> {
     rep.csv(csv, &hdr, &rows)
 }
 
+/// Writes `summary.json` into `out` and prints the results ([`print_results`]). The summary
+/// holds the settings both benchmarks share (`sampled`: identities, faces per identity, gallery
+/// and probe faces; the seed, the geodesic method, the resolution and the curve settings), the
+/// task's own `fields` and the `results`.
+fn write_summary(
+    out: &std::path::Path,
+    args: &Args,
+    sampled: [usize; 4],
+    method: geodesic::Method,
+    fields: serde_json::Value,
+    results: &[Metrics],
+) -> Result<()> {
+    let [identities, expressions, gallery, probes] = sampled;
+    let mut summary = serde_json::json!({
+        "identities": identities,
+        "faces_per_identity": expressions,
+        "seed": args.seed,
+        "gallery": gallery,
+        "probes": probes,
+        "geodesic_method": method.name(),
+        "levels": args.res.levels,
+        "sectors": args.res.sectors,
+        "iso_levels": args.iso_levels,
+        "curve_samples": args.curve_samples,
+        "results": results,
+    });
+    if let (Some(s), serde_json::Value::Object(f)) = (summary.as_object_mut(), fields) {
+        s.extend(f);
+    }
+    std::fs::write(
+        out.join("summary.json"),
+        serde_json::to_string_pretty(&summary)?,
+    )?;
+    print_results(results);
+    Ok(())
+}
+
 /// One line per result on stderr (the end of a run).
 fn print_results(all: &[Metrics]) {
     for m in all {
@@ -896,28 +910,14 @@ pub fn run(args: Args) -> Result<()> {
     let secs = t0.elapsed().as_secs_f64();
     rep.para(&format!("Run time: {secs:.1} s."));
     rep.finish()?;
-    let summary = serde_json::json!({
-        "identities": identities,
-        "faces_per_identity": expressions,
-        "seed": args.seed,
-        "gallery": gallery.len(),
-        "probes": probes.len(),
-        "geodesic_method": method.name(),
+    let fields = serde_json::json!({
         "geodesic_note": method_note,
-        "levels": args.res.levels,
-        "sectors": args.res.sectors,
-        "iso_levels": args.iso_levels,
-        "curve_samples": args.curve_samples,
         "landmark_detection": { "detected": n_det, "faces": samples.len(), "mean_error_cm": { "right_eye_outer": mean_err(0), "left_eye_outer": mean_err(1), "nose_tip": mean_err(2) } },
-        "results": all,
         "roc_plot": "roc.svg",
         "seconds": secs,
     });
-    std::fs::write(
-        out.join("summary.json"),
-        serde_json::to_string_pretty(&summary)?,
-    )?;
-    print_results(&all);
+    let sampled = [identities, expressions, gallery.len(), probes.len()];
+    write_summary(&out, &args, sampled, method, fields, &all)?;
     eprintln!("{secs:.1} s wall");
     println!("{}", out.display());
     Ok(())

@@ -38,6 +38,12 @@ impl Report {
         let _ = write!(self.md, "{}\n\n", text.trim_end());
     }
 
+    /// Appends a bulleted list, one item per line.
+    pub fn list<T: std::fmt::Display>(&mut self, items: &[T]) {
+        let text: String = items.iter().map(|s| format!("- {s}\n")).collect();
+        self.para(&text);
+    }
+
     /// Appends an embedded figure (file relative to the report folder).
     pub fn figure(&mut self, file: &str, caption: &str) {
         let _ = write!(self.md, "![{caption}]({file})\n\n*{caption}*\n\n");
@@ -114,6 +120,15 @@ pub fn f4(x: f64) -> String {
     }
 }
 
+/// `items` formatted by `f` and separated by `sep`.
+pub fn joined<T>(
+    items: impl IntoIterator<Item = T>,
+    sep: &str,
+    f: impl FnMut(T) -> String,
+) -> String {
+    items.into_iter().map(f).collect::<Vec<_>>().join(sep)
+}
+
 pub use viz::Series;
 
 /// Markers of one colour and radius at `points`.
@@ -130,6 +145,34 @@ pub fn markers(
             radius,
         })
         .collect()
+}
+
+/// Polylines of one width through `curves` (`(points, closed, colour)` each).
+pub fn polylines(
+    curves: impl IntoIterator<Item = (Vec<meshcore::DVec3>, bool, [u8; 3])>,
+    width: f64,
+) -> Vec<viz::Polyline> {
+    curves
+        .into_iter()
+        .map(|(points, closed, color)| viz::Polyline {
+            points,
+            closed,
+            color,
+            width,
+        })
+        .collect()
+}
+
+/// Renders a scene of a face seen from the front of its frame (looking along -`forward`),
+/// 560 x 640 pixels, into `path` (SVG or PNG by the extension).
+pub fn render_face(
+    path: &Path,
+    scene: &viz::Scene<'_>,
+    up: meshcore::DVec3,
+    forward: meshcore::DVec3,
+) -> Result<()> {
+    viz::render_to_file(path, scene, &viz::View::new(-forward, up), 560, 640)
+        .with_context(|| format!("rendering {}", path.display()))
 }
 
 /// A line plot drawn by `viz` (SVG or PNG by the extension of `path`).

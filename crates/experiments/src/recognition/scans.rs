@@ -9,16 +9,14 @@
 //! the scan, a descriptor error) is listed with the face's name and counted, never replaced.
 
 use super::{
-    describe_face, elastic_options, icp_points, iso_levels_of, median, order_stat, print_results,
-    results_table, roc_figure, score_row, summarize, time_comparisons, time_descriptions,
-    timed_pairs, Args, DescribeOptions, Described, Lm, Metrics, Row, TIMED_FACES,
+    describe_face, elastic_options, icp_points, iso_levels_of, median, order_stat, results_table,
+    roc_figure, score_row, summarize, time_comparisons, time_descriptions, timed_pairs,
+    write_summary, Args, DescribeOptions, Described, Lm, Metrics, Row, TIMED_FACES,
 };
-use crate::experiments::pipeline::{bar, resolve_methods};
-use crate::experiments::report::{line_plot, Report, Series};
-use crate::experiments::scans::{
-    sample_weights, scan_face, scan_seed, FaceSpec, ScanSetOptions, ScanSettings,
-};
-use crate::experiments::walk::Walker;
+use crate::pipeline::{bar, resolve_methods};
+use crate::report::{line_plot, Report, Series};
+use crate::scans::{sample_weights, scan_face, scan_seed, FaceSpec, ScanSetOptions, ScanSettings};
+use crate::walk::Walker;
 use anyhow::{bail, Context, Result};
 use facecurves::ElasticOptions;
 use facemodel::FaceModel;
@@ -557,21 +555,10 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
     rep.png_twins()?;
     rep.para(&format!("Run time: {secs:.1} s wall."));
     rep.finish()?;
-    let summary = serde_json::json!({
-        "identities": identities,
-        "faces_per_identity": expressions,
-        "seed": args.seed,
+    let fields = serde_json::json!({
         "gallery_scan": base.label(),
-        "gallery": gallery.len(),
-        "probes": probes.len(),
         "sweep_identities": sweep_ids,
-        "geodesic_method": method.name(),
-        "levels": args.res.levels,
-        "sectors": args.res.sectors,
-        "iso_levels": args.iso_levels,
-        "curve_samples": args.curve_samples,
         "scan_edge_mm": scan_opts.target_edge_mm,
-        "results": main,
         "sweeps": sweep_defs.iter().zip(&sweep_results).map(|(sw, pv)| serde_json::json!({
             "name": sw.name,
             "unit": sw.unit,
@@ -582,11 +569,8 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         "scans": everyone.len(),
         "seconds": secs,
     });
-    std::fs::write(
-        out.join("summary.json"),
-        serde_json::to_string_pretty(&summary)?,
-    )?;
-    print_results(&main);
+    let sampled = [identities, expressions, gallery.len(), probes.len()];
+    write_summary(&out, args, sampled, method, fields, &main)?;
     eprintln!("{} failures; {secs:.1} s wall", fails.len());
     println!("{}", out.display());
     Ok(())

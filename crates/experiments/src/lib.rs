@@ -1,16 +1,28 @@
-//! Shared pieces of `cargo xtask robustness`, `recognition` and `section6`: the single-pole
-//! descriptor, the curve representations of section 6 (`curves`), the pipeline glue around
-//! `bipolar` and `shapedist`, and report writing. Straightest geodesics are
-//! `geodesic::straightest`, the single-pole descriptor is `bipolar::polar`; face-set loading,
-//! the face frame and the static-area mask are in the `facemodel` crate.
+//! The experiments of the bipolar workspace, run as `cargo xtask <task>`: one module per task
+//! (`sphere_validate`, `robustness`, `recognition`, `landmarks_eval`, `scan_study`, `scan_path`,
+//! `section6`), each with its clap `Args` and a `run` function. They compose the libraries'
+//! public APIs; the pieces several tasks share are the curve representations of section 6
+//! (`curves`), the pipeline glue around `bipolar` and `shapedist` (`pipeline`), the range-scan
+//! sets (`scans`), report writing (`report`) and the default paths (`paths`). Straightest
+//! geodesics are `geodesic::straightest`, the single-pole descriptor is `bipolar::polar`;
+//! face-set loading, the face frame and the static-area mask are in the `facemodel` crate.
 
-pub mod curves;
-pub mod pipeline;
-pub mod report;
-pub mod scans;
+pub mod landmarks_eval;
+pub mod recognition;
+pub mod robustness;
+pub mod scan_path;
+pub mod scan_study;
+pub mod section6;
+pub mod sphere_validate;
+
+mod curves;
+mod paths;
+mod pipeline;
+mod report;
+mod scans;
 
 /// Straightest geodesics: the library's walker (`geodesic::straightest`).
-pub mod walk {
+mod walk {
     pub use geodesic::straightest::Walker;
 
     #[cfg(test)]
@@ -25,7 +37,7 @@ pub mod walk {
 }
 
 /// The single-pole descriptor of `bipolar::polar`.
-pub mod polar {
+mod polar {
     use anyhow::Result;
     use bipolar::{BipolarError, PolarDescriptor};
     use geodesic::Walker;

@@ -27,13 +27,18 @@ fn or_exit(r: Result<PathBuf, facemodel::FaceModelError>) -> PathBuf {
 pub fn default_out_dir(name: &str) -> PathBuf {
     let target = match std::env::var_os("CARGO_TARGET_DIR") {
         Some(p) if !p.is_empty() => PathBuf::from(p),
-        _ => Path::new(env!("CARGO_MANIFEST_DIR"))
-            .parent()
-            .map(Path::to_path_buf)
-            .unwrap_or_else(|| PathBuf::from("."))
-            .join("target"),
+        _ => workspace_root().join("target"),
     };
     target.join(name)
+}
+
+/// The workspace root: two levels above this crate's manifest (`crates/experiments`).
+fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .ancestors()
+        .nth(2)
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| PathBuf::from("."))
 }
 
 /// `--faces` and `--out` of the tasks that read a face set.

@@ -4,9 +4,9 @@
 
 use super::base::Base;
 use super::stats::{max, mean, min};
-use super::{eye_mid, Ctx, MethodResults, Prepared, N_DIRS, RADII_PCT, RESOLUTIONS};
-use crate::experiments::pipeline::{bar, field, field_at, perturb, Refs, Region};
-use crate::experiments::polar::{polar_descriptor, Pole};
+use super::{eye_mid, Ctx, MethodResults, Prepared, RESOLUTIONS};
+use crate::pipeline::{bar, error_grid, field, field_at, perturb, Refs, Region};
+use crate::polar::{polar_descriptor, Pole};
 use anyhow::Result;
 use bipolar::PolarDescriptor;
 use facemodel::face_frame;
@@ -75,12 +75,7 @@ pub(super) fn run(
 ) -> Result<()> {
     let (faces, test, n) = (ctx.faces, ctx.test, ctx.args.res.levels);
     let tf = &faces[test];
-    let cells: Vec<(f64, f64)> = RADII_PCT
-        .iter()
-        .flat_map(|&p| {
-            (0..N_DIRS).map(move |k| (p, std::f64::consts::TAU * k as f64 / N_DIRS as f64))
-        })
-        .collect();
+    let cells = error_grid();
     let grid = perturbed(ctx, prep, &cells)?;
     let cell_name = |c: &(f64, f64)| {
         format!(
