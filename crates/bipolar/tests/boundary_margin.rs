@@ -76,12 +76,12 @@ fn band_is_the_distance_to_the_boundary_on_a_plane() {
     let margin = 0.2;
     let band = boundary_band(&Surface::new(mesh.clone()), margin).unwrap();
     let mut inside = 0;
-    for v in 0..mesh.n_vertices() {
-        let d = to_boundary(&mesh, mesh.position(v as u32));
+    for (v, (&p, &in_band)) in mesh.positions().iter().zip(&band).enumerate() {
+        let d = to_boundary(&mesh, p);
         if (d - margin).abs() > 1e-9 {
-            assert_eq!(band[v], d < margin, "vertex {v} at {d} from the boundary");
+            assert_eq!(in_band, d < margin, "vertex {v} at {d} from the boundary");
         }
-        inside += usize::from(band[v]);
+        inside += usize::from(in_band);
     }
     // The band holds the hole's ring and the outer border: neither empty nor everything.
     assert!(
