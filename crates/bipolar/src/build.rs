@@ -333,17 +333,28 @@ fn describe_fields(
         )));
     }
 
-    // Working fields: masked-out vertices become unreachable (+inf, faces skipped).
+    // Working fields: masked-out vertices (the vertex mask, the boundary band) become
+    // unreachable (+inf, faces skipped).
+    let band = opts
+        .boundary_margin
+        .map(|m| band(mesh, topo, m))
+        .transpose()?;
+    let keep = |v: usize| {
+        opts.vertex_mask.as_ref().is_none_or(|m| m[v]) && band.as_ref().is_none_or(|b| !b[v])
+    };
     let work: Vec<std::borrow::Cow<'_, [f64]>> = fields
         .iter()
-        .map(|f| match &opts.vertex_mask {
-            Some(mask) => std::borrow::Cow::Owned(
-                f.iter()
-                    .zip(mask)
-                    .map(|(&x, &keep)| if keep { x } else { f64::INFINITY })
-                    .collect(),
-            ),
-            None => std::borrow::Cow::Borrowed(f.as_slice()),
+        .map(|f| {
+            if opts.vertex_mask.is_none() && band.is_none() {
+                std::borrow::Cow::Borrowed(f.as_slice())
+            } else {
+                std::borrow::Cow::Owned(
+                    f.iter()
+                        .enumerate()
+                        .map(|(v, &x)| if keep(v) { x } else { f64::INFINITY })
+                        .collect(),
+                )
+            }
         })
         .collect();
 
@@ -437,8 +448,50 @@ pub(crate) fn check_field(field: usize, values: &[f64], n: usize) -> Result<(), 
     }
 }
 
+/// The vertices within geodesic distance `margin` (mesh units) of the boundary of `surface`
+/// (exact geodesics from every boundary vertex, cut off at `margin`), one flag per vertex: the
+/// band [`DescriptorOptions::boundary_margin`] leaves out. All `false` on a closed surface.
+pub fn boundary_band(surface: &Surface, margin: f64) -> Result<Vec<bool>, BipolarError> {
+    check_margin(margin)?;
+    band(surface.mesh(), surface.topology(), margin)
+}
+
+fn check_margin(margin: f64) -> Result<(), BipolarError> {
+    if margin.is_finite() && margin >= 0.0 {
+        Ok(())
+    } else {
+        Err(BipolarError::InvalidOption(format!(
+            "boundary margin {margin} (must be finite and non-negative)"
+        )))
+    }
+}
+
+fn band(mesh: &TriMesh, topo: &Topology, margin: f64) -> Result<Vec<bool>, BipolarError> {
+    let n = mesh.n_vertices();
+    let sources: Vec<Source> = topo
+        .boundary_loops()
+        .iter()
+        .flatten()
+        .map(|&v| Source::Vertex(v))
+        .collect();
+    if sources.is_empty() || margin == 0.0 {
+        return Ok(vec![false; n]);
+    }
+    let solver = geodesic::new_solver(mesh, geodesic::Method::Exact)?;
+    let u = solver.distances(
+        &sources,
+        &SolveOptions {
+            max_distance: Some(margin),
+        },
+    )?;
+    Ok(u.iter().map(|&d| d < margin).collect())
+}
+
 fn check_options(opts: &DescriptorOptions, n: usize) -> Result<(), BipolarError> {
     let bad = |m: String| Err(BipolarError::InvalidOption(m));
+    if let Some(m) = opts.boundary_margin {
+        check_margin(m)?;
+    }
     if let LevelSpec::Count(0) = opts.levels {
         return bad("the number of levels must be at least 1".into());
     }

@@ -33,7 +33,7 @@ pub mod polar;
 pub mod synthetic;
 mod types;
 
-pub use build::{describe, solve_fields, Fields};
+pub use build::{boundary_band, describe, solve_fields, Fields};
 pub use error::BipolarError;
 pub use geodesic::Source;
 pub use key::Key;

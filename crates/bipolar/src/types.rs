@@ -206,6 +206,12 @@ pub struct DescriptorOptions {
     /// Region: vertices to use (`false` vertices act as holes); one entry per vertex.
     #[serde(skip)]
     pub vertex_mask: Option<Vec<bool>>,
+    /// Region: leave out the band within this geodesic distance (mesh units) of the mesh
+    /// boundary (holes, eye openings, a scan's border), as if it were a hole. Near a hole the
+    /// fields bend around it and the level curves of two acquisitions of one surface cross in
+    /// different places (docs/scans.md, "Yaw"); `None` keeps everything.
+    #[serde(default)]
+    pub boundary_margin: Option<f64>,
     /// Number of angle levels `K` (targets `alpha k / K`, `k = 0..=K`).
     pub angles: u32,
     /// Maximum angular opening `alpha` in `(0, 1]` (below 1: `k = K` is then not a tangency).
@@ -232,6 +238,7 @@ impl Default for DescriptorOptions {
             levels: LevelSpec::Count(10),
             max_level: None,
             vertex_mask: None,
+            boundary_margin: None,
             angles: 8,
             alpha: 0.95,
             rule: SelectionRule::IsoAngle,

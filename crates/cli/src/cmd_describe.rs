@@ -51,6 +51,10 @@ pub struct Args {
     /// Geodesic method: exact, fmm, heat or dijkstra.
     #[arg(long, default_value = "exact", value_parser = choice::<Method>())]
     pub method: Method,
+    /// Leave out the band within this geodesic distance (mesh units) of the mesh boundary:
+    /// holes, eye openings, a scan's border (on scans in mm, 6 is the benchmark's choice).
+    #[arg(long = "boundary-margin")]
+    pub boundary_margin: Option<f64>,
     /// Output file: .csv, .json or .ply.
     #[arg(long)]
     pub out: PathBuf,
@@ -77,6 +81,7 @@ pub fn options(args: &Args) -> anyhow::Result<DescriptorOptions> {
         alpha: args.alpha,
         rule,
         tangent: args.tangent,
+        boundary_margin: args.boundary_margin,
         ..DescriptorOptions::default()
     })
 }

@@ -1,7 +1,7 @@
 //! End-to-end tests of `bipolar describe`.
 
 mod common;
-use common::{arg, bipolar, sphere_obj};
+use common::{arg, bipolar, grid_obj, sphere_obj};
 
 #[test]
 fn describe_writes_csv_json_and_ply() {
@@ -78,7 +78,7 @@ fn describe_reports_bad_input() {
     let out = dir.path().join("x.csv");
     let o = arg(&out);
     // (arguments after the mesh, what the error names)
-    let cases: [(&[&str], &str); 6] = [
+    let cases: [(&[&str], &str); 7] = [
         (
             &["--ref-b", "99999", "--method", "dijkstra", "--out", o],
             "99999",
@@ -101,6 +101,18 @@ fn describe_reports_bad_input() {
                 "--ref-b", "5", "--method", "dijkstra", "--step", "50", "--out", o,
             ],
             "no descriptor points",
+        ),
+        (
+            &[
+                "--ref-b",
+                "5",
+                "--method",
+                "dijkstra",
+                "--boundary-margin=-1",
+                "--out",
+                o,
+            ],
+            "boundary margin",
         ),
     ];
     for (args, needle) in cases {
@@ -145,4 +157,28 @@ fn landmark_names_are_detected_or_fail_clearly() {
             "{name}: detected vertex {v} is {d} cm from {truth}"
         );
     }
+}
+
+#[test]
+fn boundary_margin_leaves_out_the_band_along_the_border() {
+    // A 30 x 30 grid of unit cells; references (5, 15) and (25, 15), 20 apart.
+    let dir = tempfile::tempdir().unwrap();
+    let obj = grid_obj(dir.path(), "grid.obj", 30, 1.0);
+    let id = |i: usize, j: usize| (j * 31 + i).to_string();
+    let run = |extra: &[&str], name: &str| {
+        let out = dir.path().join(name);
+        let (a, b) = (id(5, 15), id(25, 15));
+        let base = ["describe", arg(&obj), "--ref-a", &a, "--ref-b", &b];
+        let opts = ["--step", "2", "--rule", "all", "--out", arg(&out)];
+        bipolar(&[&base[..], &opts, extra].concat()).success();
+        bipolar::io::read_csv(&out).unwrap()
+    };
+    let all = run(&[], "all.csv");
+    let cut = run(&["--boundary-margin", "4"], "cut.csv");
+    // Distance to the square's border [0, 30]^2.
+    let border = |p: glam::DVec3| p.x.min(30.0 - p.x).min(p.y).min(30.0 - p.y);
+    assert!(all.points.iter().any(|p| border(p.position) < 3.0));
+    assert!(!cut.is_empty() && cut.len() < all.len());
+    // Kept faces have every vertex at least 4 from the border: points at least 3 (one cell).
+    assert!(cut.points.iter().all(|p| border(p.position) >= 3.0 - 1e-9));
 }

@@ -145,13 +145,15 @@ pub enum DescriptorRule {
 
 /// The bipolar descriptor of a configuration at `n` levels between the references (step
 /// `D / n`; static region: levels up to n with the static mask; whole: levels up to 2n), built
-/// by `bipolar::describe` (precomputed fields) with `rule`.
+/// by `bipolar::describe` (precomputed fields) with `rule`; `boundary_margin` leaves out the
+/// band next to the mesh boundary (`bipolar::DescriptorOptions::boundary_margin`).
 pub fn bipolar(
     mesh: &TriMesh,
     refs: &Refs,
     n: u32,
     region: Region,
     rule: DescriptorRule,
+    boundary_margin: Option<f64>,
 ) -> Result<bipolar::Descriptor, bipolar::BipolarError> {
     let step = refs.d / f64::from(n);
     let (max_level, mask) = match region {
@@ -172,6 +174,7 @@ pub fn bipolar(
         levels: bipolar::LevelSpec::Step(step),
         max_level: Some(max_level),
         vertex_mask: mask,
+        boundary_margin,
         rule: match rule {
             DescriptorRule::CrateAll => bipolar::SelectionRule::All,
             DescriptorRule::CrateIsoAngle => bipolar::SelectionRule::IsoAngle,

@@ -386,11 +386,13 @@ struct Variant {
     name: &'static str,
     /// `None`: rule `All`; else the iso-angle rule with these crossings and repeats.
     isoangle: Option<(bipolar::IsoCrossings, bipolar::IsoRepeats)>,
+    /// Band along the scan's boundary left out (`DescriptorOptions::boundary_margin`, mm).
+    margin_mm: Option<f64>,
 }
 
 impl Variant {
     fn options(&self) -> bipolar::DescriptorOptions {
-        match self.isoangle {
+        let opts = match self.isoangle {
             None => bipolar::DescriptorOptions {
                 rule: bipolar::SelectionRule::All,
                 ..Default::default()
@@ -404,6 +406,10 @@ impl Variant {
                 },
                 ..Default::default()
             },
+        };
+        bipolar::DescriptorOptions {
+            boundary_margin: self.margin_mm,
+            ..opts
         }
     }
 }
@@ -411,25 +417,36 @@ impl Variant {
 /// The bipolar variants: the experiments' rule (`All`, grid keys) and the iso-angle rule with
 /// every crossing (the first behaviour), with the monotone fit keeping repeated keys as ambiguous
 /// (the second) and with the monotone fit and repeated keys resolved to the place nearest the
-/// geodesic between the references (the library's default).
-const VARIANTS: [Variant; 4] = {
+/// geodesic between the references (the library's default); and rule `All` without the 6 mm
+/// band along the holes and the border of each scan (the scans' choice in the recognition
+/// benchmark).
+const VARIANTS: [Variant; 5] = {
     use bipolar::{IsoCrossings::*, IsoRepeats::*};
     [
         Variant {
             name: "bipolar All",
             isoangle: None,
+            margin_mm: None,
         },
         Variant {
             name: "bipolar iso-angle, every crossing",
             isoangle: Some((Every, Ambiguous)),
+            margin_mm: None,
         },
         Variant {
             name: "bipolar iso-angle, monotone, repeats ambiguous",
             isoangle: Some((Monotone, Ambiguous)),
+            margin_mm: None,
         },
         Variant {
             name: "bipolar iso-angle, monotone, nearest",
             isoangle: Some((Monotone, Nearest)),
+            margin_mm: None,
+        },
+        Variant {
+            name: "bipolar All, 6 mm band left out",
+            isoangle: None,
+            margin_mm: Some(6.0),
         },
     ]
 };

@@ -183,7 +183,14 @@ impl Ctx<'_> {
         let n = self.args.res.levels;
         let bip = which.bipolar.then(|| {
             self.ok(
-                bipolar(mesh, refs, n, Region::Static, DescriptorRule::CrateAll),
+                bipolar(
+                    mesh,
+                    refs,
+                    n,
+                    Region::Static,
+                    DescriptorRule::CrateAll,
+                    None,
+                ),
                 || format!("bipolar descriptor of {name}"),
             )
         });

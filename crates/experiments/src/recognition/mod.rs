@@ -88,6 +88,10 @@ pub struct Args {
     /// Skip the sweeps (`--scans`).
     #[arg(long)]
     pub no_sweeps: bool,
+    /// Band (mm) along the holes and the border of each cleaned scan that the bipolar
+    /// descriptor leaves out (`--scans`; 0 keeps everything).
+    #[arg(long, default_value_t = SCAN_BOUNDARY_MARGIN_MM)]
+    pub boundary_margin: f64,
 }
 
 /// One sampled face.
@@ -108,6 +112,10 @@ struct Lm {
 
 /// Default of `--scan-edge`, mm.
 const SCAN_EDGE_MM: f64 = 1.5;
+
+/// Default of `--boundary-margin`: the band next to the holes where the fields of two scans
+/// disagree most (docs/scans.md, "Yaw").
+const SCAN_BOUNDARY_MARGIN_MM: f64 = 6.0;
 
 /// Default of `--curve-samples`.
 const CURVE_SAMPLES: usize = 50;
@@ -162,6 +170,8 @@ struct DescribeOptions {
     sectors: u32,
     /// Iso-curvature levels shared by every face (`None`: not described).
     iso_levels: Option<IsoLevels>,
+    /// Band next to the mesh boundary left out of the bipolar descriptor (mesh units).
+    boundary_margin: Option<f64>,
 }
 
 /// The three fields of a face cut off at 1.4 |q - r| (corners r, q; nose tip), D, and the wall
@@ -259,6 +269,7 @@ fn describe_face(
         o.levels,
         Region::Static,
         DescriptorRule::CrateAll,
+        o.boundary_margin,
     )
     .map_err(|e| format!("bipolar descriptor: {e}"));
     let t_bip = t.elapsed().as_secs_f64();
@@ -779,6 +790,7 @@ pub fn run(args: Args) -> Result<()> {
         levels: args.res.levels,
         sectors: args.res.sectors,
         iso_levels: Some(iso_levels),
+        boundary_margin: None,
     };
     let elastic = elastic_options(args.curve_samples);
     // Landmark detection.

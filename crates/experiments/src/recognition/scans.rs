@@ -271,6 +271,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         levels: args.res.levels,
         sectors: args.res.sectors,
         iso_levels: None,
+        boundary_margin: (args.boundary_margin > 0.0).then_some(args.boundary_margin),
     };
     let elastic = elastic_options(args.curve_samples);
     // Specs: gallery, main probes, sweeps (each face its own scan seed).

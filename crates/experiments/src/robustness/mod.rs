@@ -135,7 +135,7 @@ impl Ctx<'_> {
         region: Region,
         what: impl FnOnce() -> String,
     ) -> Desc {
-        match bipolar(mesh, refs, n, region, self.args.descriptor) {
+        match bipolar(mesh, refs, n, region, self.args.descriptor, None) {
             Ok(d) => Some(d),
             Err(e) => {
                 self.failures
