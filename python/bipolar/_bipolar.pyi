@@ -169,6 +169,7 @@ def describe(
     method: MethodName = "exact",
     landmarks: Optional[Union[PathLike, Dict[str, ArrayLike]]] = None,
     solver: Optional[GeodesicSolver] = None,
+    boundary_margin: Optional[float] = None,
 ) -> Descriptor: ...
 def read_descriptor(path: PathLike) -> Descriptor: ...
 

@@ -107,6 +107,21 @@ def test_point_references_are_snapped(bump_mesh, bump_desc):
     np.testing.assert_allclose(d2.points, bump_desc.points, atol=1e-9)
 
 
+def test_boundary_margin_leaves_out_the_band_along_the_border(bump_mesh, bump_desc):
+    # The bump's border is the square |x|, |y| = 1 (grid from -1 to 1).
+    def border(p):
+        return np.min(1.0 - np.abs(p[:, :2]), axis=1)
+
+    cut = bipolar.describe(bump_mesh, 0, 1599, levels=12, boundary_margin=0.3)
+    assert 0 < len(cut) < len(bump_desc)
+    assert border(bump_desc.points).min() < 0.1
+    # Geodesic distance to the border is at least the distance in the plane; kept faces have
+    # every vertex 0.3 or more from it (less one cell, 0.05 plus jitter, for the points).
+    assert border(cut.points).min() > 0.15
+    with pytest.raises(errors.InputError, match="boundary margin"):
+        bipolar.describe(bump_mesh, 0, 1599, boundary_margin=-1.0)
+
+
 def test_describe_bad_input(bump_mesh):
     n = bump_mesh.n_vertices
     with pytest.raises(errors.InputError, match="levels or step"):

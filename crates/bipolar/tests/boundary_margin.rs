@@ -132,14 +132,7 @@ fn margin_is_invariant_under_rigid_motion() {
         DQuat::from_euler(glam::EulerRot::XYZ, 0.4, -1.1, 2.0),
         DVec3::new(3.0, -2.0, 0.5),
     );
-    let moved = TriMesh::new(
-        mesh.positions()
-            .iter()
-            .map(|p| m.transform_point3(*p))
-            .collect(),
-        mesh.triangles().to_vec(),
-    )
-    .unwrap();
+    let moved = mesh.transformed(&m);
     let a = describe_exact(&mesh, refs, &options(Some(0.15))).unwrap();
     let b = describe_exact(&moved, refs, &options(Some(0.15))).unwrap();
     assert_eq!(a.len(), b.len());

@@ -260,14 +260,7 @@ fn monotone_rule_is_invariant_under_renumbering_and_rigid_motion_on_a_noisy_plan
             DQuat::from_axis_angle(DVec3::new(0.3, -0.5, 0.8).normalize(), 1.1),
             DVec3::new(4.0, -2.0, 7.0),
         );
-        let m3 = TriMesh::new(
-            mesh.positions()
-                .iter()
-                .map(|p| t.transform_point3(*p))
-                .collect(),
-            mesh.triangles().to_vec(),
-        )
-        .unwrap();
+        let m3 = mesh.transformed(&t);
         let d3 = describe_with(&m3, &fields, refs, &o);
         assert_same(&d1, &d3, &t, 1e-9);
     }

@@ -135,11 +135,13 @@ pub(crate) fn references(
 /// ``angles`` K, ``alpha``; ``rule`` ``"isoangle"`` | ``"filter"`` (``tolerance``, default
 /// ``alpha / (4 K)``) | ``"all"``; ``tangent`` ``"gradient"`` | ``"strip"`` | ``"spline"``;
 /// geodesic ``method`` ``"exact"`` | ``"fmm"`` | ``"heat"`` | ``"dijkstra"``, or a prepared
-/// ``solver`` for this mesh (then ``method`` is ignored). The GIL is released while it runs.
+/// ``solver`` for this mesh (then ``method`` is ignored). ``boundary_margin`` leaves out the band
+/// within that geodesic distance (mesh units) of the mesh boundary: holes, eye openings, a
+/// scan's border. The GIL is released while it runs.
 #[pyfunction]
 #[pyo3(signature = (mesh, ref_a, ref_b, *, refs=None, levels=None, step=None, max_level=None,
                     angles=8, alpha=0.95, rule="isoangle", tolerance=None, tangent="gradient",
-                    method="exact", landmarks=None, solver=None))]
+                    method="exact", landmarks=None, solver=None, boundary_margin=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn describe(
     py: Python<'_>,
@@ -158,6 +160,7 @@ pub fn describe(
     method: &str,
     landmarks: Option<&Bound<'_, PyAny>>,
     solver: Option<&Bound<'_, PyGeodesicSolver>>,
+    boundary_margin: Option<f64>,
 ) -> PyResult<PyDescriptor> {
     // The options of `bipolar describe` (same defaults and rules).
     let levels = match (levels, step) {
@@ -177,6 +180,7 @@ pub fn describe(
         alpha,
         rule,
         tangent: tangent.parse().map_err(errors::descriptor)?,
+        boundary_margin,
         ..DescriptorOptions::default()
     };
     let m = mesh_arg(mesh)?;
