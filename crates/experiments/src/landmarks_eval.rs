@@ -219,7 +219,7 @@ pub fn run(args: Args) -> Result<()> {
     let ict = FaceModel::load(&model_dir)
         .with_context(|| format!("loading the ICT face model from {}", model_dir.display()))?;
     anyhow::ensure!(args.faces > 0, "--faces must be positive");
-    let out = args.io.out_dir("landmarks-eval");
+    let out = args.io.out.out_dir("landmarks-eval");
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
     // Different streams for training and test faces.
     let train_seed = training_seed(args.seed);

@@ -1,5 +1,5 @@
-//! Default locations of the tasks' inputs and outputs (the defaults of `--faces`, `--model`,
-//! `--out`).
+//! The command-line options the tasks share (`--out`, `--faces`, `--model`, the resolution) and
+//! the default locations behind them.
 
 use std::path::{Path, PathBuf};
 
@@ -41,6 +41,21 @@ fn workspace_root() -> PathBuf {
         .unwrap_or_else(|| PathBuf::from("."))
 }
 
+/// `--out` of every task: the folder the task writes into.
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct OutArgs {
+    /// Output folder (default `target/<task>`).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+impl OutArgs {
+    /// The output folder: `--out` or `target/<task>` ([`default_out_dir`]).
+    pub fn out_dir(&self, task: &str) -> PathBuf {
+        self.out.clone().unwrap_or_else(|| default_out_dir(task))
+    }
+}
+
 /// `--faces` and `--out` of the tasks that read a face set.
 #[derive(Debug, Clone, clap::Args)]
 pub struct FaceSetArgs {
@@ -48,20 +63,15 @@ pub struct FaceSetArgs {
     /// `$BIPOLAR_SHARED/faces/ict-facekit/paper-set` (BIPOLAR_SHARED defaults to `../shared`).
     #[arg(long)]
     pub faces: Option<PathBuf>,
-    /// Report folder (default `target/<task>`).
-    #[arg(long)]
-    pub out: Option<PathBuf>,
+    /// `--out`.
+    #[command(flatten)]
+    pub out: OutArgs,
 }
 
 impl FaceSetArgs {
     /// The face-set folder: `--faces` or the shared paper set.
     pub fn faces_dir(&self) -> PathBuf {
         self.faces.clone().unwrap_or_else(default_paper_set)
-    }
-
-    /// The report folder: `--out` or `target/<task>`.
-    pub fn out_dir(&self, task: &str) -> PathBuf {
-        self.out.clone().unwrap_or_else(|| default_out_dir(task))
     }
 
     /// Loads the face set and picks the test face (`id1_neutral`, else the first); prints
@@ -101,19 +111,14 @@ pub struct ModelArgs {
     /// ICT model folder (default `$BIPOLAR_SHARED/faces/ict-facekit/model`).
     #[arg(long = "model", visible_alias = "model-dir")]
     pub model: Option<PathBuf>,
-    /// Output folder (default `target/<task>`).
-    #[arg(long)]
-    pub out: Option<PathBuf>,
+    /// `--out`.
+    #[command(flatten)]
+    pub out: OutArgs,
 }
 
 impl ModelArgs {
     /// The model folder: `--model` or the shared one.
     pub fn model_dir(&self) -> PathBuf {
         self.model.clone().unwrap_or_else(default_model_dir)
-    }
-
-    /// The output folder: `--out` or `target/<task>`.
-    pub fn out_dir(&self, task: &str) -> PathBuf {
-        self.out.clone().unwrap_or_else(|| default_out_dir(task))
     }
 }

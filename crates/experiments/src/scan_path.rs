@@ -5,7 +5,7 @@
 //! outer-eye-left` does). Without `--bnt` it scans the ICT neutral face (structured-light
 //! artifacts) at `--pitch` and writes the scan into the output folder first.
 
-use crate::paths::{default_model_dir, default_out_dir};
+use crate::paths::{default_model_dir, OutArgs};
 use anyhow::{bail, Context, Result};
 use facemodel::FaceModel;
 use landmarks::GenericModel;
@@ -29,9 +29,9 @@ pub struct Args {
     /// fields go, as `bipolar describe` without `--max-level`).
     #[arg(long)]
     pub max_level: Option<u32>,
-    /// Output folder (default `target/scan-path`).
-    #[arg(long)]
-    pub out: Option<PathBuf>,
+    /// `--out`.
+    #[command(flatten)]
+    pub out: OutArgs,
 }
 
 /// FNV-1a hash of the descriptor's keys and point positions (bit patterns): equal fingerprints
@@ -59,7 +59,7 @@ fn median(mut v: Vec<Duration>) -> Duration {
 
 /// Runs the timing; prints the output folder on the last line.
 pub fn run(args: Args) -> Result<()> {
-    let out = args.out.unwrap_or_else(|| default_out_dir("scan-path"));
+    let out = args.out.out_dir("scan-path");
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
     let bnt = match args.bnt {
         Some(p) => p,

@@ -491,7 +491,7 @@ pub fn run(args: Args) -> Result<()> {
             );
         }
     }
-    let out = args.set.out_dir("scan-study");
+    let out = args.set.out.out_dir("scan-study");
     std::fs::create_dir_all(&out)?;
     let mut sets = settings();
     if args.settings > 0 {

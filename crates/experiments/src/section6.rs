@@ -289,7 +289,7 @@ pub fn run(args: Args) -> Result<()> {
         bail!("--levels must be >= 2, --sectors >= 3 and --iso-levels >= 1");
     }
     let (faces, test) = args.set.load()?;
-    let out = args.set.out_dir("section6");
+    let out = args.set.out.out_dir("section6");
     let mut rep = Report::new(&out, "Section 6: the four representations side by side")?;
     let walkers: Vec<Walker<'_>> = faces.par_iter().map(|f| Walker::new(&f.mesh)).collect();
     let pb = bar(faces.len(), "geodesic fields");

@@ -25,7 +25,6 @@ use indicatif::{ProgressBar, ProgressStyle};
 use meshcore::{FaceLocator, TriMesh};
 use std::collections::{BTreeMap, HashMap};
 use std::fmt::Write as _;
-use std::path::PathBuf;
 use std::time::Instant;
 
 const ALPHA: f64 = 0.95;
@@ -318,17 +317,15 @@ fn method_name(m: TangentMethod) -> &'static str {
 /// Arguments of `cargo xtask sphere-validate`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Output folder (default: `target/sphere-validate` in the workspace).
-    #[arg(long)]
-    pub out: Option<PathBuf>,
+    /// `--out`.
+    #[command(flatten)]
+    pub out: crate::paths::OutArgs,
 }
 
 /// Runs the experiment, writing into the output folder.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let t_start = Instant::now();
-    let out_dir = args
-        .out
-        .unwrap_or_else(|| crate::paths::default_out_dir("sphere-validate"));
+    let out_dir = args.out.out_dir("sphere-validate");
     std::fs::create_dir_all(&out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
     let meshes = meshes()?;
     let rules: [(SelectionRule, &'static str); 3] = [

@@ -739,7 +739,7 @@ pub fn run(args: Args) -> Result<()> {
     if identities < 2 || expressions < 2 {
         bail!("need at least 2 identities and 2 expressions (one neutral gallery face + probes)");
     }
-    let out = args.io.out_dir("recognition");
+    let out = args.io.out.out_dir("recognition");
     let gt = Lm {
         r: model.landmark_id("right_eye_outer")?,
         q: model.landmark_id("left_eye_outer")?,

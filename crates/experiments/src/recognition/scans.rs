@@ -252,7 +252,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
     if identities < 2 || expressions < 2 {
         bail!("need at least 2 identities and 2 expressions (one neutral gallery face + probes)");
     }
-    let out = args.io.out_dir("recognition-scans");
+    let out = args.io.out.out_dir("recognition-scans");
     let base = args.scan.settings();
     let generic =
         GenericModel::default_model().map_err(|e| anyhow::anyhow!("landmark model: {e}"))?;

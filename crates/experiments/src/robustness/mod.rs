@@ -248,7 +248,7 @@ pub fn run(args: Args) -> Result<()> {
     if args.res.levels < 2 || args.res.sectors < 3 {
         bail!("--levels must be >= 2 and --sectors >= 3");
     }
-    let out = args.set.out_dir("robustness");
+    let out = args.set.out.out_dir("robustness");
     let walkers: Vec<Walker<'_>> = faces.par_iter().map(|f| Walker::new(&f.mesh)).collect();
     let methods = resolve_methods(&args.methods, &faces[test].mesh)?;
     let failures = Failures::default();
