@@ -70,7 +70,7 @@ pub struct Args {
     /// `RegressorOptions::spacing` (fraction of the inner-eye distance).
     #[arg(long)]
     pub regressor_spacing: Option<f64>,
-    /// `RegressorOptions::ridge`.
+    /// `RegressorOptions::ridge`: the ridge penalty of the landmark regression.
     #[arg(long)]
     pub regressor_ridge: Option<f64>,
     /// `RegressorOptions::perturbations` (extra perturbed poses per training face).

@@ -63,7 +63,7 @@ pub struct FaceSetArgs {
     /// `$BIPOLAR_SHARED/faces/ict-facekit/paper-set` (BIPOLAR_SHARED defaults to `../shared`).
     #[arg(long)]
     pub faces: Option<PathBuf>,
-    /// `--out`.
+    /// The output folder (`--out`).
     #[command(flatten)]
     pub out: OutArgs,
 }
@@ -111,7 +111,7 @@ pub struct ModelArgs {
     /// ICT model folder (default `$BIPOLAR_SHARED/faces/ict-facekit/model`).
     #[arg(long = "model", visible_alias = "model-dir")]
     pub model: Option<PathBuf>,
-    /// `--out`.
+    /// The output folder (`--out`).
     #[command(flatten)]
     pub out: OutArgs,
 }

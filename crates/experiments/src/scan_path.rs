@@ -29,7 +29,12 @@ pub struct Args {
     /// fields go, as `bipolar describe` without `--max-level`).
     #[arg(long)]
     pub max_level: Option<u32>,
-    /// `--out`.
+    /// Band (mesh units) along the holes and the border that the descriptor leaves out
+    /// (`bipolar describe --boundary-margin`; default none). Its cost lands in the step
+    /// "descriptor from the fields".
+    #[arg(long)]
+    pub boundary_margin: Option<f64>,
+    /// Output folder.
     #[command(flatten)]
     pub out: OutArgs,
 }
@@ -86,6 +91,7 @@ pub fn run(args: Args) -> Result<()> {
     let generic = GenericModel::default_model()?;
     let opts = bipolar::DescriptorOptions {
         max_level: args.max_level,
+        boundary_margin: args.boundary_margin,
         ..bipolar::DescriptorOptions::default()
     };
     let steps = [

@@ -160,7 +160,7 @@ pub struct StepTimes {
     pub scan: Duration,
     /// `scanprep::clean` (with the decimation, if any).
     pub clean: Duration,
-    /// `landmarks::detect`.
+    /// Landmark detection (`landmarks::detect`) on the cleaned scan.
     pub detect: Duration,
 }
 

@@ -317,7 +317,7 @@ fn method_name(m: TangentMethod) -> &'static str {
 /// Arguments of `cargo xtask sphere-validate`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// `--out`.
+    /// The output folder (`--out`).
     #[command(flatten)]
     pub out: crate::paths::OutArgs,
 }

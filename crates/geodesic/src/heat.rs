@@ -43,9 +43,9 @@ use glam::DVec3;
 struct FaceOp {
     /// Internal indices of the corners.
     v: [u32; 3],
-    /// `a_1`.
+    /// `a_1 = ½ n × e_1` (see above).
     a1: DVec3,
-    /// `a_2`.
+    /// `a_2 = ½ n × e_2`.
     a2: DVec3,
 }
 

@@ -23,7 +23,7 @@ pub enum Kind {
     NoPoints,
     /// `FileError` (an `OSError`).
     File,
-    /// `LandmarksNotFoundError`.
+    /// `LandmarksNotFoundError` (detection found no face).
     NotFound,
     /// `ComputationError` (a `RuntimeError`).
     Computation,
@@ -76,7 +76,7 @@ pub fn index(message: impl Into<String>) -> PyErr {
     err(Kind::Index, message)
 }
 
-/// `meshcore::MeshError`.
+/// The Python exception (of `bipolar.errors`) for a `meshcore::MeshError`.
 pub fn mesh(e: meshcore::MeshError) -> PyErr {
     use meshcore::MeshError as E;
     let kind = match e {
@@ -119,7 +119,7 @@ fn io_kind_err(e: &mesh_io::IoError, message: String) -> PyErr {
     err(io_kind(e), message)
 }
 
-/// `mesh_io::IoError`.
+/// The Python exception (of `bipolar.errors`) for a `mesh_io::IoError`.
 pub fn io(e: mesh_io::IoError) -> PyErr {
     err(io_kind(&e), chain(&e))
 }
@@ -143,12 +143,12 @@ fn geodesic_kind(e: &geodesic::GeodesicError) -> Kind {
     }
 }
 
-/// `geodesic::GeodesicError`.
+/// The Python exception (of `bipolar.errors`) for a `geodesic::GeodesicError`.
 pub fn geodesic(e: geodesic::GeodesicError) -> PyErr {
     err(geodesic_kind(&e), e.to_string())
 }
 
-/// `bipolar::BipolarError`.
+/// The Python exception (of `bipolar.errors`) for a `bipolar::BipolarError`.
 pub fn descriptor(e: bipolar::BipolarError) -> PyErr {
     use bipolar::BipolarError as E;
     let kind = match &e {
@@ -168,7 +168,7 @@ pub fn shapedist(e: shapedist::ShapeDistError) -> PyErr {
     input(e.to_string())
 }
 
-/// `landmarks::LandmarkError`.
+/// The Python exception (of `bipolar.errors`) for a `landmarks::LandmarkError`.
 pub fn landmarks(e: landmarks::LandmarkError) -> PyErr {
     use landmarks::LandmarkError as E;
     let kind = match &e {
@@ -185,7 +185,7 @@ pub fn landmarks(e: landmarks::LandmarkError) -> PyErr {
     err(kind, chain(&e))
 }
 
-/// `rangescan::ScanError`.
+/// The Python exception (of `bipolar.errors`) for a `rangescan::ScanError`.
 pub fn scan(e: rangescan::ScanError) -> PyErr {
     use rangescan::ScanError as E;
     let kind = match &e {
@@ -195,7 +195,7 @@ pub fn scan(e: rangescan::ScanError) -> PyErr {
     err(kind, chain(&e))
 }
 
-/// `scanprep::ScanPrepError`.
+/// The Python exception (of `bipolar.errors`) for a `scanprep::ScanPrepError`.
 pub fn scanprep(e: scanprep::ScanPrepError) -> PyErr {
     use scanprep::ScanPrepError as E;
     match e {
@@ -205,7 +205,7 @@ pub fn scanprep(e: scanprep::ScanPrepError) -> PyErr {
     }
 }
 
-/// `facecurves::FaceCurvesError`.
+/// The Python exception (of `bipolar.errors`) for a `facecurves::FaceCurvesError`.
 pub fn facecurves(e: facecurves::FaceCurvesError) -> PyErr {
     use facecurves::FaceCurvesError as E;
     let kind = match &e {

@@ -49,9 +49,8 @@ fn code_offenders(pred: impl Fn(&str) -> bool, except: &[&str]) -> Vec<String> {
         .collect()
 }
 
-/// `file:line: text` of every line of the workspace's sources whose trimmed text satisfies
-/// `pred`; this file is left out.
-fn lines_where(pred: impl Fn(&str) -> bool) -> Vec<String> {
+/// Every Rust source of the workspace but this file, as (path from the root, text).
+fn sources() -> Vec<(String, String)> {
     let root = workspace_root();
     let mut files = Vec::new();
     rust_files(&root.join("crates"), &mut files);
@@ -62,13 +61,21 @@ fn lines_where(pred: impl Fn(&str) -> bool) -> Vec<String> {
         files.len(),
         root.display()
     );
-    let mut out = Vec::new();
-    for f in files
+    files
         .iter()
         .filter(|f| !f.ends_with("testsupport/tests/tidy.rs"))
-    {
-        let text = std::fs::read_to_string(f).unwrap_or_default();
-        let rel = f.strip_prefix(&root).unwrap_or(f).display().to_string();
+        .map(|f| {
+            let rel = f.strip_prefix(&root).unwrap_or(f).display().to_string();
+            (rel, std::fs::read_to_string(f).unwrap_or_default())
+        })
+        .collect()
+}
+
+/// `file:line: text` of every line of the workspace's sources whose trimmed text satisfies
+/// `pred`; this file is left out.
+fn lines_where(pred: impl Fn(&str) -> bool) -> Vec<String> {
+    let mut out = Vec::new();
+    for (rel, text) in sources() {
         for (i, line) in text.lines().enumerate() {
             let t = line.trim_start();
             if pred(t) {
@@ -79,9 +86,41 @@ fn lines_where(pred: impl Fn(&str) -> bool) -> Vec<String> {
     out
 }
 
+/// A whole doc comment that is one name or path in a code span and a full stop
+/// ("/// `--out`."): it names its item instead of saying what it is (a formula is fine).
+fn only_a_name(doc: &str) -> bool {
+    let body = doc.trim();
+    body.len() > 3
+        && body.starts_with('`')
+        && body.ends_with("`.")
+        && body[1..body.len() - 2]
+            .chars()
+            .all(|c| c.is_alphanumeric() || matches!(c, '_' | ':' | '-'))
+}
+
+/// `file:line: text` of every one-line `///` doc comment (no doc line above or below it) whose
+/// text satisfies `pred`.
+fn one_line_docs(pred: impl Fn(&str) -> bool) -> Vec<String> {
+    let mut out = Vec::new();
+    for (rel, text) in sources() {
+        let lines: Vec<&str> = text.lines().map(str::trim_start).collect();
+        let doc = |i: usize| lines.get(i).is_some_and(|l| l.starts_with("///"));
+        for (i, l) in lines.iter().enumerate() {
+            let alone = doc(i) && !(i > 0 && doc(i - 1)) && !doc(i + 1);
+            if alone && pred(&l[3..]) {
+                out.push(format!("{rel}:{}: {l}", i + 1));
+            }
+        }
+    }
+    out
+}
+
 #[test]
 fn no_boilerplate_doc_comments() {
-    let bad = offenders(|l| l.contains("see the struct doc") || l.contains("see the enum doc"));
+    assert!(only_a_name(" `--out`.") && only_a_name(" `mesh_io::IoError`."));
+    assert!(!only_a_name(" `--out` of every task.") && !only_a_name(" `sum d_i`."));
+    let mut bad = offenders(|l| l.contains("see the struct doc") || l.contains("see the enum doc"));
+    bad.extend(one_line_docs(only_a_name));
     assert!(
         bad.is_empty(),
         "boilerplate doc comments:\n{}",
