@@ -449,8 +449,9 @@ pub(crate) fn check_field(field: usize, values: &[f64], n: usize) -> Result<(), 
 }
 
 /// The vertices within geodesic distance `margin` (mesh units) of the boundary of `surface`
-/// (exact geodesics from every boundary vertex, cut off at `margin`), one flag per vertex: the
-/// band [`DescriptorOptions::boundary_margin`] leaves out. All `false` on a closed surface.
+/// (exact geodesics from the boundary vertices, cut off at `margin`), one flag per vertex: the
+/// band [`DescriptorOptions::boundary_margin`] leaves out. Boundary loops shorter than
+/// `2 * margin` (pinholes) get no band. All `false` on a closed surface.
 pub fn boundary_band(surface: &Surface, margin: f64) -> Result<Vec<bool>, BipolarError> {
     check_margin(margin)?;
     band(surface.mesh(), surface.topology(), margin)
@@ -468,9 +469,18 @@ fn check_margin(margin: f64) -> Result<(), BipolarError> {
 
 fn band(mesh: &TriMesh, topo: &Topology, margin: f64) -> Result<Vec<bool>, BipolarError> {
     let n = mesh.n_vertices();
+    // A geodesic bends around a hole by at most about half its perimeter: loops shorter than
+    // twice the margin (the pinholes a noisy scan keeps) bend the fields by less than the
+    // margin and get no band.
+    let perimeter = |l: &[u32]| -> f64 {
+        (0..l.len())
+            .map(|k| (mesh.position(l[k]) - mesh.position(l[(k + 1) % l.len()])).length())
+            .sum()
+    };
     let sources: Vec<Source> = topo
         .boundary_loops()
         .iter()
+        .filter(|l| perimeter(l) >= 2.0 * margin)
         .flatten()
         .map(|&v| Source::Vertex(v))
         .collect();

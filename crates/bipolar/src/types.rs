@@ -209,7 +209,8 @@ pub struct DescriptorOptions {
     /// Region: leave out the band within this geodesic distance (mesh units) of the mesh
     /// boundary (holes, eye openings, a scan's border), as if it were a hole. Near a hole the
     /// fields bend around it and the level curves of two acquisitions of one surface cross in
-    /// different places (docs/scans.md, "Yaw"); `None` keeps everything.
+    /// different places (docs/scans.md, "Yaw"). Holes whose boundary is shorter than twice the
+    /// margin get no band. `None` keeps everything.
     #[serde(default)]
     pub boundary_margin: Option<f64>,
     /// Number of angle levels `K` (targets `alpha k / K`, `k = 0..=K`).

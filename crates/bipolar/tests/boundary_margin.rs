@@ -188,3 +188,41 @@ fn margin_is_invariant_under_renumbering() {
         );
     }
 }
+
+#[test]
+fn pinholes_shorter_than_twice_the_margin_get_no_band() {
+    let pin = DVec3::new(-0.6, -0.6, 0.0);
+    let mesh = grid_plane(60, 0.05, -1.5, 0.3, 7, |c| {
+        (c - HOLE).length() < HOLE_R || (c - pin).length() < 0.045
+    });
+    let topo = Topology::new(&mesh);
+    let perimeter = |l: &[u32]| -> f64 {
+        (0..l.len())
+            .map(|k| (mesh.position(l[k]) - mesh.position(l[(k + 1) % l.len()])).length())
+            .sum()
+    };
+    let pinhole = topo
+        .boundary_loops()
+        .iter()
+        .find(|l| l.iter().all(|&v| (mesh.position(v) - pin).length() < 0.2))
+        .expect("the pinhole is a boundary loop")
+        .clone();
+    let p = perimeter(&pinhole);
+    assert!(p > 0.05 && p < 0.49, "pinhole perimeter {p}");
+    let surface = Surface::new(mesh.clone());
+    // Margin 0.25: the pinhole (perimeter < 0.5) gets no band, the large hole does.
+    let band = boundary_band(&surface, 0.25).unwrap();
+    assert!(pinhole.iter().all(|&v| !band[v as usize]));
+    let rim = topo
+        .boundary_loops()
+        .iter()
+        .find(|l| {
+            l.iter()
+                .all(|&v| (mesh.position(v) - HOLE).length() < HOLE_R + 0.1)
+        })
+        .unwrap();
+    assert!(rim.iter().all(|&v| band[v as usize]));
+    // A margin below half the perimeter bands the pinhole too.
+    let small = boundary_band(&surface, 0.4 * p).unwrap();
+    assert!(pinhole.iter().all(|&v| small[v as usize]));
+}
