@@ -469,22 +469,20 @@ fn check_margin(margin: f64) -> Result<(), BipolarError> {
 
 fn band(mesh: &TriMesh, topo: &Topology, margin: f64) -> Result<Vec<bool>, BipolarError> {
     let n = mesh.n_vertices();
+    if margin == 0.0 {
+        return Ok(vec![false; n]);
+    }
     // A geodesic bends around a hole by at most about half its perimeter: loops shorter than
     // twice the margin (the pinholes a noisy scan keeps) bend the fields by less than the
     // margin and get no band.
-    let perimeter = |l: &[u32]| -> f64 {
-        (0..l.len())
-            .map(|k| (mesh.position(l[k]) - mesh.position(l[(k + 1) % l.len()])).length())
-            .sum()
-    };
     let sources: Vec<Source> = topo
         .boundary_loops()
         .iter()
-        .filter(|l| perimeter(l) >= 2.0 * margin)
+        .filter(|l| mesh.ring_length(l) >= 2.0 * margin)
         .flatten()
         .map(|&v| Source::Vertex(v))
         .collect();
-    if sources.is_empty() || margin == 0.0 {
+    if sources.is_empty() {
         return Ok(vec![false; n]);
     }
     let solver = geodesic::new_solver(mesh, geodesic::Method::Exact)?;

@@ -196,18 +196,13 @@ fn pinholes_shorter_than_twice_the_margin_get_no_band() {
         (c - HOLE).length() < HOLE_R || (c - pin).length() < 0.045
     });
     let topo = Topology::new(&mesh);
-    let perimeter = |l: &[u32]| -> f64 {
-        (0..l.len())
-            .map(|k| (mesh.position(l[k]) - mesh.position(l[(k + 1) % l.len()])).length())
-            .sum()
-    };
     let pinhole = topo
         .boundary_loops()
         .iter()
         .find(|l| l.iter().all(|&v| (mesh.position(v) - pin).length() < 0.2))
         .expect("the pinhole is a boundary loop")
         .clone();
-    let p = perimeter(&pinhole);
+    let p = mesh.ring_length(&pinhole);
     assert!(p > 0.05 && p < 0.49, "pinhole perimeter {p}");
     let surface = Surface::new(mesh.clone());
     // Margin 0.25: the pinhole (perimeter < 0.5) gets no band, the large hole does.

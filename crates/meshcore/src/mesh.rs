@@ -209,6 +209,17 @@ impl TriMesh {
         sum / (3 * self.triangles.len()) as f64
     }
 
+    /// Length of the closed polyline through the vertices `ring` (the last joined to the first),
+    /// e.g. the perimeter of a boundary loop; 0 for fewer than two vertices.
+    pub fn ring_length(&self, ring: &[u32]) -> f64 {
+        if ring.len() < 2 {
+            return 0.0;
+        }
+        (0..ring.len())
+            .map(|k| (self.position(ring[k]) - self.position(ring[(k + 1) % ring.len()])).length())
+            .sum()
+    }
+
     /// Length of the longest triangle edge.
     pub fn longest_edge(&self) -> f64 {
         self.triangles
@@ -288,6 +299,15 @@ mod tests {
             vec![[0, 1, 2], [0, 2, 3]],
         )
         .unwrap()
+    }
+
+    #[test]
+    fn ring_length_is_the_closed_perimeter() {
+        let m = quad();
+        assert!((m.ring_length(&[0, 1, 2, 3]) - 4.0).abs() < 1e-12);
+        assert!((m.ring_length(&[0, 2]) - 2.0 * 2f64.sqrt()).abs() < 1e-12);
+        assert_eq!(m.ring_length(&[1]), 0.0);
+        assert_eq!(m.ring_length(&[]), 0.0);
     }
 
     #[test]

@@ -151,17 +151,12 @@ pub fn fill_mesh_holes(
     }
     let topo = Topology::new(mesh);
     let p = mesh.positions();
-    let perimeter = |l: &[u32]| -> f64 {
-        (0..l.len())
-            .map(|k| (p[l[k] as usize] - p[l[(k + 1) % l.len()] as usize]).length())
-            .sum()
-    };
     // Outer loop per component: the longest perimeter (ties to the first listed).
     let mut outer: std::collections::BTreeMap<u32, (f64, usize)> = Default::default();
     for (k, l) in topo.boundary_loops().iter().enumerate() {
         let Some(&v0) = l.first() else { continue };
         let c = topo.vertex_component()[v0 as usize];
-        let per = perimeter(l);
+        let per = mesh.ring_length(l);
         let e = outer.entry(c).or_insert((per, k));
         if per > e.0 {
             *e = (per, k);
