@@ -33,8 +33,8 @@ pub use grid::{
     SpikeOptions, MAX_COORDINATE_MM,
 };
 pub use mesh::{
-    compact, crop_sphere, fill_mesh_holes, remove_mesh_spikes, remove_small_components,
-    taubin_smooth,
+    close_mesh_gaps, compact, crop_sphere, fill_mesh_holes, remove_mesh_spikes,
+    remove_small_components, taubin_smooth,
 };
 
 use mesh_io::{BntGrid, BntOptions};
@@ -209,6 +209,9 @@ pub struct CleanReport {
     pub small_components: (usize, usize),
     /// Every hole found, filled or not.
     pub holes: Vec<Hole>,
+    /// Grid input: gaps the triangulation left among valid samples (cells dropped by its
+    /// long-edge rule on depth noise), closed by [`close_mesh_gaps`] up to the hole diameter.
+    pub gaps_closed: usize,
     /// Vertices removed by the crop.
     pub cropped_vertices: usize,
     /// Smoothing iterations run.
@@ -290,6 +293,9 @@ impl CleanReport {
                 format!(" ({})", left.join("; "))
             }
         ));
+        if self.grid.is_some() {
+            out.push(format!("triangulation gaps closed: {}", self.gaps_closed));
+        }
         out.push(format!("vertices cropped: {}", self.cropped_vertices));
         out.push(format!(
             "smoothing iterations: {}",
@@ -367,6 +373,7 @@ pub fn clean(input: Input<'_>, o: &CleanOptions) -> Result<Cleaned, ScanPrepErro
         mesh_spikes: 0,
         small_components: (0, 0),
         holes: Vec::new(),
+        gaps_closed: 0,
         cropped_vertices: 0,
         smoothing_iterations: 0,
         decimation: None,
@@ -467,11 +474,18 @@ pub fn clean(input: Input<'_>, o: &CleanOptions) -> Result<Cleaned, ScanPrepErro
         mesh = m;
         report.small_components = (c, v);
     }
-    if is_mesh_input {
-        if let Some(d) = o.max_hole_diameter_mm {
+    if let Some(d) = o.max_hole_diameter_mm {
+        if is_mesh_input {
             let (m, holes) = timed(&mut timings, "holes", || fill_mesh_holes(&mesh, d))?;
             mesh = m;
             report.holes = holes;
+        } else {
+            // The grid's holes are filled; what is left open among valid samples are the cells
+            // the triangulation's long-edge rule dropped (depth noise), closed from the same
+            // vertices so that the grid index stays.
+            let (m, gaps) = timed(&mut timings, "gaps", || close_mesh_gaps(&mesh, d))?;
+            mesh = m;
+            report.gaps_closed = gaps.iter().filter(|h| h.filled).count();
         }
     }
     if let Some(c) = &o.crop {

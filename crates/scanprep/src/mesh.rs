@@ -133,23 +133,10 @@ pub fn remove_mesh_spikes(mesh: &TriMesh, factor: f64) -> Result<(TriMesh, usize
     Ok((m, n))
 }
 
-/// Fills the holes of a mesh up to `max_diameter_mm` and reports every hole.
-///
-/// Holes are the boundary loops other than the outer boundary of each component (the loop of
-/// largest perimeter in it; a closed component has none). The diameter of a loop is the largest
-/// distance between two of its vertices. A hole is closed by a fan around a new vertex at the
-/// mean of the loop's vertices; on a curved surface that vertex lies off the surface by about
-/// `d^2 / (8 R)` (diameter `d`, radius of curvature `R`), which the optional smoothing evens out.
-pub fn fill_mesh_holes(
-    mesh: &TriMesh,
-    max_diameter_mm: f64,
-) -> Result<(TriMesh, Vec<Hole>), ScanPrepError> {
-    if !(max_diameter_mm.is_finite() && max_diameter_mm >= 0.0) {
-        return Err(ScanPrepError::InvalidOption(format!(
-            "max hole diameter {max_diameter_mm} mm (expected a finite value >= 0)"
-        )));
-    }
-    let topo = Topology::new(mesh);
+/// The holes of a mesh: its boundary loops other than the outer boundary of each component (the
+/// loop of largest perimeter in it; a closed component has none), each with its [`Hole`] record
+/// (`filled` false). The diameter of a loop is the largest distance between two of its vertices.
+fn inner_loops<'t>(mesh: &TriMesh, topo: &'t Topology) -> Vec<(&'t [u32], Hole)> {
     let p = mesh.positions();
     // Outer loop per component: the longest perimeter (ties to the first listed).
     let mut outer: std::collections::BTreeMap<u32, (f64, usize)> = Default::default();
@@ -163,15 +150,13 @@ pub fn fill_mesh_holes(
         }
     }
     let outer_ids: std::collections::BTreeSet<usize> = outer.values().map(|&(_, k)| k).collect();
-    let mut pos = p.to_vec();
-    let mut tris = mesh.triangles().to_vec();
-    let mut holes = Vec::new();
+    let mut out = Vec::new();
     for (k, l) in topo.boundary_loops().iter().enumerate() {
         if outer_ids.contains(&k) || l.len() < 3 {
             continue;
         }
         let pts: Vec<DVec3> = l.iter().map(|&v| p[v as usize]).collect();
-        let diameter = if pts.len() <= 4000 {
+        let diameter_mm = if pts.len() <= 4000 {
             let mut d = 0.0f64;
             for i in 0..pts.len() {
                 for j in i + 1..pts.len() {
@@ -183,27 +168,140 @@ pub fn fill_mesh_holes(
             meshcore::Aabb::from_points(&pts).map_or(0.0, |b| b.diagonal())
         };
         let centre = pts.iter().sum::<DVec3>() / pts.len() as f64;
-        let filled = diameter <= max_diameter_mm;
-        if filled {
+        out.push((
+            l.as_slice(),
+            Hole {
+                size: l.len(),
+                diameter_mm,
+                centre,
+                filled: false,
+            },
+        ));
+    }
+    out
+}
+
+fn check_max_diameter(max_diameter_mm: f64) -> Result<(), ScanPrepError> {
+    if max_diameter_mm.is_finite() && max_diameter_mm >= 0.0 {
+        Ok(())
+    } else {
+        Err(ScanPrepError::InvalidOption(format!(
+            "max hole diameter {max_diameter_mm} mm (expected a finite value >= 0)"
+        )))
+    }
+}
+
+/// Fills the holes of a mesh up to `max_diameter_mm` and reports every hole.
+///
+/// Holes are the boundary loops other than the outer boundary of each component (the loop of
+/// largest perimeter in it; a closed component has none). The diameter of a loop is the largest
+/// distance between two of its vertices. A hole is closed by a fan around a new vertex at the
+/// mean of the loop's vertices; on a curved surface that vertex lies off the surface by about
+/// `d^2 / (8 R)` (diameter `d`, radius of curvature `R`), which the optional smoothing evens out.
+pub fn fill_mesh_holes(
+    mesh: &TriMesh,
+    max_diameter_mm: f64,
+) -> Result<(TriMesh, Vec<Hole>), ScanPrepError> {
+    check_max_diameter(max_diameter_mm)?;
+    let topo = Topology::new(mesh);
+    let mut pos = mesh.positions().to_vec();
+    let mut tris = mesh.triangles().to_vec();
+    let mut holes = Vec::new();
+    for (l, mut hole) in inner_loops(mesh, &topo) {
+        if hole.diameter_mm <= max_diameter_mm {
             let c = pos.len() as u32;
-            pos.push(centre);
+            pos.push(hole.centre);
             // The loop follows its faces' winding; the fan runs the other way along each edge.
             for i in 0..l.len() {
                 let (a, b) = (l[i], l[(i + 1) % l.len()]);
                 tris.push([b, a, c]);
             }
+            hole.filled = true;
         }
-        holes.push(Hole {
-            size: l.len(),
-            diameter_mm: diameter,
-            centre,
-            filled,
-        });
+        holes.push(hole);
     }
     if holes.iter().all(|h| !h.filled) {
         return Ok((mesh.clone(), holes));
     }
     Ok((TriMesh::new(pos, tris)?, holes))
+}
+
+/// Closes the small holes of a mesh *without new vertices*: each hole up to `max_diameter_mm`
+/// (holes as in [`fill_mesh_holes`]) is triangulated from its own boundary vertices by clipping,
+/// again and again, the ear whose new edge is the shortest. Every hole is reported; one is left
+/// open (`filled` false) when it is larger, or when no ear can be cut without a degenerate
+/// triangle or an edge the mesh already has (which would make it non-manifold).
+///
+/// This is what a range grid's triangulation needs after its long-edge rule: with depth noise,
+/// two neighbouring samples can differ by more than the rule allows, and the cells around them
+/// are dropped although no sample is missing. Closing the gap re-forms those cells from the
+/// samples that are there, so vertices (and a grid index) are unchanged.
+pub fn close_mesh_gaps(
+    mesh: &TriMesh,
+    max_diameter_mm: f64,
+) -> Result<(TriMesh, Vec<Hole>), ScanPrepError> {
+    check_max_diameter(max_diameter_mm)?;
+    let topo = Topology::new(mesh);
+    let p = mesh.positions();
+    let key = |a: u32, b: u32| (a.min(b), a.max(b));
+    let loops = inner_loops(mesh, &topo);
+    // The edges a new edge could coincide with: those around the vertices of the holes to close.
+    let mut edges: std::collections::HashSet<(u32, u32)> = Default::default();
+    for (l, hole) in &loops {
+        if hole.diameter_mm <= max_diameter_mm {
+            for &v in *l {
+                for &f in topo.vertex_faces(v) {
+                    let t = mesh.triangles()[f as usize];
+                    edges.extend([key(t[0], t[1]), key(t[1], t[2]), key(t[2], t[0])]);
+                }
+            }
+        }
+    }
+    let mut tris = mesh.triangles().to_vec();
+    let mut holes = Vec::new();
+    for (l, mut hole) in loops {
+        if hole.diameter_mm <= max_diameter_mm {
+            let mut ring = l.to_vec();
+            let mut new_tris = Vec::new();
+            let mut new_edges = Vec::new();
+            while ring.len() > 3 {
+                let n = ring.len();
+                // The ear at i cuts (prev, i, next) off with the new edge prev-next.
+                let best = (0..n)
+                    .filter_map(|i| {
+                        let (a, b, c) = (ring[(i + n - 1) % n], ring[i], ring[(i + 1) % n]);
+                        let ok = a != b && b != c && a != c && !edges.contains(&key(a, c));
+                        ok.then(|| (p[a as usize].distance(p[c as usize]), i))
+                    })
+                    .min_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+                let Some((_, i)) = best else { break };
+                let (a, b, c) = (ring[(i + n - 1) % n], ring[i], ring[(i + 1) % n]);
+                // The loop follows its faces' winding; the ear runs the other way along it.
+                new_tris.push([c, b, a]);
+                edges.insert(key(a, c));
+                new_edges.push(key(a, c));
+                ring.remove(i);
+            }
+            let closable = ring.len() == 3 && {
+                let (a, b, c) = (ring[0], ring[1], ring[2]);
+                a != b && b != c && a != c
+            };
+            if closable {
+                new_tris.push([ring[2], ring[1], ring[0]]);
+                tris.extend(new_tris);
+                hole.filled = true;
+            } else {
+                for e in new_edges {
+                    edges.remove(&e);
+                }
+            }
+        }
+        holes.push(hole);
+    }
+    if holes.iter().all(|h| !h.filled) {
+        return Ok((mesh.clone(), holes));
+    }
+    Ok((TriMesh::new(p.to_vec(), tris)?, holes))
 }
 
 /// Keeps the faces whose three vertices lie within `radius` of `centre` (then drops unused

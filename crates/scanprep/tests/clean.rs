@@ -6,8 +6,8 @@ use meshcore::units::{detect_units, Units};
 use meshcore::{shapes, DVec3, TriMesh};
 use rangescan::{scan, Artifacts, HeadPose, ScanOptions, Spikes};
 use scanprep::{
-    check_grid, clean, crop_sphere, decimate, fill_grid_holes, fill_mesh_holes, remove_grid_spikes,
-    remove_mesh_spikes, CleanOptions, Crop, Input, ScanPrepError, SpikeOptions,
+    check_grid, clean, close_mesh_gaps, crop_sphere, decimate, fill_grid_holes, fill_mesh_holes,
+    remove_grid_spikes, remove_mesh_spikes, CleanOptions, Crop, Input, ScanPrepError, SpikeOptions,
 };
 
 /// The plane z = 5 over [0, 60]^2 mm.
@@ -194,6 +194,96 @@ fn mesh_holes_are_fanned_and_big_ones_left() {
     assert_eq!(topo.boundary_loops().len(), 2);
     assert!(topo.is_oriented_manifold());
     assert!(filled.positions().iter().all(|p| p.z == 0.0));
+}
+
+#[test]
+fn mesh_gaps_are_closed_from_their_own_vertices() {
+    // A 40 x 40 mm plane with gaps of one cell (4 edges) and of two cells (6 edges), whose
+    // vertices are all there, and a 14 mm hole.
+    let m = shapes::grid_plane(40, 1.0, 0.0, 0.0, 0, |c| {
+        (c.x > 10.0 && c.x < 11.0 && c.y > 10.0 && c.y < 11.0)
+            || (c.x > 5.0 && c.x < 7.0 && c.y > 30.0 && c.y < 31.0)
+            || (c.x > 20.0 && c.x < 30.0 && c.y > 20.0 && c.y < 30.0)
+    });
+    let before = meshcore::Topology::new(&m);
+    assert_eq!(before.boundary_loops().len(), 4);
+    let (closed, holes) = close_mesh_gaps(&m, 6.0).unwrap();
+    assert_eq!(holes.len(), 3, "{holes:?}");
+    let mut sizes: Vec<_> = holes.iter().filter(|h| h.filled).map(|h| h.size).collect();
+    sizes.sort_unstable();
+    assert_eq!(sizes, [4, 6]);
+    assert!(holes.iter().any(|h| !h.filled && h.diameter_mm > 14.0));
+    // No vertex added or moved; a gap of k edges takes k - 2 triangles.
+    assert_eq!(closed.positions(), m.positions());
+    assert_eq!(closed.n_faces(), m.n_faces() + 2 + 4);
+    let topo = meshcore::Topology::new(&closed);
+    assert_eq!(topo.boundary_loops().len(), 2);
+    assert!(topo.is_oriented_manifold());
+    // The new triangles cover the gaps with the plane's orientation: the area is back.
+    let area = |t: &TriMesh| -> f64 {
+        let p = t.positions();
+        t.triangles()
+            .iter()
+            .map(|f| {
+                let (a, b, c) = (p[f[0] as usize], p[f[1] as usize], p[f[2] as usize]);
+                (b - a).cross(c - a).z / 2.0
+            })
+            .sum()
+    };
+    assert!((area(&closed) - area(&m) - 3.0).abs() < 1e-9);
+    // Nothing to close at a 0 mm limit; a bad limit is an error.
+    assert_eq!(close_mesh_gaps(&m, 0.0).unwrap().0, m);
+    assert!(close_mesh_gaps(&m, f64::NAN).is_err());
+}
+
+#[test]
+fn cells_dropped_on_depth_noise_are_closed_by_clean() {
+    // 1 mm of depth noise at 0.5 mm pitch: neighbouring samples differ by more than the
+    // triangulation's long-edge rule allows here and there, although none is missing.
+    let g = scan_of(
+        &plane(),
+        Artifacts {
+            noise: Some(rangescan::DepthNoise { sigma_mm: 1.0 }),
+            ..Artifacts::none()
+        },
+    );
+    let o = CleanOptions {
+        units: Some(Units::Millimetre),
+        spikes: None,
+        ..CleanOptions::default()
+    };
+    let open = mesh_io::bnt_grid_to_mesh(&g, &BntOptions::default()).unwrap();
+    let gaps_before = meshcore::Topology::new(&open.mesh).boundary_loops().len() - 1;
+    assert!(gaps_before >= 5, "{gaps_before} gaps: the test needs some");
+    let c = clean(Input::Grid(&g), &o).unwrap();
+    let topo = meshcore::Topology::new(&c.mesh);
+    assert_eq!(topo.boundary_loops().len(), 1, "only the border is left");
+    assert_eq!(c.report.gaps_closed, gaps_before);
+    assert!(c
+        .report
+        .summary()
+        .iter()
+        .any(|l| l == &format!("triangulation gaps closed: {gaps_before}")));
+    // The samples are the vertices, in the grid index, as before.
+    let gi = c.grid_index.unwrap();
+    assert_eq!(c.mesh.n_vertices(), open.mesh.n_vertices());
+    for (k, &s) in gi.iter().enumerate() {
+        assert_eq!(g.xyz[s as usize], c.mesh.positions()[k]);
+    }
+    // Without hole filling the gaps stay.
+    let kept = clean(
+        Input::Grid(&g),
+        &CleanOptions {
+            max_hole_diameter_mm: None,
+            ..o
+        },
+    )
+    .unwrap();
+    assert_eq!(kept.report.gaps_closed, 0);
+    assert_eq!(
+        meshcore::Topology::new(&kept.mesh).boundary_loops().len(),
+        gaps_before + 1
+    );
 }
 
 #[test]
