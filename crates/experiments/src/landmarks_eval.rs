@@ -584,7 +584,7 @@ fn run_scans(
     let opts = ScanSetOptions {
         crop_radius_mm: args.scan.crop_radius,
         detect: Some(*dopt),
-        target_edge_mm: None,
+        ..ScanSetOptions::default()
     };
     let faces = scan_faces(ict, generic, &specs, &opts, &pb);
     pb.finish_and_clear();

@@ -57,6 +57,9 @@ pub struct Args {
     /// landmarks (occluded, in a hole, cropped) make the scan unusable.
     #[arg(long, default_value_t = 2.0)]
     pub landmark_tolerance_mm: f64,
+    /// Taubin smoothing iterations of the cleaned scans (`scanprep`; 0: none).
+    #[arg(long, default_value_t = 0)]
+    pub smooth: usize,
 }
 
 /// One way of acquiring a face.
@@ -151,7 +154,11 @@ struct Described {
 
 /// The acquired mesh (mm) and the three ground-truth landmarks (r, q, nose) in its frame.
 /// Also returns the landmarks the scanner did not see (label and why).
-fn acquire(face: &Face, setting: &Setting) -> Result<(TriMesh, [DVec3; 3], Vec<String>)> {
+fn acquire(
+    face: &Face,
+    setting: &Setting,
+    smooth: usize,
+) -> Result<(TriMesh, [DVec3; 3], Vec<String>)> {
     let lm = face.landmarks;
     let truth = [lm.right_eye_outer, lm.left_eye_outer, lm.nose_tip].map(|v| face.mesh.position(v));
     let Some(spec) = setting.scan else {
@@ -212,6 +219,7 @@ fn acquire(face: &Face, setting: &Setting) -> Result<(TriMesh, [DVec3; 3], Vec<S
         &CleanOptions {
             units: Some(meshcore::units::Units::Millimetre),
             crop: Some(Crop::around(pos[2])),
+            smoothing_iterations: smooth,
             ..CleanOptions::default()
         },
     )?;
@@ -246,7 +254,7 @@ fn field_at(mesh: &TriMesh, u: &[f64], sp: &SurfacePoint) -> f64 {
 
 fn describe_scan(face: &Face, setting: &Setting, args: &Args) -> Result<Described> {
     let t0 = Instant::now();
-    let (mesh, lms, hidden) = acquire(face, setting)?;
+    let (mesh, lms, hidden) = acquire(face, setting, args.smooth)?;
     let loc = FaceLocator::new(&mesh);
     let (sp, off) = snap(&loc, &lms, args.landmark_tolerance_mm)?;
     let pos = sp.map(|s| mesh.point_position(&s).unwrap_or(DVec3::NAN));

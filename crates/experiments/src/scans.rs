@@ -222,6 +222,9 @@ pub struct ScanSetOptions {
     /// Target edge length (mm) of the cleaned scan, decimated by `scanprep`
     /// (`CleanOptions::target_edge_mm`); `None`: the scan's own sampling.
     pub target_edge_mm: Option<f64>,
+    /// Taubin smoothing iterations of the cleaned scan, before the decimation
+    /// (`CleanOptions::smoothing_iterations`).
+    pub smoothing_iterations: usize,
 }
 
 impl Default for ScanSetOptions {
@@ -230,6 +233,7 @@ impl Default for ScanSetOptions {
             crop_radius_mm: scanprep::DEFAULT_CROP_RADIUS_MM,
             detect: Some(DetectOptions::default()),
             target_edge_mm: None,
+            smoothing_iterations: 0,
         }
     }
 }
@@ -340,6 +344,7 @@ pub fn scan_face(
                 radius_mm: options.crop_radius_mm,
             }),
             target_edge_mm: options.target_edge_mm,
+            smoothing_iterations: options.smoothing_iterations,
             ..CleanOptions::default()
         },
     )?;

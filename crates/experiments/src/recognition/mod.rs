@@ -82,6 +82,10 @@ pub struct Args {
     /// description (`--scans`; 0 keeps the scan's sampling).
     #[arg(long, default_value_t = SCAN_EDGE_MM)]
     pub scan_edge: f64,
+    /// Taubin smoothing iterations of the cleaned scans, before the decimation (`--scans`; 0:
+    /// none).
+    #[arg(long, default_value_t = 0)]
+    pub scan_smooth: usize,
     /// Identities whose probes are rescanned at every sweep setting (`--scans`).
     #[arg(long, default_value_t = 4)]
     pub sweep_identities: usize,

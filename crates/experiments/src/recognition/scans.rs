@@ -265,6 +265,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
     let scan_opts = ScanSetOptions {
         crop_radius_mm: args.scan.crop_radius,
         target_edge_mm: (args.scan_edge > 0.0).then_some(args.scan_edge),
+        smoothing_iterations: args.scan_smooth,
         ..ScanSetOptions::default()
     };
     let mut dopt = DescribeOptions {
@@ -559,6 +560,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         "gallery_scan": base.label(),
         "sweep_identities": sweep_ids,
         "scan_edge_mm": scan_opts.target_edge_mm,
+        "scan_smoothing_iterations": scan_opts.smoothing_iterations,
         "sweeps": sweep_defs.iter().zip(&sweep_results).map(|(sw, pv)| serde_json::json!({
             "name": sw.name,
             "unit": sw.unit,
