@@ -18,7 +18,7 @@
 use crate::paths::{FaceSetArgs, ResolutionArgs};
 use crate::pipeline::{bar, dist, landmark_icp_rms};
 use crate::polar::{polar_descriptor, PolarOptions, Pole};
-use crate::report::joined;
+use crate::report::{joined, write_csv};
 use anyhow::{bail, Context, Result};
 use facemodel::{face_frame, load_face_set, static_mask, Face};
 use geodesic::{Method, SolveOptions, Source};
@@ -602,67 +602,89 @@ fn write_outputs(
     out: &std::path::Path,
     t0: Instant,
 ) -> Result<()> {
-    // Per-scan table.
-    let mut csv = String::from(
-        "face,setting,status,vertices,mean_edge_mm,D_mm,lm_offset_r_mm,lm_offset_q_mm,lm_offset_nose_mm,",
-    );
+    // Per-scan table (the variant names have commas: `write_csv` quotes them).
+    let mut header: Vec<String> = [
+        "face",
+        "setting",
+        "status",
+        "vertices",
+        "mean_edge_mm",
+        "D_mm",
+        "lm_offset_r_mm",
+        "lm_offset_q_mm",
+        "lm_offset_nose_mm",
+    ]
+    .map(String::from)
+    .to_vec();
     for v in &VARIANTS {
-        let _ = write!(csv, "points {0},ambiguous {0},", v.name);
+        header.extend([
+            format!("points {}", v.name),
+            format!("ambiguous {}", v.name),
+        ]);
     }
-    csv.push_str("points_polar,seconds,notes\n");
+    header.extend(["points_polar", "seconds", "notes"].map(String::from));
+    let mut rows = Vec::new();
     for s in scans {
-        let name = &faces[s.face].name;
-        let set = sets[s.setting].name;
+        let mut row = vec![faces[s.face].name.clone(), sets[s.setting].name.to_string()];
         match &s.status {
             Ok(d) => {
-                let _ = write!(
-                    csv,
-                    "{name},{set},ok,{},{:.4},{:.4},{:.4},{:.4},{:.4},",
-                    d.vertices,
-                    d.mean_edge_mm,
-                    d.d_mm,
-                    d.landmark_offsets_mm[0],
-                    d.landmark_offsets_mm[1],
-                    d.landmark_offsets_mm[2],
+                row.push("ok".into());
+                row.push(d.vertices.to_string());
+                row.extend(
+                    [
+                        d.mean_edge_mm,
+                        d.d_mm,
+                        d.landmark_offsets_mm[0],
+                        d.landmark_offsets_mm[1],
+                        d.landmark_offsets_mm[2],
+                    ]
+                    .map(|x| format!("{x:.4}")),
                 );
                 for b in &d.bip {
-                    let _ = write!(csv, "{},{:.4},", n_points(b), ambiguous_fraction(b));
+                    row.extend([
+                        n_points(b).to_string(),
+                        format!("{:.4}", ambiguous_fraction(b)),
+                    ]);
                 }
-                let _ = writeln!(
-                    csv,
-                    "{},{:.2},\"{}\"",
-                    d.polar.points.len(),
-                    d.seconds,
-                    d.notes.join("; ").replace('"', "'")
-                );
+                row.extend([
+                    d.polar.points.len().to_string(),
+                    format!("{:.2}", d.seconds),
+                    d.notes.join("; "),
+                ]);
             }
-            Err(e) => {
-                let _ = writeln!(csv, "{name},{set},\"{}\"", e.replace('"', "'"));
-            }
+            Err(e) => row.push(e.clone()),
         }
+        rows.push(row);
     }
-    std::fs::write(out.join("scans.csv"), csv)?;
-    let mut csv = format!(
-        "face_a,setting_a,face_b,setting_b,relation,{}\n",
-        methods().join(",")
-    );
-    for p in pairs {
-        let (a, b) = (&scans[p.a], &scans[p.b]);
-        let _ = writeln!(
-            csv,
-            "{},{},{},{},{},{}",
-            faces[a.face].name,
-            sets[a.setting].name,
-            faces[b.face].name,
-            sets[b.setting].name,
-            p.rel.name(),
-            p.d.iter()
-                .map(|x| format!("{x:.6}"))
-                .collect::<Vec<_>>()
-                .join(",")
-        );
-    }
-    std::fs::write(out.join("pairs.csv"), csv)?;
+    write_csv(
+        &out.join("scans.csv"),
+        &header.iter().map(String::as_str).collect::<Vec<_>>(),
+        &rows,
+    )?;
+    let mut header: Vec<String> = ["face_a", "setting_a", "face_b", "setting_b", "relation"]
+        .map(String::from)
+        .to_vec();
+    header.extend(methods().into_iter().map(String::from));
+    let rows: Vec<Vec<String>> = pairs
+        .iter()
+        .map(|p| {
+            let (a, b) = (&scans[p.a], &scans[p.b]);
+            let mut row = vec![
+                faces[a.face].name.clone(),
+                sets[a.setting].name.to_string(),
+                faces[b.face].name.clone(),
+                sets[b.setting].name.to_string(),
+                p.rel.name().to_string(),
+            ];
+            row.extend(p.d.iter().map(|x| format!("{x:.6}")));
+            row
+        })
+        .collect();
+    write_csv(
+        &out.join("pairs.csv"),
+        &header.iter().map(String::as_str).collect::<Vec<_>>(),
+        &rows,
+    )?;
 
     let mut md = String::new();
     let _ = writeln!(md, "# Scan study: the descriptor on range scans\n");
@@ -848,13 +870,14 @@ fn write_outputs(
         ))
     );
     let _ = writeln!(md, "|---|---|{}---|", "---|".repeat(VARIANTS.len()));
-    let mut csv = format!(
-        "setting,{}\n",
-        joined(&VARIANTS, ",", |v| format!(
-            "ambiguous median {0},ambiguous max {0}",
-            v.name
-        ))
-    );
+    let mut header = vec!["setting".to_string()];
+    for v in &VARIANTS {
+        header.extend([
+            format!("ambiguous median {}", v.name),
+            format!("ambiguous max {}", v.name),
+        ]);
+    }
+    let mut rows = Vec::new();
     for (si, s) in sets.iter().enumerate() {
         let ds: Vec<&Described> = scans
             .iter()
@@ -865,7 +888,7 @@ fn write_outputs(
         let (_, edge, _, _) = quantiles(&col(&|d| d.mean_edge_mm));
         let (_, pp, _, _) = quantiles(&col(&|d| d.polar.points.len() as f64));
         let mut cells = Vec::new();
-        let _ = write!(csv, "{}", s.name);
+        let mut row = vec![s.name.to_string()];
         for k in 0..VARIANTS.len() {
             let (_, med, max, _) = quantiles(&col(&|d| ambiguous_fraction(&d.bip[k])));
             let (_, pts, _, _) = quantiles(&col(&|d| n_points(&d.bip[k]) as f64));
@@ -874,9 +897,9 @@ fn write_outputs(
                 100.0 * med,
                 100.0 * max
             ));
-            let _ = write!(csv, ",{med:.4},{max:.4}");
+            row.extend([format!("{med:.4}"), format!("{max:.4}")]);
         }
-        csv.push('\n');
+        rows.push(row);
         let _ = writeln!(
             md,
             "| {} | {edge:.2} | {} | {pp:.0} |",
@@ -884,12 +907,20 @@ fn write_outputs(
             cells.join(" | ")
         );
     }
-    std::fs::write(out.join("ambiguity.csv"), csv)?;
-    let mut csv = String::from("method,ratio_all_pairs,ratio_scans_only\n");
-    for (n, a, s) in &ratios {
-        let _ = writeln!(csv, "{n},{a:.4},{s:.4}");
-    }
-    std::fs::write(out.join("ratios.csv"), csv)?;
+    write_csv(
+        &out.join("ambiguity.csv"),
+        &header.iter().map(String::as_str).collect::<Vec<_>>(),
+        &rows,
+    )?;
+    let rows: Vec<Vec<String>> = ratios
+        .iter()
+        .map(|(n, a, s)| vec![n.to_string(), format!("{a:.4}"), format!("{s:.4}")])
+        .collect();
+    write_csv(
+        &out.join("ratios.csv"),
+        &["method", "ratio_all_pairs", "ratio_scans_only"],
+        &rows,
+    )?;
     let _ = writeln!(
         md,
         "\nRun time: {:.0} s wall (release, 2 cores shared). Per-scan details: `scans.csv`.",

@@ -11,7 +11,7 @@
 use super::{
     describe_face, elastic_options, icp_points, iso_levels_of, median, order_stat, results_table,
     roc_figure, score_row, summarize, time_comparisons, time_descriptions, timed_pairs,
-    write_summary, Args, DescribeOptions, Described, Lm, Metrics, Row, TIMED_FACES,
+    write_summary, Args, DescribeOptions, Described, Lm, Metrics, Row, SCORES, TIMED_FACES,
 };
 use crate::pipeline::{bar, resolve_methods};
 use crate::report::{line_plot, Report, Series};
@@ -191,10 +191,11 @@ fn score_group(
     probes: &[Face],
     elastic: &ElasticOptions,
     ms_desc: &[f64; 4],
-) -> Result<Vec<Metrics>> {
+) -> Result<(Vec<Metrics>, Vec<Vec<String>>)> {
     let gid: Vec<usize> = gallery.iter().map(|g| g.identity).collect();
     let pid: Vec<usize> = probes.iter().map(|p| p.identity).collect();
     let mut all = Vec::new();
+    let mut per_probe = Vec::new();
     for (k, set) in SETS.iter().enumerate() {
         let gal: Vec<Option<(&Described, &FaceLocator<'_>)>> = gallery
             .iter()
@@ -211,8 +212,61 @@ fn score_group(
             .collect();
         let ms_cmp = time_comparisons(&timed_pairs(&pr, &gal), elastic)?;
         all.extend(summarize(&rows, &ms_cmp, ms_desc, &pid, &gid, set));
+        for (p, row) in probes.iter().zip(&rows) {
+            for (j, score) in SCORES.iter().enumerate() {
+                per_probe.push(probe_rank(&p.name, p.identity, set, score, &row[j], &gid));
+            }
+        }
     }
-    Ok(all)
+    Ok((all, per_probe))
+}
+
+/// One line of `probes.csv`: where the probe's own identity ranks among the gallery for one
+/// score (1 = identified; empty when its genuine score failed), its genuine score, and the
+/// best impostor with its score.
+fn probe_rank(
+    name: &str,
+    identity: usize,
+    set: &str,
+    score: &str,
+    row: &[f64],
+    gallery_id: &[usize],
+) -> Vec<String> {
+    let genuine = row
+        .iter()
+        .zip(gallery_id)
+        .filter(|(_, &g)| g == identity)
+        .map(|(v, _)| *v)
+        .fold(f64::NAN, f64::min);
+    let impostor = row
+        .iter()
+        .zip(gallery_id)
+        .filter(|(v, &g)| g != identity && v.is_finite())
+        .min_by(|a, b| a.0.total_cmp(b.0).then(a.1.cmp(b.1)));
+    let rank = genuine.is_finite().then(|| {
+        1 + row
+            .iter()
+            .zip(gallery_id)
+            .filter(|(v, &g)| g != identity && v.is_finite() && **v < genuine)
+            .count()
+    });
+    let num = |v: f64| {
+        if v.is_finite() {
+            format!("{v:.6}")
+        } else {
+            String::new()
+        }
+    };
+    vec![
+        name.to_string(),
+        identity.to_string(),
+        set.to_string(),
+        score.to_string(),
+        rank.map(|r| r.to_string()).unwrap_or_default(),
+        num(genuine),
+        impostor.map(|(_, g)| g.to_string()).unwrap_or_default(),
+        impostor.map(|(v, _)| num(*v)).unwrap_or_default(),
+    ]
 }
 
 /// Every failure of a group: (face, landmark set, what failed).
@@ -388,7 +442,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         .take(TIMED_FACES)
         .collect();
     let ms_desc = time_descriptions(&first, method, &dopt)?;
-    let main = score_group(&gallery, &locators, &probes, &elastic, &ms_desc)?;
+    let (main, per_probe) = score_group(&gallery, &locators, &probes, &elastic, &ms_desc)?;
     let mut fails = failures(&gallery, "gallery");
     fails.extend(failures(&probes, "probes"));
     // Sweeps.
@@ -398,9 +452,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         let mut per_value = Vec::new();
         for (v, specs) in sw.values.iter().zip(groups) {
             let faces = run(specs, false, &format!("sweep {} {v}", sw.name));
-            per_value.push(score_group(
-                &gallery, &locators, &faces, &elastic, &ms_desc,
-            )?);
+            per_value.push(score_group(&gallery, &locators, &faces, &elastic, &ms_desc)?.0);
             fails.extend(failures(&faces, &format!("sweep {} {v}", sw.name)));
             sweep_faces.extend(faces);
         }
@@ -434,6 +486,21 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
     ));
     rep.heading(2, "Main run");
     results_table(&mut rep, &main, "results.csv")?;
+    rep.csv(
+        "probes.csv",
+        &[
+            "probe",
+            "identity",
+            "landmarks",
+            "score",
+            "rank",
+            "genuine",
+            "best impostor",
+            "best impostor score",
+        ],
+        &per_probe,
+    )?;
+    rep.para("Per probe and score: the rank of the probe's own identity in the gallery (1: identified; empty: its genuine comparison failed), its score and the nearest other identity (`probes.csv`).");
     roc_figure(&mut rep, &main, "roc.svg", "ROC on scans (verification)")?;
     // Landmark detection on every scan of the run.
     let everyone: Vec<&Face> = gallery.iter().chain(&probes).chain(&sweep_faces).collect();
