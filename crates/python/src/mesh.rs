@@ -464,12 +464,29 @@ pub fn read_bnt(
     Ok(PyMesh { loaded })
 }
 
-fn labelled<'py>(py: Python<'py>, items: Vec<(String, Vec<f64>)>) -> PyResult<Bound<'py, PyDict>> {
+/// `{label: (K,) array}` of labels and their coordinates.
+fn labelled<'py, const K: usize>(
+    py: Python<'py>,
+    labels: impl IntoIterator<Item = String>,
+    points: impl IntoIterator<Item = [f64; K]>,
+) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    for (k, v) in items {
-        d.set_item(k, vec_out(py, v))?;
+    for (label, p) in labels.into_iter().zip(points) {
+        d.set_item(label, vec_out(py, p.to_vec()))?;
     }
     Ok(d)
+}
+
+/// The landmark file named by the ``path`` argument, read by `read` into labels and their
+/// coordinates, as `{label: (K,) array}`.
+fn read_labelled<'py, const K: usize>(
+    py: Python<'py>,
+    path: &Bound<'py, PyAny>,
+    read: impl FnOnce(&Path) -> Result<(Vec<String>, Vec<[f64; K]>), mesh_io::IoError>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let p = convert::path(path, "path")?;
+    let (labels, points) = read(&p).map_err(errors::io)?;
+    labelled(py, labels, points)
 }
 
 /// Reads labelled 3D landmarks: Bosphorus ``.lm3`` by extension, otherwise JSON as written by
@@ -479,16 +496,10 @@ pub fn read_landmarks<'py>(
     py: Python<'py>,
     path: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let p = convert::path(path, "path")?;
-    let lm = mesh_io::read_landmark_file(&p, None).map_err(errors::io)?;
-    labelled(
-        py,
-        lm.labels
-            .into_iter()
-            .zip(lm.points)
-            .map(|(l, q)| (l, q.to_array().to_vec()))
-            .collect(),
-    )
+    read_labelled(py, path, |p| {
+        let lm = mesh_io::read_landmark_file(p, None)?;
+        Ok((lm.labels, lm.points.iter().map(|q| q.to_array()).collect()))
+    })
 }
 
 /// Reads the ICT FaceKit ``landmarks.json`` layout: ``{face: {name: (3,) array}}`` with the five
@@ -503,12 +514,10 @@ pub fn read_ict_landmarks<'py>(
     let out = PyDict::new(py);
     for (face, lm) in faces {
         let pts = landmarks::io::select_five(&lm, &face).map_err(errors::landmarks)?;
-        let items = landmarks::LandmarkName::ALL
+        let labels = landmarks::LandmarkName::ALL
             .iter()
-            .zip(pts)
-            .map(|(n, q)| (n.key().to_string(), q.to_array().to_vec()))
-            .collect();
-        out.set_item(face, labelled(py, items)?)?;
+            .map(|n| n.key().to_string());
+        out.set_item(face, labelled(py, labels, pts.map(|q| q.to_array()))?)?;
     }
     Ok(out)
 }
@@ -516,16 +525,10 @@ pub fn read_ict_landmarks<'py>(
 /// Reads Bosphorus ``.lm2`` 2D landmarks (texture pixel coordinates): ``{label: (2,) array}``.
 #[pyfunction]
 pub fn read_lm2<'py>(py: Python<'py>, path: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
-    let p = convert::path(path, "path")?;
-    let lm = mesh_io::read_lm2(&p).map_err(errors::io)?;
-    labelled(
-        py,
-        lm.labels
-            .into_iter()
-            .zip(lm.points)
-            .map(|(l, q)| (l, q.to_vec()))
-            .collect(),
-    )
+    read_labelled(py, path, |p| {
+        let lm = mesh_io::read_lm2(p)?;
+        Ok((lm.labels, lm.points))
+    })
 }
 
 /// Writes labelled 3D landmarks ``{label: (x, y, z)}`` as a Bosphorus ``.lm3`` file.
