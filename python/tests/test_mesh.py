@@ -1,4 +1,5 @@
 import pickle
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -109,6 +110,17 @@ def test_landmark_files_roundtrip(tmp_path):
     assert set(r) == set(lm)
     for k in lm:
         np.testing.assert_array_equal(r[k], lm[k])
+
+
+def test_lm2_reads_2d_landmarks():
+    fixtures = Path(__file__).resolve().parents[2] / "fixtures"
+    r = bipolar.read_lm2(fixtures / "sample.lm2")
+    assert list(r) == ["Nose tip", "Chin middle"]
+    np.testing.assert_array_equal(r["Nose tip"], [120.5, 200.0])
+    np.testing.assert_array_equal(r["Chin middle"], [118.0, 330.25])
+    assert r["Nose tip"].dtype == np.float64
+    with pytest.raises(errors.FileError):
+        bipolar.read_lm2(fixtures / "missing.lm2")
 
 
 # --- bad input: a clear exception, never a crash --------------------------------------------
