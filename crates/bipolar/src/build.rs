@@ -87,9 +87,7 @@ fn fields_for(
     refs: &[Source],
     opts: &DescriptorOptions,
 ) -> Result<Vec<Vec<f64>>, BipolarError> {
-    if refs.len() < 2 || refs.len() > 256 {
-        return Err(BipolarError::ReferenceCount(refs.len()));
-    }
+    check_reference_count(refs.len())?;
     if solver.n_vertices() != mesh.n_vertices() {
         return Err(BipolarError::InvalidOption(format!(
             "the solver was prepared for {} vertices but the mesh has {}",
@@ -233,9 +231,7 @@ fn describe_fields(
     opts: &DescriptorOptions,
 ) -> Result<Descriptor, BipolarError> {
     let n = mesh.n_vertices();
-    if fields.len() < 2 || fields.len() > 256 {
-        return Err(BipolarError::ReferenceCount(fields.len()));
-    }
+    check_reference_count(fields.len())?;
     for (fi, f) in fields.iter().enumerate() {
         check_field(fi, f, n)?;
     }
@@ -577,6 +573,15 @@ fn source_vertex(mesh: &TriMesh, r: &Source) -> u32 {
     match r {
         Source::Vertex(v) => *v,
         Source::Point(sp) => mesh.triangles()[sp.face as usize][0],
+    }
+}
+
+/// Checks that there are between 2 and 256 reference points (or fields).
+fn check_reference_count(n: usize) -> Result<(), BipolarError> {
+    if (2..=256).contains(&n) {
+        Ok(())
+    } else {
+        Err(BipolarError::ReferenceCount(n))
     }
 }
 

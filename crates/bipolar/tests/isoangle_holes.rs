@@ -8,7 +8,7 @@
 
 use bipolar::{
     describe, Descriptor, DescriptorOptions, Fields, IsoAngleOptions, IsoRepeats, LevelSpec,
-    SelectionRule, Surface,
+    Surface,
 };
 use facemodel::Face;
 use geodesic::Method;
@@ -25,15 +25,15 @@ fn iso_descriptor(face: &Face, repeats: IsoRepeats) -> (Descriptor, Vec<f64>) {
             references: None,
         },
         &DescriptorOptions {
-            levels: LevelSpec::Step(d / 10.0),
-            max_level: Some(10),
             vertex_mask: Some(mask),
-            rule: SelectionRule::IsoAngle,
-            isoangle: IsoAngleOptions {
-                repeats,
-                ..IsoAngleOptions::default()
-            },
-            ..DescriptorOptions::default()
+            ..common::iso_angle(
+                LevelSpec::Step(d / 10.0),
+                10,
+                IsoAngleOptions {
+                    repeats,
+                    ..IsoAngleOptions::default()
+                },
+            )
         },
     )
     .unwrap();

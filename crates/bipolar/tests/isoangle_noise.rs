@@ -6,13 +6,15 @@
 use bipolar::synthetic::{grid_plane, icosphere};
 use bipolar::{
     describe, Descriptor, DescriptorOptions, Fields, IsoAngleOptions, IsoCrossings, LevelSpec,
-    SelectionRule, Source,
+    Source,
 };
 use glam::{DAffine3, DQuat, DVec3};
 use meshcore::{Surface, TriMesh};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use testsupport::nearest_vertex;
+
+mod common;
 
 /// Plane grid on [-1.5, 1.5]^2, `n` cells a side, jittered in the plane, with uniform height
 /// noise of amplitude `noise` (as a fraction of the cell size); references at the vertices
@@ -60,17 +62,13 @@ fn noisy_sphere(level: u32, noise: f64, seed: u64) -> (TriMesh, [u32; 2]) {
     (mesh, [0, vq])
 }
 
+/// The iso-angle rule with `crossings` on `levels` levels.
 fn iso(crossings: IsoCrossings, levels: u32) -> DescriptorOptions {
-    DescriptorOptions {
-        levels: LevelSpec::Count(levels),
-        max_level: Some(levels),
-        rule: SelectionRule::IsoAngle,
-        isoangle: IsoAngleOptions {
-            crossings,
-            ..IsoAngleOptions::default()
-        },
-        ..DescriptorOptions::default()
-    }
+    let isoangle = IsoAngleOptions {
+        crossings,
+        ..IsoAngleOptions::default()
+    };
+    common::iso_angle(LevelSpec::Count(levels), levels, isoangle)
 }
 
 /// Exact geodesic fields from the two reference vertices.

@@ -56,7 +56,7 @@ impl OutArgs {
     }
 }
 
-/// `--faces` and `--out` of the tasks that read a face set.
+/// `--faces`, `--out` and the resolution of the tasks that read a face set.
 #[derive(Debug, Clone, clap::Args)]
 pub struct FaceSetArgs {
     /// Folder of the face set (OBJ files + landmarks.json); default
@@ -66,6 +66,9 @@ pub struct FaceSetArgs {
     /// The output folder (`--out`).
     #[command(flatten)]
     pub out: OutArgs,
+    /// The resolution of the descriptors (`--levels`, `--sectors`).
+    #[command(flatten)]
+    pub res: ResolutionArgs,
 }
 
 impl FaceSetArgs {

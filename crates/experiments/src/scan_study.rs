@@ -15,7 +15,7 @@
 //! Only composes the libraries; deterministic (the scanner's seeds, rayon results collected in
 //! input order).
 
-use crate::paths::{FaceSetArgs, ResolutionArgs};
+use crate::paths::FaceSetArgs;
 use crate::pipeline::{bar, dist, landmark_icp_rms};
 use crate::polar::{polar_descriptor, PolarOptions, Pole};
 use crate::report::{joined, write_csv};
@@ -32,12 +32,10 @@ use std::time::Instant;
 /// Arguments of `cargo xtask scan-study`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
-    /// Face set and report folder (default `target/scan-study`).
+    /// Face set, report folder (default `target/scan-study`) and descriptor resolution (static
+    /// area: levels <= N).
     #[command(flatten)]
     pub set: FaceSetArgs,
-    /// Descriptor resolution (static area: levels <= N).
-    #[command(flatten)]
-    pub res: ResolutionArgs,
     /// Only the first `n` scan settings (of the fixed list; 0 = all).
     #[arg(long, default_value_t = 0)]
     pub settings: usize,
@@ -300,8 +298,8 @@ fn describe_scan(face: &Face, setting: &Setting, args: &Args) -> Result<Describe
         .iter()
         .map(|v| {
             let opts = bipolar::DescriptorOptions {
-                levels: bipolar::LevelSpec::Step(d / f64::from(args.res.levels)),
-                max_level: Some(args.res.levels),
+                levels: bipolar::LevelSpec::Step(d / f64::from(args.set.res.levels)),
+                max_level: Some(args.set.res.levels),
                 vertex_mask: Some(mask.clone()),
                 ..v.options()
             };
@@ -328,9 +326,9 @@ fn describe_scan(face: &Face, setting: &Setting, args: &Args) -> Result<Describe
         Pole::Point(sp[2]),
         0.5 * (pos[0] + pos[1]),
         &PolarOptions {
-            step: d / f64::from(args.res.levels),
-            levels: args.res.levels,
-            sectors: args.res.sectors,
+            step: d / f64::from(args.set.res.levels),
+            levels: args.set.res.levels,
+            sectors: args.set.res.sectors,
         },
     )?;
     let inside: Vec<DVec3> = (0..mesh.n_vertices())
@@ -706,8 +704,8 @@ fn write_outputs(
         sets.len(),
         joined(sets, ", ", |s| s.name.to_string()),
         args.landmark_tolerance_mm,
-        args.res.levels,
-        args.res.sectors,
+        args.set.res.levels,
+        args.set.res.sectors,
         args.icp_points
     );
     let _ = writeln!(

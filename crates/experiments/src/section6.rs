@@ -18,7 +18,7 @@
 use crate::curves::{
     facial_curves, facial_distance, iso_curves, iso_distance, reference_iso_levels,
 };
-use crate::paths::{FaceSetArgs, ResolutionArgs};
+use crate::paths::FaceSetArgs;
 use crate::pipeline::{
     bar, bipolar, dist, error_grid, field, field_at, perturb, single_thread, DescriptorRule, Refs,
     Region, RADII_PCT,
@@ -61,13 +61,10 @@ const CSV_COLUMNS: [&str; 4] = ["bipolar", "single_pole", "facial", "iso_curvatu
 /// Arguments of `cargo xtask section6`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
-    /// Face set and report folder (default `target/section6`).
+    /// Face set, report folder (default `target/section6`) and resolution: bipolar levels N
+    /// between the corners; polar radii and facial curves at D / N; single-pole sectors.
     #[command(flatten)]
     pub set: FaceSetArgs,
-    /// Resolution: bipolar levels N between the corners; polar radii and facial curves at
-    /// D / N; single-pole sectors.
-    #[command(flatten)]
-    pub res: ResolutionArgs,
     /// Levels per principal field of the iso-curvature network (between the 5 % and 95 %
     /// quantiles of the test face, the same levels for every face).
     #[arg(long = "iso-levels", default_value_t = 6)]
@@ -180,7 +177,7 @@ impl Ctx<'_> {
         name: &str,
         which: Which,
     ) -> Descs {
-        let n = self.args.res.levels;
+        let n = self.args.set.res.levels;
         let bip = which.bipolar.then(|| {
             self.ok(
                 bipolar(
@@ -205,7 +202,7 @@ impl Ctx<'_> {
         let popts = PolarOptions {
             step: refs.d / f64::from(n),
             levels: n,
-            sectors: self.args.res.sectors,
+            sectors: self.args.set.res.sectors,
         };
         let polar = self
             .ok(
@@ -285,7 +282,7 @@ fn noisy(mesh: &TriMesh, sigma: f64, seed: u64) -> Result<TriMesh> {
 /// Runs the task; prints the report folder on the last line.
 pub fn run(args: Args) -> Result<()> {
     let t_start = Instant::now();
-    if args.res.levels < 2 || args.res.sectors < 3 || args.iso_levels == 0 {
+    if args.set.res.levels < 2 || args.set.res.sectors < 3 || args.iso_levels == 0 {
         bail!("--levels must be >= 2, --sectors >= 3 and --iso-levels >= 1");
     }
     let (faces, test) = args.set.load()?;
@@ -506,7 +503,7 @@ pub fn run(args: Args) -> Result<()> {
             .context("the test face's single-pole descriptor")?,
         other.and_then(|j| base[j].polar.as_ref()),
         args.seed,
-        args.res.levels,
+        args.set.res.levels,
     )?;
 
     write_report(
@@ -733,8 +730,8 @@ fn write_report(
          `cargo xtask section6` (release); total {:.0} s.",
         faces.len(),
         tf.name,
-        args.res.levels,
-        args.res.sectors,
+        args.set.res.levels,
+        args.set.res.sectors,
         args.iso_levels,
         args.seed,
         t_start.elapsed().as_secs_f64()

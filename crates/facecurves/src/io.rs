@@ -70,8 +70,40 @@ fn arr(p: &[DVec3]) -> Vec<[f64; 3]> {
     p.iter().map(|p| p.to_array()).collect()
 }
 
-fn vecs(p: &[[f64; 3]]) -> Vec<DVec3> {
-    p.iter().map(|a| DVec3::from_array(*a)).collect()
+/// A curve record of a file.
+trait FileCurve {
+    /// Its points as stored.
+    fn points(&self) -> &[[f64; 3]];
+}
+
+impl FileCurve for FileFacialCurve {
+    fn points(&self) -> &[[f64; 3]] {
+        &self.points
+    }
+}
+
+impl FileCurve for FileIsoCurve {
+    fn points(&self) -> &[[f64; 3]] {
+        &self.points
+    }
+}
+
+/// Reads the curve records of a file in order: `read(i, record, points)` makes curve `i` from
+/// its record and its points, which must all be finite (`bad` makes the error).
+fn read_curves<C: FileCurve, T>(
+    records: Vec<C>,
+    bad: &dyn Fn(String) -> FaceCurvesError,
+    mut read: impl FnMut(usize, C, Vec<DVec3>) -> Result<T, FaceCurvesError>,
+) -> Result<Vec<T>, FaceCurvesError> {
+    let mut out = Vec::with_capacity(records.len());
+    for (i, c) in records.into_iter().enumerate() {
+        if !c.points().iter().flatten().all(|x| x.is_finite()) {
+            return Err(bad(format!("curve {i} has a non-finite coordinate")));
+        }
+        let points = c.points().iter().map(|a| DVec3::from_array(*a)).collect();
+        out.push(read(i, c, points)?);
+    }
+    Ok(out)
 }
 
 /// JSON text of a curve set.
@@ -130,29 +162,20 @@ pub fn parse_json(text: &str, path: &Path) -> Result<CurveSet, FaceCurvesError> 
             f.format, f.version
         )));
     }
-    let finite = |pts: &[[f64; 3]], i: usize| -> Result<(), FaceCurvesError> {
-        if pts.iter().flatten().all(|x| x.is_finite()) {
-            Ok(())
-        } else {
-            Err(bad(format!("curve {i} has a non-finite coordinate")))
-        }
-    };
     Ok(match f.body {
         Body::Facial {
             step,
             levels,
             curves,
         } => {
-            let mut out = Vec::with_capacity(curves.len());
-            for (i, c) in curves.into_iter().enumerate() {
-                finite(&c.points, i)?;
-                out.push(FacialCurve {
+            let out = read_curves(curves, &bad, |_, c, points| {
+                Ok(FacialCurve {
                     level: c.level,
-                    points: vecs(&c.points),
+                    points,
                     closed: c.closed,
                     pieces: c.pieces,
-                });
-            }
+                })
+            })?;
             if out.windows(2).any(|w| w[0].level >= w[1].level) {
                 return Err(bad("facial curve levels are not increasing".into()));
             }
@@ -167,21 +190,19 @@ pub fn parse_json(text: &str, path: &Path) -> Result<CurveSet, FaceCurvesError> 
             radius,
             curves,
         } => {
-            let mut out = Vec::with_capacity(curves.len());
-            for (i, c) in curves.into_iter().enumerate() {
-                finite(&c.points, i)?;
+            let out = read_curves(curves, &bad, |i, c, points| {
                 let field: PrincipalField = c
                     .field
                     .parse()
                     .map_err(|e| bad(format!("curve {i}: {e}")))?;
-                out.push(IsoCurve {
+                Ok(IsoCurve {
                     field,
                     level_index: c.level_index,
                     level: c.level,
-                    points: vecs(&c.points),
+                    points,
                     closed: c.closed,
-                });
-            }
+                })
+            })?;
             CurveSet::IsoCurvature(IsoCurvatureDescriptor {
                 curves: out,
                 levels_k1,

@@ -1,5 +1,9 @@
-//! What the paper-face tests share: the fields from the outer eye corners and the static area.
+//! What the descriptor tests share: the fields from the outer eye corners and the static area of
+//! paper-set faces, and the options of the iso-angle rule.
 
+#![allow(dead_code)] // every test binary uses a part
+
+use bipolar::{DescriptorOptions, IsoAngleOptions, LevelSpec, SelectionRule};
 use facemodel::{face_frame, static_mask, Face};
 use geodesic::{new_solver, Method, SolveOptions, Source};
 
@@ -30,4 +34,20 @@ pub fn corner_fields(face: &Face, method: Method) -> CornerFields {
     );
     let mask = static_mask(m, &ur, &uq, d, &face_frame(m, r, q, nose), nose);
     CornerFields { ur, uq, d, mask }
+}
+
+/// The iso-angle rule with `isoangle` on the levels `levels`, up to level `max_level` of both
+/// fields.
+pub fn iso_angle(
+    levels: LevelSpec,
+    max_level: u32,
+    isoangle: IsoAngleOptions,
+) -> DescriptorOptions {
+    DescriptorOptions {
+        levels,
+        max_level: Some(max_level),
+        rule: SelectionRule::IsoAngle,
+        isoangle,
+        ..DescriptorOptions::default()
+    }
 }

@@ -62,7 +62,7 @@ fn curves(
 /// Figures 4 and 5 on the test face: level curves at 5, 10 and 30 levels between the corners
 /// with the whole-face descriptor, and the static area with its descriptor.
 pub(super) fn renders(ctx: &Ctx<'_>, prep: &Prepared, out: &Path) -> Result<()> {
-    let (mname, n) = (ctx.mname(), ctx.args.res.levels);
+    let (mname, n) = (ctx.mname(), ctx.args.set.res.levels);
     let f = &ctx.faces[ctx.test];
     let rf = &prep.refs[ctx.test];
     let topo = Topology::new(&f.mesh);
@@ -125,7 +125,7 @@ pub(super) fn renders(ctx: &Ctx<'_>, prep: &Prepared, out: &Path) -> Result<()> 
 /// Figures 6 and 7: the distance from the test face against resolution, the static and whole
 /// matrices at the default resolution, and the single-pole matrix.
 pub(super) fn run(ctx: &Ctx<'_>, prep: &Prepared, res: &mut MethodResults) -> Result<Base> {
-    let (faces, test, n) = (ctx.faces, ctx.test, ctx.args.res.levels);
+    let (faces, test, n) = (ctx.faces, ctx.test, ctx.args.set.res.levels);
     let nf = faces.len();
     let describe_all = |nl: u32, region: Region, label: &'static str| -> Vec<Desc> {
         faces

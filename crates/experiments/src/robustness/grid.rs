@@ -73,7 +73,7 @@ pub(super) fn run(
     base: &Base,
     res: &mut MethodResults,
 ) -> Result<()> {
-    let (faces, test, n) = (ctx.faces, ctx.test, ctx.args.res.levels);
+    let (faces, test, n) = (ctx.faces, ctx.test, ctx.args.set.res.levels);
     let tf = &faces[test];
     let cells = error_grid();
     let grid = perturbed(ctx, prep, &cells)?;

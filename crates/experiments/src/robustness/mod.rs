@@ -16,7 +16,7 @@ mod random;
 mod report;
 pub(crate) mod stats;
 
-use crate::paths::{FaceSetArgs, ResolutionArgs};
+use crate::paths::FaceSetArgs;
 use crate::pipeline::{bipolar, dist, resolve_methods, DescriptorRule, Refs, Region};
 use crate::polar::PolarOptions;
 use crate::walk::Walker;
@@ -34,15 +34,13 @@ use std::time::Instant;
 /// Arguments of `cargo xtask robustness`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
-    /// Face set and report folder (default `target/robustness`).
+    /// Face set, report folder (default `target/robustness`) and descriptor resolution (the
+    /// default N of the figures that do not vary it).
     #[command(flatten)]
     pub set: FaceSetArgs,
     /// Geodesic methods to run, comma separated (exact, fmm, heat, dijkstra).
     #[arg(long, default_value = "exact,dijkstra")]
     pub methods: String,
-    /// Descriptor resolution (the default N of the figures that do not vary it).
-    #[command(flatten)]
-    pub res: ResolutionArgs,
     /// Seed of the random reference-point errors.
     #[arg(long, default_value_t = 2013)]
     pub seed: u64,
@@ -220,9 +218,9 @@ impl Ctx<'_> {
     /// Options of the single-pole descriptor for a configuration.
     fn polar_opts(&self, r: &Refs) -> PolarOptions {
         PolarOptions {
-            step: r.d / f64::from(self.args.res.levels),
-            levels: self.args.res.levels,
-            sectors: self.args.res.sectors,
+            step: r.d / f64::from(self.args.set.res.levels),
+            levels: self.args.set.res.levels,
+            sectors: self.args.set.res.sectors,
         }
     }
 }
@@ -245,7 +243,7 @@ fn n_keys(d: &Desc) -> usize {
 pub fn run(args: Args) -> Result<()> {
     let t0 = Instant::now();
     let (faces, test) = args.set.load()?;
-    if args.res.levels < 2 || args.res.sectors < 3 {
+    if args.set.res.levels < 2 || args.set.res.sectors < 3 {
         bail!("--levels must be >= 2 and --sectors >= 3");
     }
     let out = args.set.out.out_dir("robustness");

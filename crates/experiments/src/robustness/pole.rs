@@ -106,12 +106,12 @@ pub(super) fn figure15(
         .unwrap_or(test);
     let descs: Vec<(PolarDescriptor, FaceFrame)> = [test, other]
         .par_iter()
-        .map(|&i| describe(&faces[i], method, args.res.levels, args.res.sectors))
+        .map(|&i| describe(&faces[i], method, args.set.res.levels, args.set.res.sectors))
         .collect::<Result<_>>()?;
     let (s, frame) = &descs[0];
     let s1 = rotate_rings(s, args.seed);
     let mut per_ring = Vec::new();
-    for lvl in 1..=args.res.levels {
+    for lvl in 1..=args.set.res.levels {
         let idx: Vec<usize> = (0..s.points.len())
             .filter(|&k| s.points[k].key.level == lvl)
             .collect();

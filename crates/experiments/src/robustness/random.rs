@@ -51,7 +51,7 @@ fn one_face(ctx: &Ctx<'_>, prep: &Prepared, i: usize) -> Result<Run> {
     let w = &ctx.walkers[i];
     let s = prep.solvers[i].as_ref();
     let lm = f.landmarks;
-    let n = ctx.args.res.levels;
+    let n = ctx.args.set.res.levels;
     let mut rng =
         ChaCha8Rng::seed_from_u64(ctx.args.seed ^ (i as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
     // One corner (q).

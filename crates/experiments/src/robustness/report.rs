@@ -142,7 +142,7 @@ pub(super) fn write_report(
         fig15,
         labels: faces.iter().map(|f| f.name.clone()).collect(),
         names: results.iter().map(|r| r.name.as_str()).collect(),
-        n: args.res.levels,
+        n: args.set.res.levels,
     };
     let mut rep = Report::new(
         out,
@@ -520,7 +520,7 @@ fn single_pole(rep: &mut Report, inp: &Input<'_>) -> Result<()> {
         2,
         "4. Single-pole representation around the nose tip (figures 15-17)",
     );
-    rep.para(&format!("Geodesic polar coordinates around the nose tip: {} rays (straightest geodesics at equal angles from the direction towards the eye-corner midpoint) and N = {n} radius levels of step D/N (radius from the same solver's distance field); keys (level, sector). Under the same perturbation grid the nose tip is moved by the same geodesic distances (directions measured from the eye-midpoint direction).", inp.args.res.sectors));
+    rep.para(&format!("Geodesic polar coordinates around the nose tip: {} rays (straightest geodesics at equal angles from the direction towards the eye-corner midpoint) and N = {n} radius levels of step D/N (radius from the same solver's distance field); keys (level, sector). Under the same perturbation grid the nose tip is moved by the same geodesic distances (directions measured from the eye-midpoint direction).", inp.args.set.res.sectors));
     let mut rows = Vec::new();
     for res in inp.results {
         let series = vec![
