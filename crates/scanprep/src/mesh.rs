@@ -133,10 +133,21 @@ pub fn remove_mesh_spikes(mesh: &TriMesh, factor: f64) -> Result<(TriMesh, usize
     Ok((m, n))
 }
 
-/// The holes of a mesh: its boundary loops other than the outer boundary of each component (the
-/// loop of largest perimeter in it; a closed component has none), each with its [`Hole`] record
-/// (`filled` false). The diameter of a loop is the largest distance between two of its vertices.
-fn inner_loops<'t>(mesh: &TriMesh, topo: &'t Topology) -> Vec<(&'t [u32], Hole)> {
+/// The topology of a mesh and its holes: the boundary loops other than the outer boundary of
+/// each component (the loop of largest perimeter in it; a closed component has none), each with
+/// its [`Hole`] record (`filled` false). The diameter of a loop is the largest distance between
+/// two of its vertices. An error when `max_diameter_mm`, the size of the holes to close, is not
+/// a finite value >= 0.
+fn holes(
+    mesh: &TriMesh,
+    max_diameter_mm: f64,
+) -> Result<(Topology, Vec<(Vec<u32>, Hole)>), ScanPrepError> {
+    if !(max_diameter_mm.is_finite() && max_diameter_mm >= 0.0) {
+        return Err(ScanPrepError::InvalidOption(format!(
+            "max hole diameter {max_diameter_mm} mm (expected a finite value >= 0)"
+        )));
+    }
+    let topo = Topology::new(mesh);
     let p = mesh.positions();
     // Outer loop per component: the longest perimeter (ties to the first listed).
     let mut outer: std::collections::BTreeMap<u32, (f64, usize)> = Default::default();
@@ -169,7 +180,7 @@ fn inner_loops<'t>(mesh: &TriMesh, topo: &'t Topology) -> Vec<(&'t [u32], Hole)>
         };
         let centre = pts.iter().sum::<DVec3>() / pts.len() as f64;
         out.push((
-            l.as_slice(),
+            l.clone(),
             Hole {
                 size: l.len(),
                 diameter_mm,
@@ -178,17 +189,7 @@ fn inner_loops<'t>(mesh: &TriMesh, topo: &'t Topology) -> Vec<(&'t [u32], Hole)>
             },
         ));
     }
-    out
-}
-
-fn check_max_diameter(max_diameter_mm: f64) -> Result<(), ScanPrepError> {
-    if max_diameter_mm.is_finite() && max_diameter_mm >= 0.0 {
-        Ok(())
-    } else {
-        Err(ScanPrepError::InvalidOption(format!(
-            "max hole diameter {max_diameter_mm} mm (expected a finite value >= 0)"
-        )))
-    }
+    Ok((topo, out))
 }
 
 /// Fills the holes of a mesh up to `max_diameter_mm` and reports every hole.
@@ -202,12 +203,11 @@ pub fn fill_mesh_holes(
     mesh: &TriMesh,
     max_diameter_mm: f64,
 ) -> Result<(TriMesh, Vec<Hole>), ScanPrepError> {
-    check_max_diameter(max_diameter_mm)?;
-    let topo = Topology::new(mesh);
+    let (_, loops) = holes(mesh, max_diameter_mm)?;
     let mut pos = mesh.positions().to_vec();
     let mut tris = mesh.triangles().to_vec();
-    let mut holes = Vec::new();
-    for (l, mut hole) in inner_loops(mesh, &topo) {
+    let mut found = Vec::new();
+    for (l, mut hole) in loops {
         if hole.diameter_mm <= max_diameter_mm {
             let c = pos.len() as u32;
             pos.push(hole.centre);
@@ -218,12 +218,12 @@ pub fn fill_mesh_holes(
             }
             hole.filled = true;
         }
-        holes.push(hole);
+        found.push(hole);
     }
-    if holes.iter().all(|h| !h.filled) {
-        return Ok((mesh.clone(), holes));
+    if found.iter().all(|h| !h.filled) {
+        return Ok((mesh.clone(), found));
     }
-    Ok((TriMesh::new(pos, tris)?, holes))
+    Ok((TriMesh::new(pos, tris)?, found))
 }
 
 /// Closes the small holes of a mesh *without new vertices*: each hole up to `max_diameter_mm`
@@ -240,16 +240,14 @@ pub fn close_mesh_gaps(
     mesh: &TriMesh,
     max_diameter_mm: f64,
 ) -> Result<(TriMesh, Vec<Hole>), ScanPrepError> {
-    check_max_diameter(max_diameter_mm)?;
-    let topo = Topology::new(mesh);
+    let (topo, loops) = holes(mesh, max_diameter_mm)?;
     let p = mesh.positions();
     let key = |a: u32, b: u32| (a.min(b), a.max(b));
-    let loops = inner_loops(mesh, &topo);
     // The edges a new edge could coincide with: those around the vertices of the holes to close.
     let mut edges: std::collections::HashSet<(u32, u32)> = Default::default();
     for (l, hole) in &loops {
         if hole.diameter_mm <= max_diameter_mm {
-            for &v in *l {
+            for &v in l {
                 for &f in topo.vertex_faces(v) {
                     let t = mesh.triangles()[f as usize];
                     edges.extend([key(t[0], t[1]), key(t[1], t[2]), key(t[2], t[0])]);
@@ -258,10 +256,10 @@ pub fn close_mesh_gaps(
         }
     }
     let mut tris = mesh.triangles().to_vec();
-    let mut holes = Vec::new();
+    let mut found = Vec::new();
     for (l, mut hole) in loops {
         if hole.diameter_mm <= max_diameter_mm {
-            let mut ring = l.to_vec();
+            let mut ring = l;
             let mut new_tris = Vec::new();
             let mut new_edges = Vec::new();
             while ring.len() > 3 {
@@ -296,12 +294,12 @@ pub fn close_mesh_gaps(
                 }
             }
         }
-        holes.push(hole);
+        found.push(hole);
     }
-    if holes.iter().all(|h| !h.filled) {
-        return Ok((mesh.clone(), holes));
+    if found.iter().all(|h| !h.filled) {
+        return Ok((mesh.clone(), found));
     }
-    Ok((TriMesh::new(p.to_vec(), tris)?, holes))
+    Ok((TriMesh::new(p.to_vec(), tris)?, found))
 }
 
 /// Keeps the faces whose three vertices lie within `radius` of `centre` (then drops unused
