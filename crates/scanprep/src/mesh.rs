@@ -133,15 +133,15 @@ pub fn remove_mesh_spikes(mesh: &TriMesh, factor: f64) -> Result<(TriMesh, usize
     Ok((m, n))
 }
 
+/// A hole's boundary loop (vertex ids, in its faces' winding) and its record.
+type LoopHole = (Vec<u32>, Hole);
+
 /// The topology of a mesh and its holes: the boundary loops other than the outer boundary of
 /// each component (the loop of largest perimeter in it; a closed component has none), each with
 /// its [`Hole`] record (`filled` false). The diameter of a loop is the largest distance between
 /// two of its vertices. An error when `max_diameter_mm`, the size of the holes to close, is not
 /// a finite value >= 0.
-fn holes(
-    mesh: &TriMesh,
-    max_diameter_mm: f64,
-) -> Result<(Topology, Vec<(Vec<u32>, Hole)>), ScanPrepError> {
+fn holes(mesh: &TriMesh, max_diameter_mm: f64) -> Result<(Topology, Vec<LoopHole>), ScanPrepError> {
     if !(max_diameter_mm.is_finite() && max_diameter_mm >= 0.0) {
         return Err(ScanPrepError::InvalidOption(format!(
             "max hole diameter {max_diameter_mm} mm (expected a finite value >= 0)"
