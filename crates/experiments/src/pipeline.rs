@@ -146,7 +146,8 @@ pub enum DescriptorRule {
 /// The bipolar descriptor of a configuration at `n` levels between the references (step
 /// `D / n`; static region: levels up to n with the static mask; whole: levels up to 2n), built
 /// by `bipolar::describe` (precomputed fields) with `rule`; `boundary_margin` leaves out the
-/// band next to the mesh boundary (`bipolar::DescriptorOptions::boundary_margin`).
+/// band next to the mesh boundary (`bipolar::DescriptorOptions::boundary_margin`), and `seen`,
+/// when given, keeps only its `true` vertices (with the static mask, both must hold).
 pub fn bipolar(
     mesh: &TriMesh,
     refs: &Refs,
@@ -154,6 +155,7 @@ pub fn bipolar(
     region: Region,
     rule: DescriptorRule,
     boundary_margin: Option<f64>,
+    seen: Option<&[bool]>,
 ) -> Result<bipolar::Descriptor, bipolar::BipolarError> {
     let step = refs.d / f64::from(n);
     let (max_level, mask) = match region {
@@ -169,6 +171,10 @@ pub fn bipolar(
             )),
         ),
         Region::Whole => (2 * n, None),
+    };
+    let mask = match (mask, seen) {
+        (Some(m), Some(s)) => Some(m.iter().zip(s).map(|(&a, &b)| a && b).collect()),
+        (m, s) => m.or_else(|| s.map(<[bool]>::to_vec)),
     };
     let opts = bipolar::DescriptorOptions {
         levels: bipolar::LevelSpec::Step(step),

@@ -297,10 +297,20 @@ fn describe_scan(face: &Face, setting: &Setting, args: &Args) -> Result<Describe
     let bip = VARIANTS
         .iter()
         .map(|v| {
+            let mut mask = mask.clone();
+            if let Some(deg) = v.max_incidence_deg {
+                match scanprep::incidence_mask(&mesh, DVec3::Z, deg) {
+                    Ok(seen) => mask.iter_mut().zip(seen).for_each(|(m, s)| *m &= s),
+                    Err(e) => {
+                        notes.push(format!("{}: {e}", v.name));
+                        return None;
+                    }
+                }
+            }
             let opts = bipolar::DescriptorOptions {
                 levels: bipolar::LevelSpec::Step(d / f64::from(args.set.res.levels)),
                 max_level: Some(args.set.res.levels),
-                vertex_mask: Some(mask.clone()),
+                vertex_mask: Some(mask),
                 ..v.options()
             };
             match bipolar::describe(
@@ -394,6 +404,9 @@ struct Variant {
     isoangle: Option<(bipolar::IsoCrossings, bipolar::IsoRepeats)>,
     /// Band along the scan's boundary left out (`DescriptorOptions::boundary_margin`, mm).
     margin_mm: Option<f64>,
+    /// Vertices the scanner saw at a larger incidence left out (`scanprep::incidence_mask`,
+    /// degrees; the scans and the face mesh look along +z).
+    max_incidence_deg: Option<f64>,
 }
 
 impl Variant {
@@ -423,36 +436,54 @@ impl Variant {
 /// The bipolar variants: the experiments' rule (`All`, grid keys) and the iso-angle rule with
 /// every crossing (the first behaviour), with the monotone fit keeping repeated keys as ambiguous
 /// (the second) and with the monotone fit and repeated keys resolved to the place nearest the
-/// geodesic between the references (the library's default); and rule `All` without the 6 mm
-/// band along the holes and the border of each scan (the scans' choice in the recognition
-/// benchmark).
-const VARIANTS: [Variant; 5] = {
+/// geodesic between the references (the library's default); rule `All` without the 6 mm band
+/// along the holes and the border of each scan (the scans' choice in the recognition
+/// benchmark), and that with the parts seen at more than 60 or 45 degrees of incidence left out
+/// too.
+const VARIANTS: [Variant; 7] = {
     use bipolar::{IsoCrossings::*, IsoRepeats::*};
     [
         Variant {
             name: "bipolar All",
             isoangle: None,
             margin_mm: None,
+            max_incidence_deg: None,
         },
         Variant {
             name: "bipolar iso-angle, every crossing",
             isoangle: Some((Every, Ambiguous)),
             margin_mm: None,
+            max_incidence_deg: None,
         },
         Variant {
             name: "bipolar iso-angle, monotone, repeats ambiguous",
             isoangle: Some((Monotone, Ambiguous)),
             margin_mm: None,
+            max_incidence_deg: None,
         },
         Variant {
             name: "bipolar iso-angle, monotone, nearest",
             isoangle: Some((Monotone, Nearest)),
             margin_mm: None,
+            max_incidence_deg: None,
         },
         Variant {
             name: "bipolar All, 6 mm band left out",
             isoangle: None,
             margin_mm: Some(6.0),
+            max_incidence_deg: None,
+        },
+        Variant {
+            name: "bipolar All, band and incidence over 60 degrees left out",
+            isoangle: None,
+            margin_mm: Some(6.0),
+            max_incidence_deg: Some(60.0),
+        },
+        Variant {
+            name: "bipolar All, band and incidence over 45 degrees left out",
+            isoangle: None,
+            margin_mm: Some(6.0),
+            max_incidence_deg: Some(45.0),
         },
     ]
 };

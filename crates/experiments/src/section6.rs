@@ -187,6 +187,7 @@ impl Ctx<'_> {
                     Region::Static,
                     DescriptorRule::CrateAll,
                     None,
+                    None,
                 ),
                 || format!("bipolar descriptor of {name}"),
             )

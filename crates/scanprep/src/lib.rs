@@ -33,7 +33,7 @@ pub use grid::{
     SpikeOptions, MAX_COORDINATE_MM,
 };
 pub use mesh::{
-    close_mesh_gaps, compact, crop_sphere, fill_mesh_holes, remove_mesh_spikes,
+    close_mesh_gaps, compact, crop_sphere, fill_mesh_holes, incidence_mask, remove_mesh_spikes,
     remove_small_components, taubin_smooth,
 };
 

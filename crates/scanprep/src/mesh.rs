@@ -365,3 +365,46 @@ pub fn taubin_smooth(mesh: &TriMesh, iterations: usize) -> Result<TriMesh, ScanP
     }
     Ok(TriMesh::new(p, mesh.triangles().to_vec())?)
 }
+
+/// The vertices a scanner saw at an incidence of at most `max_incidence_deg`: those whose normal
+/// makes at most that angle with `toward_scanner`, the direction from the surface to the
+/// scanner (+z for a range grid in the scanner's frame, as `.bnt` files and `rangescan` give
+/// them). Beyond about 60 degrees a scanner's depth noise runs nearly along the surface and its
+/// samples thin out, so what lies there is measured least well; leaving it out of a descriptor
+/// is the choice this mask offers. Normals are area-weighted and averaged twice over each
+/// vertex's one-ring, so that depth noise does not tip single vertices across the limit.
+/// An error when the direction is zero or not finite, or the angle is not within [0, 180].
+pub fn incidence_mask(
+    mesh: &TriMesh,
+    toward_scanner: DVec3,
+    max_incidence_deg: f64,
+) -> Result<Vec<bool>, ScanPrepError> {
+    let d = toward_scanner.normalize_or_zero();
+    if !(d.is_finite() && d != DVec3::ZERO) {
+        return Err(ScanPrepError::InvalidOption(format!(
+            "scanner direction {toward_scanner:?} (expected a finite, non-zero vector)"
+        )));
+    }
+    if !(0.0..=180.0).contains(&max_incidence_deg) {
+        return Err(ScanPrepError::InvalidOption(format!(
+            "max incidence {max_incidence_deg} degrees (expected 0 to 180)"
+        )));
+    }
+    let adj = VertexAdjacency::new(mesh);
+    let mut n = mesh.vertex_normals();
+    for _ in 0..2 {
+        n = adj
+            .iter()
+            .enumerate()
+            .map(|(v, ring)| {
+                ring.iter()
+                    .fold(n[v], |s, &u| s + n[u as usize])
+                    .normalize_or_zero()
+            })
+            .collect();
+    }
+    let c = max_incidence_deg.to_radians().cos();
+    Ok(n.iter()
+        .map(|n| *n != DVec3::ZERO && n.dot(d) >= c)
+        .collect())
+}

@@ -96,6 +96,10 @@ pub struct Args {
     /// descriptor leaves out (`--scans`; 0 keeps everything).
     #[arg(long, default_value_t = SCAN_BOUNDARY_MARGIN_MM)]
     pub boundary_margin: f64,
+    /// Parts of each scan seen at more than this incidence (degrees) left out of the bipolar
+    /// descriptor (`--scans`; 0 keeps everything).
+    #[arg(long, default_value_t = 0.0)]
+    pub max_incidence: f64,
 }
 
 /// One sampled face.
@@ -176,6 +180,9 @@ struct DescribeOptions {
     iso_levels: Option<IsoLevels>,
     /// Band next to the mesh boundary left out of the bipolar descriptor (mesh units).
     boundary_margin: Option<f64>,
+    /// Parts seen at more than this incidence (degrees, scanner along +z) left out of the
+    /// bipolar descriptor (`scanprep::incidence_mask`).
+    max_incidence_deg: Option<f64>,
 }
 
 /// The three fields of a face cut off at 1.4 |q - r| (corners r, q; nose tip), D, and the wall
@@ -267,6 +274,13 @@ fn describe_face(
         frame: face_frame(mesh, r, q, nose),
     };
     let t = Instant::now();
+    let seen = match o.max_incidence_deg {
+        Some(deg) => Some(
+            scanprep::incidence_mask(mesh, DVec3::Z, deg)
+                .map_err(|e| format!("incidence mask: {e}"))?,
+        ),
+        None => None,
+    };
     let bip = bipolar(
         mesh,
         &refs,
@@ -274,6 +288,7 @@ fn describe_face(
         Region::Static,
         DescriptorRule::CrateAll,
         o.boundary_margin,
+        seen.as_deref(),
     )
     .map_err(|e| format!("bipolar descriptor: {e}"));
     let t_bip = t.elapsed().as_secs_f64();
@@ -795,6 +810,7 @@ pub fn run(args: Args) -> Result<()> {
         sectors: args.res.sectors,
         iso_levels: Some(iso_levels),
         boundary_margin: None,
+        max_incidence_deg: None,
     };
     let elastic = elastic_options(args.curve_samples);
     // Landmark detection.

@@ -327,6 +327,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         sectors: args.res.sectors,
         iso_levels: None,
         boundary_margin: (args.boundary_margin > 0.0).then_some(args.boundary_margin),
+        max_incidence_deg: (args.max_incidence > 0.0).then_some(args.max_incidence),
     };
     let elastic = elastic_options(args.curve_samples);
     // Specs: gallery, main probes, sweeps (each face its own scan seed).

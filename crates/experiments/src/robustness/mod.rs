@@ -133,7 +133,7 @@ impl Ctx<'_> {
         region: Region,
         what: impl FnOnce() -> String,
     ) -> Desc {
-        match bipolar(mesh, refs, n, region, self.args.descriptor, None) {
+        match bipolar(mesh, refs, n, region, self.args.descriptor, None, None) {
             Ok(d) => Some(d),
             Err(e) => {
                 self.failures
