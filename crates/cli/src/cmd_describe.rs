@@ -55,6 +55,11 @@ pub struct Args {
     /// holes, eye openings, a scan's border (on scans in mm, 6 is the benchmark's choice).
     #[arg(long = "boundary-margin")]
     pub boundary_margin: Option<f64>,
+    /// Leave out what a range scanner saw at more than this incidence (degrees), for a scan in
+    /// the scanner's frame looking along -z (`.bnt` files, `bipolar scan`): grazing parts, where
+    /// depth noise runs along the surface (60 is the scan benchmark's choice).
+    #[arg(long = "max-incidence", value_name = "DEG")]
+    pub max_incidence: Option<f64>,
     /// Output file: .csv, .json or .ply.
     #[arg(long)]
     pub out: PathBuf,
@@ -102,6 +107,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         refs.push(resolver.resolve(r, "--ref")?.source);
     }
     let t0 = Instant::now();
+    let mut opts = opts;
+    if let Some(deg) = args.max_incidence {
+        opts.vertex_mask = Some(
+            scanprep::incidence_mask(&mesh, meshcore::DVec3::Z, deg).context("--max-incidence")?,
+        );
+    }
     let solver = geodesic::new_solver(&mesh, method)
         .with_context(|| format!("preparing the {} geodesic solver", method.name()))?;
     let surface = bipolar::Surface::new(mesh);

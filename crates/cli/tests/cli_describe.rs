@@ -182,3 +182,47 @@ fn boundary_margin_leaves_out_the_band_along_the_border() {
     // Kept faces have every vertex at least 4 from the border: points at least 3 (one cell).
     assert!(cut.points.iter().all(|p| border(p.position) >= 3.0 - 1e-9));
 }
+
+#[test]
+fn max_incidence_leaves_out_what_the_scanner_saw_at_grazing_angles() {
+    // A sheet seen along z: flat for x <= 15, then rising at 70 degrees (incidence 70).
+    let dir = tempfile::tempdir().unwrap();
+    let rise = 70f64.to_radians().tan();
+    let sheet =
+        testsupport::shapes::grid(30, 30, testsupport::shapes::Diagonals::Uniform, |i, j| {
+            let x = i as f64;
+            glam::DVec3::new(x, j as f64, (x - 15.0).max(0.0) * rise)
+        })
+        .unwrap();
+    let obj = testsupport::cli::write_mesh(dir.path(), "sheet.obj", &sheet);
+    let id = |i: usize, j: usize| (j * 31 + i).to_string();
+    let run = |extra: &[&str], name: &str| {
+        let out = dir.path().join(name);
+        let (a, b) = (id(5, 15), id(20, 15));
+        let base = ["describe", arg(&obj), "--ref-a", &a, "--ref-b", &b];
+        let opts = ["--step", "2", "--rule", "all", "--out", arg(&out)];
+        bipolar(&[&base[..], &opts, extra].concat()).success();
+        bipolar::io::read_csv(&out).unwrap()
+    };
+    let all = run(&[], "all.csv");
+    let seen = run(&["--max-incidence", "60"], "seen.csv");
+    // Kept points lie on faces whose vertices all passed: on the flat part, up to the fold's
+    // averaged normals (two rings).
+    assert!(all.points.iter().any(|p| p.position.x > 18.0));
+    assert!(!seen.is_empty() && seen.len() < all.len());
+    assert!(seen.points.iter().all(|p| p.position.x <= 17.0 + 1e-9));
+    let err = bipolar(&[
+        "describe",
+        arg(&obj),
+        "--ref-a",
+        &id(5, 15),
+        "--ref-b",
+        &id(20, 15),
+        "--max-incidence",
+        "200",
+        "--out",
+        arg(&dir.path().join("x.csv")),
+    ])
+    .failure();
+    assert!(err.contains("max incidence 200"), "{err}");
+}
