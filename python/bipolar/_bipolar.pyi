@@ -170,6 +170,7 @@ def describe(
     landmarks: Optional[Union[PathLike, Dict[str, ArrayLike]]] = None,
     solver: Optional[GeodesicSolver] = None,
     boundary_margin: Optional[float] = None,
+    max_incidence: Optional[float] = None,
 ) -> Descriptor: ...
 def read_descriptor(path: PathLike) -> Descriptor: ...
 

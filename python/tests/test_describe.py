@@ -122,6 +122,29 @@ def test_boundary_margin_leaves_out_the_band_along_the_border(bump_mesh, bump_de
         bipolar.describe(bump_mesh, 0, 1599, boundary_margin=-1.0)
 
 
+def test_max_incidence_leaves_out_the_steep_parts(bump_mesh):
+    # Seen along z, the incidence at (x, y) is the slope angle of the bump z = f(x, y).
+    def incidence(p):
+        x, y = p[:, 0], p[:, 1]
+        g = 0.4 * np.exp(-((x - 0.1) ** 2 + (y + 0.2) ** 2) / 0.3) / 0.3
+        fx = -2.0 * (x - 0.1) * g + 0.1 * y
+        fy = -2.0 * (y + 0.2) * g + 0.1 * x
+        return np.degrees(np.arctan(np.hypot(fx, fy)))
+
+    full = bipolar.describe(bump_mesh, 0, 1599, levels=12, rule="all")
+    cut = bipolar.describe(bump_mesh, 0, 1599, levels=12, rule="all", max_incidence=20.0)
+    assert 0 < len(cut) < len(full)
+    assert incidence(full.points).max() > 30.0
+    # Kept points are on faces whose (ring-averaged) vertex normals all passed.
+    assert incidence(cut.points).max() < 28.0
+    # The fields are the same: with rule "all" every kept point is a point of the full
+    # descriptor (the iso-angle rule fits along curve runs, which the mask shortens).
+    d = np.linalg.norm(cut.points[:, None, :] - full.points[None, :, :], axis=2)
+    assert d.min(axis=1).max() < 1e-12
+    with pytest.raises(errors.InputError, match="max incidence"):
+        bipolar.describe(bump_mesh, 0, 1599, max_incidence=-5.0)
+
+
 def test_describe_bad_input(bump_mesh):
     n = bump_mesh.n_vertices
     with pytest.raises(errors.InputError, match="levels or step"):

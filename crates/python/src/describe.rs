@@ -137,11 +137,14 @@ pub(crate) fn references(
 /// geodesic ``method`` ``"exact"`` | ``"fmm"`` | ``"heat"`` | ``"dijkstra"``, or a prepared
 /// ``solver`` for this mesh (then ``method`` is ignored). ``boundary_margin`` leaves out the band
 /// within that geodesic distance (mesh units) of the mesh boundary: holes, eye openings, a
-/// scan's border. The GIL is released while it runs.
+/// scan's border. ``max_incidence`` (degrees) leaves out what a range scanner looking along -z
+/// saw at a larger incidence (a scan in its own frame, as ``read_bnt`` and ``scan`` give it).
+/// The GIL is released while it runs.
 #[pyfunction]
 #[pyo3(signature = (mesh, ref_a, ref_b, *, refs=None, levels=None, step=None, max_level=None,
                     angles=8, alpha=0.95, rule="isoangle", tolerance=None, tangent="gradient",
-                    method="exact", landmarks=None, solver=None, boundary_margin=None))]
+                    method="exact", landmarks=None, solver=None, boundary_margin=None,
+                    max_incidence=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn describe(
     py: Python<'_>,
@@ -161,6 +164,7 @@ pub fn describe(
     landmarks: Option<&Bound<'_, PyAny>>,
     solver: Option<&Bound<'_, PyGeodesicSolver>>,
     boundary_margin: Option<f64>,
+    max_incidence: Option<f64>,
 ) -> PyResult<PyDescriptor> {
     // The options of `bipolar describe` (same defaults and rules).
     let levels = match (levels, step) {
@@ -185,6 +189,15 @@ pub fn describe(
     };
     let m = mesh_arg(mesh)?;
     let mesh = m.mesh();
+    let opts = match max_incidence {
+        Some(deg) => DescriptorOptions {
+            vertex_mask: Some(
+                scanprep::incidence_mask(mesh, DVec3::Z, deg).map_err(errors::scanprep)?,
+            ),
+            ..opts
+        },
+        None => opts,
+    };
     let given = landmarks.map(given_landmarks).transpose()?;
     let mut specs = vec![
         ("ref_a".to_string(), ref_a.clone()),
