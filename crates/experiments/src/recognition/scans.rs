@@ -467,7 +467,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         "Recognition benchmark on range scans of sampled ICT faces",
     )?;
     rep.para(&format!(
-        "{identities} identities x {expressions} faces (seed {}). Gallery: {} neutral frontal scans ({}). Probes: {} scans of the other expressions, each under a random yaw of 0-45 degrees to either side and a noise of {} mm (other settings as the gallery). Scans by `rangescan` (orthographic), cleaned by `scanprep` (spikes, holes up to 10 mm, small components, crop of {} mm around the true nose tip{}). Geodesics: {}. Bipolar descriptor: static area, N = {} levels between the outer eye corners; single pole: {} sectors around the nose tip; ICP: about {} probe vertices onto the gallery surface from the 3-landmark alignment, 10 % trimmed, score = RMS closest-point distance (mm); facial curves: N level curves of the nose-tip field up to D, elastic distance ({} segments per curve, one start-point candidate, one alternation), root sum of squares; iso-curvature: {} levels per principal field (quantiles of the first gallery scan) in the geodesic disc of radius D around the nose tip, normalised RMS closest-point distance after an ICP started from the 3-landmark alignment. Times, single thread (one-thread pool after the parallel work): per comparison the mean over up to 24 probe x gallery pairs per group and landmark set; per description the median over the first 6 gallery scans (ground truth) of the fields a representation needs plus its build. Ground-truth landmarks: the model's landmark vertices carried through the scanner, at the nearest vertex of the cleaned scan (a landmark the scanner does not see is a failure); detected: `landmarks::detect` on the cleaned scan.",
+        "{identities} identities x {expressions} faces (seed {}). Gallery: {} neutral frontal scans ({}). Probes: {} scans of the other expressions, each under a random yaw of 0-45 degrees to either side and a noise of {} mm (other settings as the gallery). Scans by `rangescan` (orthographic), cleaned by `scanprep` (spikes, holes up to 10 mm, small components, crop of {} mm around the true nose tip{}). Geodesics: {}. Bipolar descriptor: static area, N = {} levels between the outer eye corners, {}; single pole: {} sectors around the nose tip; ICP: about {} probe vertices onto the gallery surface from the 3-landmark alignment, 10 % trimmed, score = RMS closest-point distance (mm); facial curves: N level curves of the nose-tip field up to D, elastic distance ({} segments per curve, one start-point candidate, one alternation), root sum of squares; iso-curvature: {} levels per principal field (quantiles of the first gallery scan) in the geodesic disc of radius D around the nose tip, normalised RMS closest-point distance after an ICP started from the 3-landmark alignment. Times, single thread (one-thread pool after the parallel work): per comparison the mean over up to 24 probe x gallery pairs per group and landmark set; per description the median over the first 6 gallery scans (ground truth) of the fields a representation needs plus its build. Ground-truth landmarks: the model's landmark vertices carried through the scanner, at the nearest vertex of the cleaned scan (a landmark the scanner does not see is a failure); detected: `landmarks::detect` on the cleaned scan.",
         args.seed,
         gallery.len(),
         base.label(),
@@ -480,6 +480,17 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
             .unwrap_or_default(),
         method.name(),
         args.res.levels,
+        match (dopt.boundary_margin, dopt.max_incidence_deg) {
+            (None, None) => "every part of the scan".to_string(),
+            (b, i) => format!(
+                "leaving out {}",
+                b.map(|m| format!("a band of {m} mm along the holes and the border"))
+                    .into_iter()
+                    .chain(i.map(|d| format!("what the scanner saw at more than {d} degrees of incidence")))
+                    .collect::<Vec<_>>()
+                    .join(" and ")
+            ),
+        },
         args.res.sectors,
         args.icp_points,
         args.curve_samples,
@@ -629,6 +640,8 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         "sweep_identities": sweep_ids,
         "scan_edge_mm": scan_opts.target_edge_mm,
         "scan_smoothing_iterations": scan_opts.smoothing_iterations,
+        "boundary_margin_mm": dopt.boundary_margin,
+        "max_incidence_deg": dopt.max_incidence_deg,
         "sweeps": sweep_defs.iter().zip(&sweep_results).map(|(sw, pv)| serde_json::json!({
             "name": sw.name,
             "unit": sw.unit,
