@@ -159,20 +159,31 @@ fn landmark_names_are_detected_or_fail_clearly() {
     }
 }
 
+/// `describe` with rule `all` and step 2 on a 30 x 30 grid mesh (31 vertices a row), the
+/// references at columns `cols` of the middle row, plus `extra` options; the descriptor read back.
+fn grid_describe(
+    obj: &std::path::Path,
+    cols: (usize, usize),
+    extra: &[&str],
+    out: &std::path::Path,
+) -> bipolar::Descriptor {
+    let (a, b) = (
+        (15 * 31 + cols.0).to_string(),
+        (15 * 31 + cols.1).to_string(),
+    );
+    let base = ["describe", arg(obj), "--ref-a", &a, "--ref-b", &b];
+    let opts = ["--step", "2", "--rule", "all", "--out", arg(out)];
+    bipolar(&[&base[..], &opts, extra].concat()).success();
+    bipolar::io::read_csv(out).unwrap()
+}
+
 #[test]
 fn boundary_margin_leaves_out_the_band_along_the_border() {
     // A 30 x 30 grid of unit cells; references (5, 15) and (25, 15), 20 apart.
     let dir = tempfile::tempdir().unwrap();
     let obj = grid_obj(dir.path(), "grid.obj", 30, 1.0);
-    let id = |i: usize, j: usize| (j * 31 + i).to_string();
-    let run = |extra: &[&str], name: &str| {
-        let out = dir.path().join(name);
-        let (a, b) = (id(5, 15), id(25, 15));
-        let base = ["describe", arg(&obj), "--ref-a", &a, "--ref-b", &b];
-        let opts = ["--step", "2", "--rule", "all", "--out", arg(&out)];
-        bipolar(&[&base[..], &opts, extra].concat()).success();
-        bipolar::io::read_csv(&out).unwrap()
-    };
+    let run =
+        |extra: &[&str], name: &str| grid_describe(&obj, (5, 25), extra, &dir.path().join(name));
     let all = run(&[], "all.csv");
     let cut = run(&["--boundary-margin", "4"], "cut.csv");
     // Distance to the square's border [0, 30]^2.
@@ -195,15 +206,8 @@ fn max_incidence_leaves_out_what_the_scanner_saw_at_grazing_angles() {
         })
         .unwrap();
     let obj = testsupport::cli::write_mesh(dir.path(), "sheet.obj", &sheet);
-    let id = |i: usize, j: usize| (j * 31 + i).to_string();
-    let run = |extra: &[&str], name: &str| {
-        let out = dir.path().join(name);
-        let (a, b) = (id(5, 15), id(20, 15));
-        let base = ["describe", arg(&obj), "--ref-a", &a, "--ref-b", &b];
-        let opts = ["--step", "2", "--rule", "all", "--out", arg(&out)];
-        bipolar(&[&base[..], &opts, extra].concat()).success();
-        bipolar::io::read_csv(&out).unwrap()
-    };
+    let run =
+        |extra: &[&str], name: &str| grid_describe(&obj, (5, 20), extra, &dir.path().join(name));
     let all = run(&[], "all.csv");
     let seen = run(&["--max-incidence", "60"], "seen.csv");
     // Kept points lie on faces whose vertices all passed: on the flat part, up to the fold's
@@ -211,13 +215,14 @@ fn max_incidence_leaves_out_what_the_scanner_saw_at_grazing_angles() {
     assert!(all.points.iter().any(|p| p.position.x > 18.0));
     assert!(!seen.is_empty() && seen.len() < all.len());
     assert!(seen.points.iter().all(|p| p.position.x <= 17.0 + 1e-9));
+    let id = |i: usize| (15 * 31 + i).to_string();
     let err = bipolar(&[
         "describe",
         arg(&obj),
         "--ref-a",
-        &id(5, 15),
+        &id(5),
         "--ref-b",
-        &id(20, 15),
+        &id(20),
         "--max-incidence",
         "200",
         "--out",
