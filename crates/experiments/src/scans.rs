@@ -225,6 +225,10 @@ pub struct ScanSetOptions {
     /// Taubin smoothing iterations of the cleaned scan, before the decimation
     /// (`CleanOptions::smoothing_iterations`).
     pub smoothing_iterations: usize,
+    /// Taubin smoothing iterations of a copy of the cleaned scan that detection runs on (the
+    /// landmarks keep their vertices and are placed on the scan itself); 0: detection on the
+    /// scan.
+    pub detect_smoothing: usize,
 }
 
 impl Default for ScanSetOptions {
@@ -234,6 +238,7 @@ impl Default for ScanSetOptions {
             detect: Some(DetectOptions::default()),
             target_edge_mm: None,
             smoothing_iterations: 0,
+            detect_smoothing: 0,
         }
     }
 }
@@ -369,17 +374,35 @@ pub fn scan_face(
     let truth: [Truth; 5] = truth
         .try_into()
         .map_err(|_| anyhow::anyhow!("the scanner returned another number of landmarks"))?;
+    let smoothed = match options.detect_smoothing {
+        0 => None,
+        k => Some(scanprep::taubin_smooth(&mesh, k)?),
+    };
+    let seen_by_detector = smoothed.as_ref().unwrap_or(&mesh);
     let detected = match &options.detect {
-        Some(o) => landmarks::mesh_units_per_model_unit(&mesh, generic)
+        Some(o) => landmarks::mesh_units_per_model_unit(seen_by_detector, generic)
             .and_then(|s| {
                 landmarks::detect_with(
-                    &mesh,
+                    seen_by_detector,
                     generic,
                     &DetectOptions {
                         mesh_units_per_model_unit: s,
                         ..*o
                     },
                 )
+            })
+            .map(|mut found| {
+                // The same vertices, at their places on the scan.
+                for l in [
+                    &mut found.outer_eye_right,
+                    &mut found.inner_eye_right,
+                    &mut found.inner_eye_left,
+                    &mut found.outer_eye_left,
+                    &mut found.nose_tip,
+                ] {
+                    l.position = mesh.position(l.vertex);
+                }
+                found
             })
             .map_err(|e| e.to_string()),
         None => Err("not run".into()),

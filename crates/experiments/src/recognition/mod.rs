@@ -86,6 +86,10 @@ pub struct Args {
     /// none).
     #[arg(long, default_value_t = 0)]
     pub scan_smooth: usize,
+    /// Taubin smoothing iterations of a copy of each cleaned scan that landmark detection runs
+    /// on (`--scans`; the landmarks keep their vertices; 0: detection on the scan itself).
+    #[arg(long, default_value_t = 0)]
+    pub detect_smooth: usize,
     /// Identities whose probes are rescanned at every sweep setting (`--scans`).
     #[arg(long, default_value_t = 4)]
     pub sweep_identities: usize,

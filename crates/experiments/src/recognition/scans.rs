@@ -320,6 +320,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         crop_radius_mm: args.scan.crop_radius,
         target_edge_mm: (args.scan_edge > 0.0).then_some(args.scan_edge),
         smoothing_iterations: args.scan_smooth,
+        detect_smoothing: args.detect_smooth,
         ..ScanSetOptions::default()
     };
     let mut dopt = DescribeOptions {
@@ -640,6 +641,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         "sweep_identities": sweep_ids,
         "scan_edge_mm": scan_opts.target_edge_mm,
         "scan_smoothing_iterations": scan_opts.smoothing_iterations,
+        "detect_smoothing_iterations": scan_opts.detect_smoothing,
         "boundary_margin_mm": dopt.boundary_margin,
         "max_incidence_deg": dopt.max_incidence_deg,
         "sweeps": sweep_defs.iter().zip(&sweep_results).map(|(sw, pv)| serde_json::json!({
