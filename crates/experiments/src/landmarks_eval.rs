@@ -582,7 +582,13 @@ fn run_scans(
     }
     let pb = bar(specs.len(), "scanning and detecting");
     let opts = ScanSetOptions {
-        crop_radius_mm: args.scan.crop_radius,
+        clean: scanprep::CleanOptions {
+            crop: Some(scanprep::Crop {
+                centre: DVec3::ZERO,
+                radius_mm: args.scan.crop_radius,
+            }),
+            ..scanprep::CleanOptions::default()
+        },
         detect: Some(*dopt),
         ..ScanSetOptions::default()
     };

@@ -213,18 +213,13 @@ impl ScannedFace {
 /// Options of [`scan_faces`].
 #[derive(Debug, Clone)]
 pub struct ScanSetOptions {
-    /// Crop radius around the nose tip, mm.
-    pub crop_radius_mm: f64,
+    /// How every scan is cleaned (mm); its crop sphere, when set, is centred on each scan's
+    /// true nose tip (the centre given here is not used).
+    pub clean: CleanOptions,
     /// Detection options for every cleaned scan (their `mesh_units_per_model_unit` is replaced
     /// by the one recognised from the scan, `landmarks::mesh_units_per_model_unit`); `None`:
     /// no detection.
     pub detect: Option<DetectOptions>,
-    /// Target edge length (mm) of the cleaned scan, decimated by `scanprep`
-    /// (`CleanOptions::target_edge_mm`); `None`: the scan's own sampling.
-    pub target_edge_mm: Option<f64>,
-    /// Taubin smoothing iterations of the cleaned scan, before the decimation
-    /// (`CleanOptions::smoothing_iterations`).
-    pub smoothing_iterations: usize,
     /// Taubin smoothing iterations of a copy of the cleaned scan that detection runs on (the
     /// landmarks keep their vertices and are placed on the scan itself); 0: detection on the
     /// scan.
@@ -234,10 +229,11 @@ pub struct ScanSetOptions {
 impl Default for ScanSetOptions {
     fn default() -> Self {
         Self {
-            crop_radius_mm: scanprep::DEFAULT_CROP_RADIUS_MM,
+            clean: CleanOptions {
+                crop: Some(Crop::around(DVec3::ZERO)),
+                ..CleanOptions::default()
+            },
             detect: Some(DetectOptions::default()),
-            target_edge_mm: None,
-            smoothing_iterations: 0,
             detect_smoothing: 0,
         }
     }
@@ -344,13 +340,8 @@ pub fn scan_face(
     let cleaned = scanprep::clean(
         Input::Grid(&scan.grid),
         &CleanOptions {
-            crop: Some(Crop {
-                centre: nose,
-                radius_mm: options.crop_radius_mm,
-            }),
-            target_edge_mm: options.target_edge_mm,
-            smoothing_iterations: options.smoothing_iterations,
-            ..CleanOptions::default()
+            crop: options.clean.crop.map(|c| Crop { centre: nose, ..c }),
+            ..options.clean.clone()
         },
     )?;
     let t2 = Instant::now();

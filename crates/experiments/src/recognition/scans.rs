@@ -26,6 +26,7 @@ use meshcore::{DVec3, FaceLocator, TriMesh};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
+use scanprep::{CleanOptions, Crop};
 use std::time::Instant;
 
 /// The two landmark sets.
@@ -317,9 +318,15 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         );
     }
     let scan_opts = ScanSetOptions {
-        crop_radius_mm: args.scan.crop_radius,
-        target_edge_mm: (args.scan_edge > 0.0).then_some(args.scan_edge),
-        smoothing_iterations: args.scan_smooth,
+        clean: CleanOptions {
+            crop: Some(Crop {
+                centre: DVec3::ZERO,
+                radius_mm: args.scan.crop_radius,
+            }),
+            target_edge_mm: (args.scan_edge > 0.0).then_some(args.scan_edge),
+            smoothing_iterations: args.scan_smooth,
+            ..CleanOptions::default()
+        },
         detect_smoothing: args.detect_smooth,
         ..ScanSetOptions::default()
     };
@@ -476,6 +483,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         PROBE_NOISE.map(|x| x.to_string()).join(" / "),
         args.scan.crop_radius,
         scan_opts
+            .clean
             .target_edge_mm
             .map(|e| format!(", then decimated to {e} mm edges"))
             .unwrap_or_default(),
@@ -639,8 +647,8 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
     let fields = serde_json::json!({
         "gallery_scan": base.label(),
         "sweep_identities": sweep_ids,
-        "scan_edge_mm": scan_opts.target_edge_mm,
-        "scan_smoothing_iterations": scan_opts.smoothing_iterations,
+        "scan_edge_mm": scan_opts.clean.target_edge_mm,
+        "scan_smoothing_iterations": scan_opts.clean.smoothing_iterations,
         "detect_smoothing_iterations": scan_opts.detect_smoothing,
         "boundary_margin_mm": dopt.boundary_margin,
         "max_incidence_deg": dopt.max_incidence_deg,
