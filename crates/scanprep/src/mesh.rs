@@ -227,10 +227,11 @@ pub fn fill_mesh_holes(
 }
 
 /// Closes the small holes of a mesh *without new vertices*: each hole up to `max_diameter_mm`
-/// (holes as in [`fill_mesh_holes`]) is triangulated from its own boundary vertices by clipping,
-/// again and again, the ear whose new edge is the shortest. Every hole is reported; one is left
-/// open (`filled` false) when it is larger, or when no ear can be cut without a degenerate
-/// triangle or an edge the mesh already has (which would make it non-manifold).
+/// (holes as in [`fill_mesh_holes`]) is split into simple cycles where its loop passes a vertex
+/// twice (a bow-tie), and each cycle is triangulated from its own vertices by clipping, again
+/// and again, the ear whose new edge is the shortest. Every hole is reported; one is left open
+/// (`filled` false) when it is larger, or when some ear cannot be cut without an edge the mesh
+/// already has (which would make it non-manifold).
 ///
 /// This is what a range grid's triangulation needs after its long-edge rule: with depth noise,
 /// two neighbouring samples can differ by more than the rule allows, and the cells around them
@@ -259,33 +260,16 @@ pub fn close_mesh_gaps(
     let mut found = Vec::new();
     for (l, mut hole) in loops {
         if hole.diameter_mm <= max_diameter_mm {
-            let mut ring = l;
+            // A loop through a bow-tie vertex visits it twice: each simple cycle is its own
+            // polygon.
             let mut new_tris = Vec::new();
             let mut new_edges = Vec::new();
-            while ring.len() > 3 {
-                let n = ring.len();
-                // The ear at i cuts (prev, i, next) off with the new edge prev-next.
-                let best = (0..n)
-                    .filter_map(|i| {
-                        let (a, b, c) = (ring[(i + n - 1) % n], ring[i], ring[(i + 1) % n]);
-                        let ok = a != b && b != c && a != c && !edges.contains(&key(a, c));
-                        ok.then(|| (p[a as usize].distance(p[c as usize]), i))
-                    })
-                    .min_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
-                let Some((_, i)) = best else { break };
-                let (a, b, c) = (ring[(i + n - 1) % n], ring[i], ring[(i + 1) % n]);
-                // The loop follows its faces' winding; the ear runs the other way along it.
-                new_tris.push([c, b, a]);
-                edges.insert(key(a, c));
-                new_edges.push(key(a, c));
-                ring.remove(i);
-            }
-            let closable = ring.len() == 3 && {
-                let (a, b, c) = (ring[0], ring[1], ring[2]);
-                a != b && b != c && a != c
-            };
-            if closable {
-                new_tris.push([ring[2], ring[1], ring[0]]);
+            let cycles = simple_cycles(&l);
+            let closed = !cycles.is_empty()
+                && cycles
+                    .into_iter()
+                    .all(|ring| clip_ears(ring, p, &mut edges, &mut new_edges, &mut new_tris, key));
+            if closed {
                 tris.extend(new_tris);
                 hole.filled = true;
             } else {
@@ -300,6 +284,64 @@ pub fn close_mesh_gaps(
         return Ok((mesh.clone(), found));
     }
     Ok((TriMesh::new(p.to_vec(), tris)?, found))
+}
+
+/// The simple cycles of a closed vertex walk, in its order: where a vertex comes back, the part
+/// of the walk since its first visit is cut off as a cycle. Cycles of fewer than 3 vertices
+/// (an edge walked both ways) are dropped.
+fn simple_cycles(walk: &[u32]) -> Vec<Vec<u32>> {
+    let mut cycles = Vec::new();
+    let mut stack: Vec<u32> = Vec::new();
+    for &v in walk {
+        if let Some(i) = stack.iter().position(|&u| u == v) {
+            let mut cycle = vec![v];
+            cycle.extend(stack.split_off(i + 1));
+            cycles.push(cycle);
+        } else {
+            stack.push(v);
+        }
+    }
+    cycles.push(stack);
+    cycles.retain(|c| c.len() >= 3);
+    cycles
+}
+
+/// Triangulates the simple polygon `ring` (in its faces' winding) by clipping, again and again,
+/// the ear whose new edge is the shortest, never one whose new edge is in `edges`. Appends the
+/// triangles (running the other way along the ring) to `tris` and the new edges to `edges` and
+/// `added`; false when some ear could not be cut.
+fn clip_ears(
+    mut ring: Vec<u32>,
+    p: &[DVec3],
+    edges: &mut std::collections::HashSet<(u32, u32)>,
+    added: &mut Vec<(u32, u32)>,
+    tris: &mut Vec<[u32; 3]>,
+    key: impl Fn(u32, u32) -> (u32, u32),
+) -> bool {
+    while ring.len() > 3 {
+        let n = ring.len();
+        let ear = |i: usize| (ring[(i + n - 1) % n], ring[i], ring[(i + 1) % n]);
+        let best = (0..n)
+            .filter(|&i| {
+                !edges.contains(&{
+                    let (a, _, c) = ear(i);
+                    key(a, c)
+                })
+            })
+            .map(|i| {
+                let (a, _, c) = ear(i);
+                (p[a as usize].distance(p[c as usize]), i)
+            })
+            .min_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+        let Some((_, i)) = best else { return false };
+        let (a, b, c) = ear(i);
+        tris.push([c, b, a]);
+        edges.insert(key(a, c));
+        added.push(key(a, c));
+        ring.remove(i);
+    }
+    tris.push([ring[2], ring[1], ring[0]]);
+    true
 }
 
 /// Keeps the faces whose three vertices lie within `radius` of `centre` (then drops unused

@@ -232,6 +232,18 @@ fn mesh_gaps_are_closed_from_their_own_vertices() {
             .sum()
     };
     assert!((area(&closed) - area(&m) - 3.0).abs() < 1e-9);
+    // Two one-cell gaps touching at a corner: one boundary loop through that vertex twice.
+    let bowtie = shapes::grid_plane(20, 1.0, 0.0, 0.0, 0, |c| {
+        (c.x > 8.0 && c.x < 9.0 && c.y > 8.0 && c.y < 9.0)
+            || (c.x > 9.0 && c.x < 10.0 && c.y > 9.0 && c.y < 10.0)
+    });
+    let (closed, holes) = close_mesh_gaps(&bowtie, 6.0).unwrap();
+    assert!(holes.iter().all(|h| h.filled), "{holes:?}");
+    assert_eq!(closed.n_faces(), bowtie.n_faces() + 4);
+    let topo = meshcore::Topology::new(&closed);
+    assert_eq!(topo.boundary_loops().len(), 1);
+    assert!(topo.is_oriented_manifold());
+    assert!((area(&closed) - area(&bowtie) - 2.0).abs() < 1e-9);
     // Nothing to close at a 0 mm limit; a bad limit is an error.
     assert_eq!(close_mesh_gaps(&m, 0.0).unwrap().0, m);
     assert!(close_mesh_gaps(&m, f64::NAN).is_err());
