@@ -93,7 +93,7 @@ pub fn options(args: &Args) -> anyhow::Result<DescriptorOptions> {
 
 /// Runs the command.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let opts = options(&args)?;
+    let mut opts = options(&args)?;
     let method = args.method;
     let _: bipolar::io::Format = from_extension(&args.out)?;
     let loaded = crate::load::mesh(&args.mesh)?;
@@ -107,7 +107,6 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         refs.push(resolver.resolve(r, "--ref")?.source);
     }
     let t0 = Instant::now();
-    let mut opts = opts;
     if let Some(deg) = args.max_incidence {
         opts.vertex_mask = Some(
             scanprep::incidence_mask(&mesh, meshcore::DVec3::Z, deg).context("--max-incidence")?,

@@ -172,10 +172,7 @@ pub fn bipolar(
         ),
         Region::Whole => (2 * n, None),
     };
-    let mask = match (mask, seen) {
-        (Some(m), Some(s)) => Some(m.iter().zip(s).map(|(&a, &b)| a && b).collect()),
-        (m, s) => m.or_else(|| s.map(<[bool]>::to_vec)),
-    };
+    let mask = restrict(mask, seen);
     let opts = bipolar::DescriptorOptions {
         levels: bipolar::LevelSpec::Step(step),
         max_level: Some(max_level),
@@ -196,6 +193,14 @@ pub fn bipolar(
         },
         &opts,
     )
+}
+
+/// A vertex mask restricted to the `seen` vertices: both must hold (`None`: no restriction).
+pub fn restrict(mask: Option<Vec<bool>>, seen: Option<&[bool]>) -> Option<Vec<bool>> {
+    match (mask, seen) {
+        (Some(m), Some(s)) => Some(m.iter().zip(s).map(|(&a, &b)| a && b).collect()),
+        (m, s) => m.or_else(|| s.map(<[bool]>::to_vec)),
+    }
 }
 
 /// A keyed point set as `shapedist::keyed_distance` takes it.

@@ -16,7 +16,7 @@
 //! input order).
 
 use crate::paths::FaceSetArgs;
-use crate::pipeline::{bar, dist, landmark_icp_rms};
+use crate::pipeline::{bar, dist, landmark_icp_rms, restrict};
 use crate::polar::{polar_descriptor, PolarOptions, Pole};
 use crate::report::{joined, write_csv};
 use anyhow::{bail, Context, Result};
@@ -25,6 +25,7 @@ use geodesic::{Method, SolveOptions, Source};
 use meshcore::{DVec3, FaceLocator, SurfacePoint, TriMesh};
 use rangescan::{Artifacts, DepthNoise, HeadPose, Quantisation, ScanOptions};
 use rayon::prelude::*;
+use scanprep::incidence_mask;
 use scanprep::{CleanOptions, Crop, Input};
 use std::fmt::Write as _;
 use std::time::Instant;
@@ -297,20 +298,21 @@ fn describe_scan(face: &Face, setting: &Setting, args: &Args) -> Result<Describe
     let bip = VARIANTS
         .iter()
         .map(|v| {
-            let mut mask = mask.clone();
-            if let Some(deg) = v.max_incidence_deg {
-                match scanprep::incidence_mask(&mesh, DVec3::Z, deg) {
-                    Ok(seen) => mask.iter_mut().zip(seen).for_each(|(m, s)| *m &= s),
-                    Err(e) => {
-                        notes.push(format!("{}: {e}", v.name));
-                        return None;
-                    }
+            let seen = match v
+                .max_incidence_deg
+                .map(|deg| incidence_mask(&mesh, DVec3::Z, deg))
+            {
+                Some(Err(e)) => {
+                    notes.push(format!("{}: {e}", v.name));
+                    return None;
                 }
-            }
+                seen => seen.and_then(Result::ok),
+            };
+            let mask = restrict(Some(mask.clone()), seen.as_deref());
             let opts = bipolar::DescriptorOptions {
                 levels: bipolar::LevelSpec::Step(d / f64::from(args.set.res.levels)),
                 max_level: Some(args.set.res.levels),
-                vertex_mask: Some(mask),
+                vertex_mask: mask,
                 ..v.options()
             };
             match bipolar::describe(
