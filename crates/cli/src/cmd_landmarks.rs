@@ -56,6 +56,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         min_confidence: args
             .min_confidence
             .unwrap_or(DetectOptions::default().min_confidence),
+        toward_viewer: crate::load::toward_scanner(&args.mesh),
         ..DetectOptions::default()
     };
     let lm = detect_with(&loaded.mesh, &model, &opts)

@@ -8,7 +8,8 @@
 //! * a landmark name (`outer-eye-right`, `Outer right eye corner`, `nose_tip`, ...): looked up in
 //!   `--landmarks FILE` when given (any landmark file `mesh-io` reads; its vertex is used when
 //!   it sits at the given position, otherwise the position is snapped under the same
-//!   tolerance), else detected once per mesh with `landmarks::detect` and the default model.
+//!   tolerance), else detected once per mesh with `landmarks::detect_with` and the default
+//!   model (units recognised from the face size; a `.bnt` grid seen from `+z`).
 
 use anyhow::{bail, Context};
 use geodesic::Source;
@@ -53,6 +54,7 @@ pub struct Resolver<'a> {
     given: Option<(PathBuf, mesh_io::Landmarks3d)>,
     locator: OnceCell<FaceLocator<'a>>,
     detected: OnceCell<landmarks::Landmarks>,
+    toward_scanner: Option<DVec3>,
 }
 
 /// Three comma-separated numbers, if `s` is that (finite or not).
@@ -92,6 +94,7 @@ impl<'a> Resolver<'a> {
             given,
             locator: OnceCell::new(),
             detected: OnceCell::new(),
+            toward_scanner: crate::load::toward_scanner(mesh_path),
         })
     }
 
@@ -128,7 +131,15 @@ impl<'a> Resolver<'a> {
                 None => {
                     let model = landmarks::GenericModel::default_model()
                         .context("loading the default generic face model")?;
-                    let d = landmarks::detect(self.mesh, &model)
+                    let options = landmarks::DetectOptions {
+                        mesh_units_per_model_unit: landmarks::mesh_units_per_model_unit(
+                            self.mesh, &model,
+                        )
+                        .with_context(|| format!("{what}: detecting the landmark {name}"))?,
+                        toward_viewer: self.toward_scanner,
+                        ..landmarks::DetectOptions::default()
+                    };
+                    let d = landmarks::detect_with(self.mesh, &model, &options)
                         .with_context(|| format!("{what}: detecting the landmark {name}"))?;
                     self.detected.get_or_init(|| d)
                 }

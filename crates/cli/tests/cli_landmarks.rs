@@ -70,3 +70,41 @@ fn a_face_in_millimetres_needs_no_scale_flag() {
     // An explicit --scale still wins: 1 (the model's cm) on a face in mm finds no face.
     bipolar(&[arg(&mm), "--scale", "1"]).failure();
 }
+
+#[test]
+fn a_range_grid_is_read_as_seen_from_its_scanner() {
+    let Some((mesh, dir)) = common::paper_face_and_tempdir("id4_neutral.obj") else {
+        return;
+    };
+    // A head turned by 35 degrees: the scanner loses the far side around the far eye corner.
+    let bnt = dir.path().join("turned.bnt");
+    common::bipolar(&[
+        "scan",
+        arg(&mesh),
+        "--out",
+        arg(&bnt),
+        "--pitch",
+        "1",
+        "--yaw",
+        "35",
+        "--artifacts",
+        "structured-light",
+        "--seed",
+        "7",
+    ])
+    .success();
+    // As a range grid, the missing surface is unobserved: the face is found.
+    let out = bipolar(&[arg(&bnt)]).success().stdout;
+    assert!(
+        out.contains("face found") && out.contains("outer_eye_left"),
+        "{out}"
+    );
+    // The same surface as a mesh file has no viewpoint: the missing surface is mismatch.
+    let ply = dir.path().join("turned.ply");
+    common::bipolar(&["convert", arg(&bnt), arg(&ply)]).success();
+    let err = bipolar(&[arg(&ply)]).failure();
+    assert!(
+        err.contains("not found") && err.contains("templates"),
+        "{err}"
+    );
+}

@@ -84,6 +84,10 @@ pub struct Args {
     /// options. Writes into the `scans` folder of the output folder.
     #[arg(long)]
     pub scans: bool,
+    /// With `--scans`: detect without the direction toward the scanner
+    /// (`DetectOptions::toward_viewer` unset, every rim counts as mismatch as on a mesh).
+    #[arg(long)]
+    pub no_viewer: bool,
     /// Scanner settings of `--scans`.
     #[command(flatten)]
     pub scan: ScanArgs,
@@ -268,6 +272,9 @@ pub fn run(args: Args) -> Result<()> {
     }
     dopt.use_regressor = !args.no_regressor;
     if args.scans {
+        if !args.no_viewer {
+            dopt.toward_viewer = Some(crate::scans::SCANNER_SIDE);
+        }
         return run_scans(&args, &ict, &generic, &dopt, &out.join("scans"));
     }
     let unit_mm = if ict.units() == "cm" { 10.0 } else { 1.0 };

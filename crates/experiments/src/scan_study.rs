@@ -300,7 +300,7 @@ fn describe_scan(face: &Face, setting: &Setting, args: &Args) -> Result<Describe
         .map(|v| {
             let seen = match v
                 .max_incidence_deg
-                .map(|deg| incidence_mask(&mesh, DVec3::Z, deg))
+                .map(|deg| incidence_mask(&mesh, crate::scans::SCANNER_SIDE, deg))
             {
                 Some(Err(e)) => {
                     notes.push(format!("{}: {e}", v.name));

@@ -210,6 +210,10 @@ impl ScannedFace {
     }
 }
 
+/// The direction toward the scanner in the frame of every scan `rangescan` writes (it looks
+/// down the z axis).
+pub const SCANNER_SIDE: DVec3 = DVec3::Z;
+
 /// Options of [`scan_faces`].
 #[derive(Debug, Clone)]
 pub struct ScanSetOptions {
@@ -233,7 +237,10 @@ impl Default for ScanSetOptions {
                 crop: Some(Crop::around(DVec3::ZERO)),
                 ..CleanOptions::default()
             },
-            detect: Some(DetectOptions::default()),
+            detect: Some(DetectOptions {
+                toward_viewer: Some(SCANNER_SIDE),
+                ..DetectOptions::default()
+            }),
             detect_smoothing: 0,
         }
     }

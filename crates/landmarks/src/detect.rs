@@ -38,6 +38,47 @@ pub struct DetectOptions {
     /// the inlier distance; below it the landmark is not on the input (occluded, in a hole or outside the
     /// scan) and the fitted pose is rejected naming the landmark. `0` disables the check.
     pub min_landmark_coverage: f64,
+    /// For a range scan: the direction from the surface toward the scanner, in the mesh's
+    /// frame (any length). The rims of what the scanner did not see (holes and borders whose
+    /// vertices face away from it by more than [`GRAZING_RIM_DEG`]: grazing dropouts, the far
+    /// side of a turned head, the shadow of the nose) then bound unobserved surface, and the
+    /// local template search scores a landmark on the part of its template that is observed
+    /// instead of counting the rest as mismatch. `None` (a mesh, not a scan): every point
+    /// counts. The rims of the eye openings face the scanner and are not affected. With a
+    /// direction the learned regression also reads surface missing where the training faces
+    /// had it as unobserved rather than as shape.
+    pub toward_viewer: Option<DVec3>,
+}
+
+/// Least angle (degrees) between a rim vertex's normal and the direction toward the scanner
+/// for [`DetectOptions::toward_viewer`] to take the rim as the edge of unobserved surface (the
+/// structured-light scanners of `rangescan` start dropping samples at 70 degrees).
+pub const GRAZING_RIM_DEG: f64 = 65.0;
+
+/// Per vertex: whether it is on a boundary edge and faces away from `toward_viewer` by more
+/// than [`GRAZING_RIM_DEG`] (all `false` without a direction).
+fn unseen_rims(
+    mesh: &TriMesh,
+    nrm: &[DVec3],
+    toward_viewer: Option<DVec3>,
+) -> Result<Vec<bool>, LandmarkError> {
+    let mut out = vec![false; nrm.len()];
+    let Some(v) = toward_viewer else {
+        return Ok(out);
+    };
+    let v = v.try_normalize().ok_or_else(|| {
+        LandmarkError::InvalidOption(format!(
+            "toward_viewer must be a finite non-zero direction, got {v}"
+        ))
+    })?;
+    let cos = GRAZING_RIM_DEG.to_radians().cos();
+    let topo = meshcore::Topology::new(mesh);
+    for e in topo.edges().iter().filter(|e| e.is_boundary()) {
+        for k in e.v {
+            out[k as usize] = nrm[k as usize].dot(v) < cos;
+        }
+    }
+    Ok(out)
 }
 
 impl Default for DetectOptions {
@@ -51,11 +92,12 @@ impl Default for DetectOptions {
             min_local_agreement: 0.85,
             use_regressor: true,
             min_landmark_coverage: 0.5,
+            toward_viewer: None,
         }
     }
 }
 
-/// Vertex normals, per-vertex reach and the k-d tree of a mesh.
+/// Vertex normals, per-vertex reach and the k-d tree of a mesh (no unseen rims).
 pub(crate) fn surface_index(mesh: &TriMesh) -> SurfaceIndex {
     let pos = mesh.positions().to_vec();
     let nrm = mesh.vertex_normals();
@@ -255,7 +297,8 @@ pub fn detect_with(
     let p = &model.params;
     let debug = std::env::var_os("LANDMARKS_DEBUG").is_some();
     let clock = std::time::Instant::now();
-    let idx = surface_index(mesh_m);
+    let mut idx = surface_index(mesh_m);
+    idx.unseen_rim = unseen_rims(mesh_m, &idx.nrm, options.toward_viewer)?;
     let adj = VertexAdjacency::new(mesh_m);
     // Candidates come from the curvature at vertices about a sixth of the curvature radius
     // apart: every vertex of a mesh as coarse as the training faces, a subsample of a dense scan
@@ -513,9 +556,16 @@ pub fn detect_with(
         }
         let best = f.h;
         let out = match &model.regressor {
-            Some(reg) if options.use_regressor => {
-                regressed(&idx, mesh_m, model, reg, &best.t, &out, debug)
-            }
+            Some(reg) if options.use_regressor => regressed(
+                &idx,
+                mesh_m,
+                model,
+                reg,
+                &best.t,
+                &out,
+                options.toward_viewer.is_some(),
+                debug,
+            ),
             _ => out,
         };
         // Every landmark must sit on the input: one the fitted face puts where the input has
@@ -596,14 +646,15 @@ fn refine_all(
             p.search_radius
         };
         let (v, cost) = refine(idx, &tpl, t, pred, radius, p.inlier_distance);
+        let c_local = (-(cost / (p.typical_rms * p.typical_rms)) * 0.1).exp();
         if debug {
             eprintln!(
-                "{name}: predicted at {:?} (vertex {}), refined to vertex {v} (cost {cost:.2e})",
+                "{name}: predicted at {:?} (vertex {}), refined to vertex {v} (cost {cost:.2e}, local agreement {:.3})",
                 pred,
-                idx.query(pred).vertex
+                idx.query(pred).vertex,
+                c_local
             );
         }
-        let c_local = (-(cost / (p.typical_rms * p.typical_rms)) * 0.1).exp();
         weakest = weakest.min(c_local);
         out[name as usize] = Landmark {
             vertex: v,
@@ -618,7 +669,9 @@ fn refine_all(
 /// eye corners at the mesh vertex nearest to the regressed point; the nose tip, a strong
 /// feature, keeps its template search `tpl` (on 300 faces of a training stream the regression
 /// placed it within 5 mm less often: 96.7 % against 98.3 %). Confidences are those of the
-/// template search.
+/// template search. On a `scan` (a viewing direction given) surface the training faces had
+/// and the input lacks is unobserved (see `LandmarkRegressor::predict`).
+#[allow(clippy::too_many_arguments)]
 fn regressed(
     idx: &SurfaceIndex,
     mesh: &TriMesh,
@@ -626,23 +679,31 @@ fn regressed(
     reg: &crate::LandmarkRegressor,
     t: &DAffine3,
     tpl: &[Landmark; 5],
+    scan: bool,
     debug: bool,
 ) -> [Landmark; 5] {
-    let q = reg.predict(mesh, t);
+    let q = reg.predict(mesh, t, scan);
     let mut out = *tpl;
     for name in LandmarkName::ALL {
         if name == LandmarkName::NoseTip {
             continue;
         }
         let k = name as usize;
+        // A patch lacking surface the training faces had: the template search stays.
+        let Some(qk) = q[k] else {
+            if debug {
+                eprintln!("{name}: not regressed (surface missing around it)");
+            }
+            continue;
+        };
         // An offset beyond what the training faces showed (their poses were kept within half
         // the inner-eye distance of the truth) is an input the regression has not learned:
         // the template search stays.
-        let off = q[k] - model.landmark(name);
+        let off = qk - model.landmark(name);
         if !(off.is_finite() && off.length() <= 0.5 * model.eye_distance()) {
             continue;
         }
-        let v = idx.query(t.transform_point3(q[k])).vertex;
+        let v = idx.query(t.transform_point3(qk)).vertex;
         if debug {
             eprintln!(
                 "{name}: regressed to vertex {v} (template search gave {})",
@@ -687,9 +748,16 @@ fn fit_confidence(f: &FitScore, typical_rms: f64, typical_inliers: f64) -> f64 {
     (a * a * b).clamp(0.0, 1.0)
 }
 
+/// Least share of a landmark template that must be observed (on the input or off it where
+/// the input has surface) for [`refine`] to score it on the observed points alone.
+const MIN_OBSERVED: f64 = 0.5;
+
 /// Template search around `pred`: the vertex minimising the truncated mean squared distance of
 /// the template (rotated by the face pose) placed at the vertex, plus a weak prior on the
-/// distance to the prediction. Returns the vertex and its cost.
+/// distance to the prediction. A template point beyond an unseen rim (its nearest vertex
+/// flagged in [`SurfaceIndex::unseen_rim`], and farther than `tau`) is unobserved, not a mismatch:
+/// when at least [`MIN_OBSERVED`] of the template is observed the mean runs over the observed
+/// points alone. Returns the vertex and its cost.
 fn refine(
     idx: &SurfaceIndex,
     tpl: &[(DVec3, DVec3)],
@@ -704,14 +772,24 @@ fn refine(
         .map(|(q, _)| pose.transform_vector3(*q))
         .collect();
     let eval = |c: DVec3, pts: &mut dyn Iterator<Item = &DVec3>| -> f64 {
-        let mut s = 0.0;
-        let mut n = 0usize;
+        let (mut s, mut n, mut unseen) = (0.0, 0usize, 0usize);
         for q in pts {
             let h = idx.query(c + *q);
-            s += h.d2.min(tau2);
+            if h.d2 < tau2 {
+                s += h.d2;
+            } else if idx.unseen_rim[h.vertex as usize] {
+                unseen += 1;
+            } else {
+                s += tau2;
+            }
             n += 1;
         }
-        s / n.max(1) as f64
+        let seen = n - unseen;
+        if seen as f64 >= MIN_OBSERVED * n as f64 {
+            s / seen.max(1) as f64
+        } else {
+            (s + unseen as f64 * tau2) / n.max(1) as f64
+        }
     };
     let prior = |c: DVec3| 0.02 * tau2 * (c - pred).length_squared() / (radius * radius);
     let mut cands = idx.within(pred, radius);

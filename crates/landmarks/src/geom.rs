@@ -18,6 +18,9 @@ pub struct SurfaceIndex {
     pub nrm: Vec<DVec3>,
     /// Half the mean length of the edges at each vertex (the vertex's share of the surface).
     pub reach: Vec<f64>,
+    /// Whether each vertex is on a rim of unobserved surface (see
+    /// [`crate::DetectOptions::toward_viewer`]); all `false` from [`SurfaceIndex::new`].
+    pub unseen_rim: Vec<bool>,
 }
 
 /// Result of a nearest query.
@@ -34,6 +37,7 @@ pub struct Hit {
 impl SurfaceIndex {
     /// Builds the index.
     pub fn new(pos: Vec<DVec3>, nrm: Vec<DVec3>, reach: Vec<f64>) -> Self {
+        let unseen_rim = vec![false; pos.len()];
         let pts: Vec<[f64; 3]> = pos.iter().map(|p| p.to_array()).collect();
         let tree = ImmutableKdTree::new_from_slice(&pts);
         Self {
@@ -41,6 +45,7 @@ impl SurfaceIndex {
             pos,
             nrm,
             reach,
+            unseen_rim,
         }
     }
 

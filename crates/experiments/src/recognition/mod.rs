@@ -285,7 +285,7 @@ fn describe_face(
     let t = Instant::now();
     let seen = match o.max_incidence_deg {
         Some(deg) => Some(
-            scanprep::incidence_mask(mesh, DVec3::Z, deg)
+            scanprep::incidence_mask(mesh, crate::scans::SCANNER_SIDE, deg)
                 .map_err(|e| format!("incidence mask: {e}"))?,
         ),
         None => None,

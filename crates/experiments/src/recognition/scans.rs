@@ -533,6 +533,28 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         everyone.len(),
         median(col(0)), p95(col(0)), median(col(1)), p95(col(1)), median(col(2)), p95(col(2)),
     ));
+    let lm_rows: Vec<Vec<String>> = everyone
+        .iter()
+        .map(|f| {
+            let mut row = vec![f.name.clone()];
+            match f.det_err {
+                Some(e) => row.extend(e.iter().map(|x| format!("{x:.2}"))),
+                None => row.extend(std::iter::repeat_n(String::new(), 3)),
+            }
+            row
+        })
+        .collect();
+    rep.csv(
+        "landmarks.csv",
+        &[
+            "scan",
+            "outer eye right (mm)",
+            "outer eye left (mm)",
+            "nose tip (mm)",
+        ],
+        &lm_rows,
+    )?;
+    rep.para("Per scan: the distance of each detected landmark from its ground truth (`landmarks.csv`; empty where detection failed or the ground truth is not on the scan).");
     let time_row = |k: usize| median(everyone.iter().map(|f| f.secs[k]).collect());
     rep.para(&format!(
         "Per scan (median wall time, {} valid samples, {} vertices after cleaning): scan {:.2} s, clean {:.2} s, detect {:.2} s, the four representations with both landmark sets {:.2} s (faces in parallel on every core, so these are upper bounds of the single-scan times).",
