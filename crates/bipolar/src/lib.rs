@@ -17,6 +17,8 @@
 //! * More than two reference points: every pair `a < b` contributes, keys carry the pair.
 //! * [`polar`]: the single-pole descriptor (geodesic polar coordinates around one point,
 //!   [`describe_polar`]), keyed by `(level, sector)`.
+//! * [`reference_candidates`]: placements of a reference point around a given one, for a
+//!   search that keeps the least distance over them (detected references are millimetres off).
 //! * [`io`]: CSV / JSON / PLY files. [`synthetic`]: test meshes.
 //!
 //! Determinism: points are sorted by key, then position. Errors: [`BipolarError`]; an empty
@@ -30,6 +32,7 @@ mod error;
 pub mod io;
 mod key;
 pub mod polar;
+mod search;
 pub mod synthetic;
 mod types;
 
@@ -39,6 +42,7 @@ pub use geodesic::Source;
 pub use key::Key;
 pub use meshcore::Surface;
 pub use polar::{describe_polar, PolarDescriptor, PolarKey, PolarOptions, PolarPoint};
+pub use search::reference_candidates;
 pub use types::{
     Descriptor, DescriptorOptions, DescriptorPoint, DescriptorStats, IsoAngleOptions, IsoCrossings,
     IsoRepeats, LevelSpec, SelectionKind, SelectionRule, SplineOptions, StripOptions,

@@ -104,6 +104,12 @@ pub struct Args {
     /// descriptor (`--scans`; 0 keeps everything).
     #[arg(long, default_value_t = SCAN_MAX_INCIDENCE_DEG)]
     pub max_incidence: f64,
+    /// Reference-point search of the bipolar score (`--scans`; mm, 0: off): each probe is also
+    /// described from its outer eye corners moved by this distance in 6 directions of their
+    /// tangent planes (48 more descriptors), and its score against a gallery face is the least
+    /// distance over the 49.
+    #[arg(long, default_value_t = 0.0)]
+    pub ref_search: f64,
 }
 
 /// One sampled face.
@@ -168,6 +174,8 @@ fn elastic_options(samples: usize) -> ElasticOptions {
 #[derive(Debug)]
 struct Described {
     bip: Result<bipolar::Descriptor, String>,
+    /// Bipolar descriptors from moved corners (`DescribeOptions::ref_search`; else empty).
+    bip_alt: Vec<bipolar::Descriptor>,
     pol: PolarDescriptor,
     facial: Result<FacialCurvesDescriptor, String>,
     /// The iso-curvature network's points prepared for ICP (the network itself is not kept).
@@ -192,6 +200,9 @@ struct DescribeOptions {
     /// Parts seen at more than this incidence (degrees, scanner along +z) left out of the
     /// bipolar descriptor (`scanprep::incidence_mask`).
     max_incidence_deg: Option<f64>,
+    /// Reference-point search radius (mesh units) of the probes' bipolar descriptors (`None`:
+    /// one descriptor from the given corners).
+    ref_search: Option<f64>,
 }
 
 /// The three fields of a face cut off at 1.4 |q - r| (corners r, q; nose tip), D, and the wall
@@ -300,6 +311,12 @@ fn describe_face(
         seen.as_deref(),
     )
     .map_err(|e| format!("bipolar descriptor: {e}"));
+    let bip_alt = match o.ref_search {
+        Some(rho) if bip.is_ok() => {
+            moved_corner_descriptors(mesh, solver, lm, &refs, rho, o, seen.as_deref())
+        }
+        _ => Vec::new(),
+    };
     let t_bip = t.elapsed().as_secs_f64();
     let opts = PolarOptions {
         step: d / f64::from(o.levels),
@@ -330,6 +347,7 @@ fn describe_face(
     let t_iso = t.elapsed().as_secs_f64();
     Ok(Described {
         bip,
+        bip_alt,
         pol,
         facial,
         iso,
@@ -341,6 +359,94 @@ fn describe_face(
             t_nose + t_surface + t_iso,
         ],
     })
+}
+
+/// The distance of two bipolar descriptors, `None` when it fails.
+fn shapedist_dist(a: &bipolar::Descriptor, b: &bipolar::Descriptor) -> Option<f64> {
+    dist(a, b).ok().filter(|v| v.is_finite())
+}
+
+/// Directions of the reference-point search around each outer eye corner.
+const SEARCH_DIRECTIONS: usize = 6;
+
+/// Bipolar descriptors of a face from its outer eye corners moved by `rho` in
+/// [`SEARCH_DIRECTIONS`] directions of their tangent planes (`bipolar::reference_candidates`,
+/// the first toward the other corner; each corner at its place or moved: 48 pairs), with the
+/// options of the face's own descriptor; pairs whose fields or descriptor fail are left out.
+fn moved_corner_descriptors(
+    mesh: &TriMesh,
+    solver: &dyn geodesic::GeodesicSolver,
+    lm: Lm,
+    refs: &Refs,
+    rho: f64,
+    o: &DescribeOptions,
+    seen: Option<&[bool]>,
+) -> Vec<bipolar::Descriptor> {
+    let around = |v: u32, other: DVec3| {
+        bipolar::reference_candidates(mesh, v, other, rho, SEARCH_DIRECTIONS).unwrap_or_default()
+    };
+    let (rs, qs) = (around(lm.r, refs.q), around(lm.q, refs.r));
+    let cut = SolveOptions {
+        max_distance: Some(1.4 * (refs.q - refs.r).length() + 4.0 * rho),
+    };
+    let field = |v: u32| solver.distances(&[Source::Vertex(v)], &cut).ok();
+    let fr: Vec<Option<Vec<f64>>> = rs
+        .iter()
+        .map(|&v| {
+            if v == lm.r {
+                Some(refs.ur.clone())
+            } else {
+                field(v)
+            }
+        })
+        .collect();
+    let fq: Vec<Option<Vec<f64>>> = qs
+        .iter()
+        .map(|&v| {
+            if v == lm.q {
+                Some(refs.uq.clone())
+            } else {
+                field(v)
+            }
+        })
+        .collect();
+    let mut out = Vec::new();
+    for (i, &r) in rs.iter().enumerate() {
+        for (j, &q) in qs.iter().enumerate() {
+            if i == 0 && j == 0 {
+                continue;
+            }
+            let (Some(ur), Some(uq)) = (&fr[i], &fq[j]) else {
+                continue;
+            };
+            let d = 0.5 * (ur[q as usize] + uq[r as usize]);
+            if !(d.is_finite() && d > 0.0) {
+                continue;
+            }
+            let (pr, pq) = (mesh.position(r), mesh.position(q));
+            let moved = Refs {
+                ur: ur.clone(),
+                uq: uq.clone(),
+                d,
+                r: pr,
+                q: pq,
+                nose: refs.nose,
+                frame: face_frame(mesh, pr, pq, refs.nose),
+            };
+            if let Ok(b) = bipolar(
+                mesh,
+                &moved,
+                o.levels,
+                Region::Static,
+                DescriptorRule::CrateAll,
+                o.boundary_margin,
+                seen,
+            ) {
+                out.push(b);
+            }
+        }
+    }
+    out
 }
 
 /// Identification/verification figures of one score matrix.
@@ -465,7 +571,17 @@ fn score_one(
     elastic: &ElasticOptions,
 ) -> f64 {
     match k {
-        0 => dist(&x.bip, &y.bip).unwrap_or(f64::NAN),
+        0 => {
+            let base = dist(&x.bip, &y.bip).unwrap_or(f64::NAN);
+            match &y.bip {
+                Ok(yb) => x
+                    .bip_alt
+                    .iter()
+                    .filter_map(|a| shapedist_dist(a, yb))
+                    .fold(base, |m, v| if m.is_nan() || v < m { v } else { m }),
+                Err(_) => base,
+            }
+        }
         1 => dist(&x.pol, &y.pol).unwrap_or(f64::NAN),
         2 => icp_score(pts, &x.lm_pos, loc, &y.lm_pos),
         3 => match (&x.facial, &y.facial) {
@@ -820,6 +936,7 @@ pub fn run(args: Args) -> Result<()> {
         iso_levels: Some(iso_levels),
         boundary_margin: None,
         max_incidence_deg: None,
+        ref_search: None,
     };
     let elastic = elastic_options(args.curve_samples);
     // Landmark detection.

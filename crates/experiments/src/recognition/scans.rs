@@ -161,6 +161,17 @@ fn describe_spec(
         face.det_err = Some([e(L::OuterEyeRight), e(L::OuterEyeLeft), e(L::NoseTip)]);
     }
     let t = Instant::now();
+    // The reference-point search is the probes' (the gallery keeps its one description).
+    let gallery_opts;
+    let dopt = if keep_mesh {
+        gallery_opts = DescribeOptions {
+            ref_search: None,
+            ..dopt.clone()
+        };
+        &gallery_opts
+    } else {
+        dopt
+    };
     let lms = [s.truth_vertices(), s.detected_vertices()];
     face.gt_lm = lms[0].as_ref().ok().map(|&[r, q, nose]| Lm { r, q, nose });
     face.desc = match geodesic::new_solver(&s.mesh, method) {
@@ -336,6 +347,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         iso_levels: None,
         boundary_margin: (args.boundary_margin > 0.0).then_some(args.boundary_margin),
         max_incidence_deg: (args.max_incidence > 0.0).then_some(args.max_incidence),
+        ref_search: (args.ref_search > 0.0).then_some(args.ref_search),
     };
     let elastic = elastic_options(args.curve_samples);
     // Specs: gallery, main probes, sweeps (each face its own scan seed).
@@ -499,7 +511,10 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
                     .collect::<Vec<_>>()
                     .join(" and ")
             ),
-        },
+        } + &dopt
+            .ref_search
+            .map(|r| format!(", each probe also described from its outer eye corners moved by {r} mm in 6 directions (`bipolar::reference_candidates`), its score the least distance over the 49 descriptors"))
+            .unwrap_or_default(),
         args.res.sectors,
         args.icp_points,
         args.curve_samples,
