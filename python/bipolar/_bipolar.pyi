@@ -322,6 +322,7 @@ def detect_landmarks(
     model: Optional[PathLike] = None,
     scale: Optional[float] = None,
     min_confidence: Optional[float] = None,
+    toward_viewer: Optional[ArrayLike] = None,
 ) -> Dict[str, Any]: ...
 
 def scan(

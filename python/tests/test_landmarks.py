@@ -40,3 +40,33 @@ def test_a_sphere_is_not_a_face():
         bipolar.detect_landmarks(bipolar.icosphere(2), scale=-1.0)
     with pytest.raises(errors.FileError):
         bipolar.detect_landmarks(bipolar.icosphere(2), model="/nonexistent.json")
+
+
+def test_a_range_scan_is_read_as_seen_from_its_scanner(tmp_path):
+    face = bipolar.read_mesh(PAPER_SET / "id4_neutral.obj")
+    # A head turned by 35 degrees: the scanner loses the far side around the far eye corner.
+    scan, _ = bipolar.scan(face, pitch=1.0, yaw=35.0, artifacts="structured-light", seed=7)
+    assert scan.grid_index is not None
+    # The scan's own mesh is a range grid's: seen from +z by default.
+    lm = bipolar.detect_landmarks(scan)
+    assert set(lm["landmarks"]) == set(bipolar.LANDMARK_NAMES)
+    same = bipolar.detect_landmarks(scan, toward_viewer=[0.0, 0.0, 2.0])
+    assert same["landmarks"]["outer_eye_left"]["vertex"] == lm["landmarks"]["outer_eye_left"]["vertex"]
+    # The same surface without a grid has no viewpoint: the missing surface is mismatch.
+    plain = bipolar.Mesh(scan.vertices, scan.triangles)
+    with pytest.raises(errors.LandmarksNotFoundError, match="templates"):
+        bipolar.detect_landmarks(plain)
+    with pytest.raises(errors.InputError, match="toward_viewer"):
+        bipolar.detect_landmarks(plain, toward_viewer=[0.0, 0.0])
+    with pytest.raises(errors.InputError, match="toward_viewer"):
+        bipolar.detect_landmarks(plain, toward_viewer=[0.0, 0.0, 0.0])
+
+
+def test_describe_names_the_corners_of_a_turned_scan():
+    face = bipolar.read_mesh(PAPER_SET / "id4_neutral.obj")
+    scan, _ = bipolar.scan(face, pitch=1.0, yaw=35.0, artifacts="structured-light", seed=7)
+    # Named references are detected as detect_landmarks does: the scan is seen from +z.
+    d = bipolar.describe(scan, "outer-eye-right", "outer-eye-left", levels=10, max_level=10)
+    assert len(d) > 0
+    with pytest.raises(errors.LandmarksNotFoundError):
+        bipolar.describe(bipolar.Mesh(scan.vertices, scan.triangles), "outer-eye-right", "outer-eye-left")

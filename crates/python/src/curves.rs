@@ -6,7 +6,7 @@ use crate::convert::{self, points_out};
 use crate::describe::{given_landmarks, references};
 use crate::errors;
 use crate::geodesic::{PyGeodesicSolver, SolverChoice};
-use crate::mesh::mesh_arg;
+use crate::mesh::{mesh_arg, MeshArg};
 use facecurves::{
     Aggregate, ElasticOptions, FacialCurvesDescriptor, FacialCurvesOptions, IsoCurvatureDescriptor,
     IsoCurvatureOptions, IsoLevels, Resampling,
@@ -141,7 +141,7 @@ fn curve_dicts<'py, C, V: IntoPyObject<'py>, L: IntoPyObject<'py>>(
 /// beyond `radius`.
 fn centre_field(
     py: Python<'_>,
-    mesh: &meshcore::TriMesh,
+    m: &MeshArg<'_>,
     centre: &Bound<'_, PyAny>,
     radius: f64,
     method: &str,
@@ -155,9 +155,11 @@ fn centre_field(
     }
     let given = landmarks.map(given_landmarks).transpose()?;
     let mut in_library = Duration::ZERO;
+    let mesh = m.mesh();
     let src = references(
         py,
         mesh,
+        m.toward_scanner(),
         &[("nose".to_string(), centre.clone())],
         given.as_deref(),
         &mut in_library,
@@ -198,7 +200,7 @@ pub fn facial_curves(
     if levels == 0 {
         return Err(errors::input("levels must be at least 1"));
     }
-    let field = centre_field(py, mesh, nose, radius, method, landmarks, solver)?;
+    let field = centre_field(py, &m, nose, radius, method, landmarks, solver)?;
     let opts = FacialCurvesOptions {
         step: radius / f64::from(levels),
         levels,
@@ -256,7 +258,7 @@ pub fn iso_curvature_curves(
     };
     let mask = match (centre, radius) {
         (Some(c), Some(r)) => {
-            let u = centre_field(py, mesh, c, r, method, landmarks, solver)?;
+            let u = centre_field(py, &m, c, r, method, landmarks, solver)?;
             Some(u.iter().map(|&d| d <= r).collect::<Vec<bool>>())
         }
         (None, None) => None,

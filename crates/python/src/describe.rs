@@ -54,10 +54,12 @@ fn snap(mesh: &TriMesh, p: DVec3, what: &str) -> PyResult<Source> {
 /// Resolves reference points as `bipolar describe` does: a vertex index; an `(x, y, z)` point
 /// snapped to the nearest surface point; a landmark name looked up in `given` (any spelling
 /// `landmarks::LandmarkName::parse` knows, or equal ignoring case) or, without `given`,
-/// detected with `landmarks::detect` and the default model (once for all names).
+/// detected with `landmarks::detect_with` and the default model (once for all names; units
+/// from the face size, seen from `toward_viewer` when given, as a range grid is from `+z`).
 pub(crate) fn references(
     py: Python<'_>,
     mesh: &TriMesh,
+    toward_viewer: Option<DVec3>,
     specs: &[(String, Bound<'_, PyAny>)],
     given: Option<&[(String, DVec3)]>,
     in_library: &mut Duration,
@@ -96,8 +98,14 @@ pub(crate) fn references(
             if detected.is_none() {
                 let t = Instant::now();
                 let model = landmarks::GenericModel::default_model().map_err(errors::landmarks)?;
+                let options = landmarks::DetectOptions {
+                    mesh_units_per_model_unit: landmarks::mesh_units_per_model_unit(mesh, &model)
+                        .map_err(errors::landmarks)?,
+                    toward_viewer,
+                    ..landmarks::DetectOptions::default()
+                };
                 let lm = py
-                    .detach(|| landmarks::detect(mesh, &model))
+                    .detach(|| landmarks::detect_with(mesh, &model, &options))
                     .map_err(errors::landmarks)?;
                 *in_library += t.elapsed();
                 detected = Some(lm);
@@ -212,7 +220,14 @@ pub fn describe(
         }
     }
     let mut in_library = Duration::ZERO;
-    let sources = references(py, mesh, &specs, given.as_deref(), &mut in_library)?;
+    let sources = references(
+        py,
+        mesh,
+        m.toward_scanner(),
+        &specs,
+        given.as_deref(),
+        &mut in_library,
+    )?;
     let choice = SolverChoice::of(method, solver)?;
     let (d, t) = py.detach(|| {
         let t = Instant::now();

@@ -17,20 +17,28 @@ pub fn names() -> Vec<&'static str> {
 /// ``model``: a generic face model JSON path (default: the model shipped with the library,
 /// trained on ICT FaceKit faces in cm); ``scale``: mesh units per model unit (10 for a scan in
 /// mm with the default model; default: recognised from the size of the face, mm, cm or m); ``min_confidence``: overall confidence below which detection
-/// fails (default: the library's). Returns a dict: one entry per landmark name
+/// fails (default: the library's); ``toward_viewer``: for a range scan, the direction toward
+/// the scanner (3 numbers), so that what the scanner did not see (grazing dropouts, the far
+/// side of a turned head) counts as unobserved rather than as a mismatch (default: ``+z`` for
+/// a range grid's mesh, from a ``.bnt`` file or ``scan``; none for other meshes). Returns a dict: one entry per landmark name
 /// (``{"vertex", "position", "confidence"}``) under ``"landmarks"``, and ``confidence``,
 /// ``fit_rms``, ``inlier_fraction``, ``symmetry``, ``model_to_mesh`` (4 x 4 rigid motion).
 /// Raises ``LandmarksNotFoundError`` when the mesh does not fit a face.
 #[pyfunction]
-#[pyo3(signature = (mesh, *, model=None, scale=None, min_confidence=None))]
+#[pyo3(signature = (mesh, *, model=None, scale=None, min_confidence=None, toward_viewer=None))]
 pub fn detect_landmarks<'py>(
     py: Python<'py>,
     mesh: &Bound<'py, PyAny>,
     model: Option<&Bound<'py, PyAny>>,
     scale: Option<f64>,
     min_confidence: Option<f64>,
+    toward_viewer: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = mesh_arg(mesh)?;
+    let toward_viewer = match toward_viewer {
+        Some(v) => Some(convert::point(v, "toward_viewer")?),
+        None => m.toward_scanner(),
+    };
     let mesh = m.mesh();
     let model = match model {
         Some(p) => GenericModel::load(&convert::path(p, "model")?),
@@ -44,6 +52,7 @@ pub fn detect_landmarks<'py>(
     let opts = DetectOptions {
         mesh_units_per_model_unit: scale,
         min_confidence: min_confidence.unwrap_or(DetectOptions::default().min_confidence),
+        toward_viewer,
         ..DetectOptions::default()
     };
     let lm = py

@@ -83,6 +83,16 @@ impl MeshArg<'_> {
             MeshArg::Owned(m) => m.mesh(),
         }
     }
+
+    /// `+z` for a range grid's mesh (it has a grid index: read from a `.bnt` or made by
+    /// `scan`; the scanner looks down the z axis), `None` for other meshes.
+    pub fn toward_scanner(&self) -> Option<meshcore::DVec3> {
+        let grid = match self {
+            MeshArg::Borrowed(b) => b.get().loaded.grid_index.is_some(),
+            MeshArg::Owned(m) => m.loaded.grid_index.is_some(),
+        };
+        grid.then_some(meshcore::DVec3::Z)
+    }
 }
 
 /// A `Mesh` argument, or a path to read one from.

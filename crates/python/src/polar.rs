@@ -93,7 +93,15 @@ pub fn describe_polar(
     let mut in_library = Duration::ZERO;
     let mut resolve = |what: &str, spec: &Bound<'_, PyAny>| {
         let one = [(what.to_string(), spec.clone())];
-        references(py, mesh, &one, given.as_deref(), &mut in_library).map(|s| s[0])
+        references(
+            py,
+            mesh,
+            m.toward_scanner(),
+            &one,
+            given.as_deref(),
+            &mut in_library,
+        )
+        .map(|s| s[0])
     };
     let pole = resolve("pole", pole)?;
     // The angular origin is only a direction: a point is used as given (the eye-corner midpoint
