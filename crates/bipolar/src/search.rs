@@ -84,24 +84,16 @@ mod tests {
     use super::*;
     use meshcore::{DAffine3, DQuat};
 
-    /// A square grid of `n x n` vertices spaced `h` in the plane z = 0.
+    /// A square grid of `n x n` vertices spaced `h` in the plane z = 0 (vertex `(i, j)` has id
+    /// `j n + i`).
     fn grid(n: usize, h: f64) -> TriMesh {
-        let mut pos = Vec::new();
-        for j in 0..n {
-            for i in 0..n {
-                pos.push(DVec3::new(i as f64 * h, j as f64 * h, 0.0));
-            }
-        }
-        let mut tri = Vec::new();
-        for j in 0..n - 1 {
-            for i in 0..n - 1 {
-                let a = (j * n + i) as u32;
-                let (b, c, d) = (a + 1, a + n as u32, a + n as u32 + 1);
-                tri.push([a, b, d]);
-                tri.push([a, d, c]);
-            }
-        }
-        TriMesh::new(pos, tri).unwrap()
+        meshcore::shapes::grid(
+            n - 1,
+            n - 1,
+            meshcore::shapes::Diagonals::Uniform,
+            |i, j| DVec3::new(i as f64 * h, j as f64 * h, 0.0),
+        )
+        .unwrap()
     }
 
     #[test]

@@ -395,26 +395,22 @@ fn moved_corner_descriptors(
         max_distance: Some(1.4 * (refs.q - refs.r).length() + 4.0 * rho),
     };
     let field = |v: u32| solver.distances(&[Source::Vertex(v)], &cut).ok();
-    let fr: Vec<Option<Vec<f64>>> = rs
-        .iter()
-        .map(|&v| {
-            if v == lm.r {
-                Some(refs.ur.clone())
-            } else {
-                field(v)
-            }
-        })
-        .collect();
-    let fq: Vec<Option<Vec<f64>>> = qs
-        .iter()
-        .map(|&v| {
-            if v == lm.q {
-                Some(refs.uq.clone())
-            } else {
-                field(v)
-            }
-        })
-        .collect();
+    // The given corner keeps its field; each moved one is solved.
+    let fields_of = |vs: &[u32], given: u32, u: &[f64]| -> Vec<Option<Vec<f64>>> {
+        vs.iter()
+            .map(|&v| {
+                if v == given {
+                    Some(u.to_vec())
+                } else {
+                    field(v)
+                }
+            })
+            .collect()
+    };
+    let (fr, fq) = (
+        fields_of(&rs, lm.r, &refs.ur),
+        fields_of(&qs, lm.q, &refs.uq),
+    );
     let mut out = Vec::new();
     for (i, &r) in rs.iter().enumerate() {
         for (j, &q) in qs.iter().enumerate() {
