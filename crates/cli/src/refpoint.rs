@@ -8,7 +8,7 @@
 //! * a landmark name (`outer-eye-right`, `Outer right eye corner`, `nose_tip`, ...): looked up in
 //!   `--landmarks FILE` when given (any landmark file `mesh-io` reads; its vertex is used when
 //!   it sits at the given position, otherwise the position is snapped under the same
-//!   tolerance), else detected once per mesh with `landmarks::detect_with` and the default
+//!   tolerance), else detected once per mesh with `landmarks::detect_seen_from` and the default
 //!   model (units recognised from the face size; a `.bnt` grid seen from `+z`).
 
 use anyhow::{bail, Context};
@@ -131,15 +131,7 @@ impl<'a> Resolver<'a> {
                 None => {
                     let model = landmarks::GenericModel::default_model()
                         .context("loading the default generic face model")?;
-                    let options = landmarks::DetectOptions {
-                        mesh_units_per_model_unit: landmarks::mesh_units_per_model_unit(
-                            self.mesh, &model,
-                        )
-                        .with_context(|| format!("{what}: detecting the landmark {name}"))?,
-                        toward_viewer: self.toward_scanner,
-                        ..landmarks::DetectOptions::default()
-                    };
-                    let d = landmarks::detect_with(self.mesh, &model, &options)
+                    let d = landmarks::detect_seen_from(self.mesh, &model, self.toward_scanner)
                         .with_context(|| format!("{what}: detecting the landmark {name}"))?;
                     self.detected.get_or_init(|| d)
                 }

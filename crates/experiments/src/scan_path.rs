@@ -1,6 +1,6 @@
 //! `cargo xtask scan-path`: wall time of each step of the whole path for one range scan: read
 //! the `.bnt`, clean it (`scanprep::clean`, defaults), detect the landmarks
-//! (`landmarks::detect_with`, seen from +z), describe it (`bipolar::describe` with the exact solver from the two
+//! (`landmarks::detect_seen_from`, seen from +z), describe it (`bipolar::describe` with the exact solver from the two
 //! detected outer eye corners, as `bipolar describe scan.bnt --ref-a outer-eye-right --ref-b
 //! outer-eye-left` does). Without `--bnt` it scans the ICT neutral face (structured-light
 //! artifacts) at `--pitch` and writes the scan into the output folder first.
@@ -115,18 +115,8 @@ pub fn run(args: Args) -> Result<()> {
         )?;
         t.push(Instant::now());
         // As `bipolar landmarks` reads a `.bnt`: units from the face size, seen from +z.
-        let lm = landmarks::detect_with(
-            &cleaned.mesh,
-            &generic,
-            &landmarks::DetectOptions {
-                mesh_units_per_model_unit: landmarks::mesh_units_per_model_unit(
-                    &cleaned.mesh,
-                    &generic,
-                )?,
-                toward_viewer: Some(crate::scans::SCANNER_SIDE),
-                ..landmarks::DetectOptions::default()
-            },
-        )?;
+        let lm =
+            landmarks::detect_seen_from(&cleaned.mesh, &generic, Some(crate::scans::SCANNER_SIDE))?;
         t.push(Instant::now());
         let n_vertices = cleaned.mesh.n_vertices();
         let solver = geodesic::new_solver(&cleaned.mesh, geodesic::Method::Exact)?;

@@ -243,8 +243,19 @@ struct Verified {
 /// units are recognised from the size of the face ([`mesh_units_per_model_unit`]). Positions
 /// are returned in the mesh's own units.
 pub fn detect(mesh: &TriMesh, model: &GenericModel) -> Result<Landmarks, LandmarkError> {
+    detect_seen_from(mesh, model, None)
+}
+
+/// [`detect`] on a range scan seen from `toward_viewer` (the direction toward the scanner,
+/// [`DetectOptions::toward_viewer`]; `None`: a mesh, as [`detect`]).
+pub fn detect_seen_from(
+    mesh: &TriMesh,
+    model: &GenericModel,
+    toward_viewer: Option<DVec3>,
+) -> Result<Landmarks, LandmarkError> {
     let options = DetectOptions {
         mesh_units_per_model_unit: mesh_units_per_model_unit(mesh, model)?,
+        toward_viewer,
         ..DetectOptions::default()
     };
     detect_with(mesh, model, &options)

@@ -24,7 +24,10 @@ mod model;
 mod regress;
 
 pub use curvature::{curvedness, shape_index, Curvature, CurvatureOptions};
-pub use detect::{detect, detect_with, mesh_units_per_model_unit, DetectOptions, GRAZING_RIM_DEG};
+pub use detect::{
+    detect, detect_seen_from, detect_with, mesh_units_per_model_unit, DetectOptions,
+    GRAZING_RIM_DEG,
+};
 pub use model::{DetectParams, GenericModel, Template, TrainOptions};
 pub use regress::{LandmarkRegressor, RegressorOptions, RegressorPatch};
 

@@ -473,17 +473,18 @@ mod tests {
         (TriMesh::new(pos, tri).unwrap(), truth)
     }
 
+    /// Face `s`'s deterministic landmark shifts in the plane, up to 0.3 model units (3 mm).
+    fn shift(s: usize) -> [DVec3; 5] {
+        LandmarkName::ALL.map(|l| {
+            let a = (s * 7 + l as usize * 3) as f64 * 0.61;
+            let r = 0.3 * ((s * 13 + l as usize) % 10) as f64 / 9.0;
+            DVec3::new(r * a.cos(), r * a.sin(), 0.0)
+        })
+    }
+
     #[test]
     fn regression_learns_where_the_bump_moved() {
         let model = GenericModel::default_model().unwrap();
-        // Deterministic shifts in the plane, up to 0.3 model units (3 mm).
-        let shift = |s: usize| {
-            LandmarkName::ALL.map(|l| {
-                let a = (s * 7 + l as usize * 3) as f64 * 0.61;
-                let r = 0.3 * ((s * 13 + l as usize) % 10) as f64 / 9.0;
-                DVec3::new(r * a.cos(), r * a.sin(), 0.0)
-            })
-        };
         let faces: Vec<(TriMesh, [DVec3; 5])> = (0..60).map(|s| bumpy(&model, shift(s))).collect();
         let samples: Vec<(&TriMesh, [DVec3; 5], DAffine3)> = faces[..48]
             .iter()
@@ -509,6 +510,75 @@ mod tests {
         assert!(
             err < 0.1 * base,
             "regression error {err} vs {base} without it"
+        );
+    }
+
+    /// `m` without the triangles that have a corner with `x > x_min`.
+    fn cut(m: &TriMesh, x_min: f64) -> TriMesh {
+        let tri: Vec<[u32; 3]> = m
+            .triangles()
+            .iter()
+            .filter(|t| t.iter().all(|&v| m.position(v).x <= x_min))
+            .copied()
+            .collect();
+        TriMesh::new(m.positions().to_vec(), tri).unwrap()
+    }
+
+    #[test]
+    fn on_a_scan_surface_the_training_faces_had_is_unobserved() {
+        let model = GenericModel::default_model().unwrap();
+        let faces: Vec<(TriMesh, [DVec3; 5])> = (0..50).map(|s| bumpy(&model, shift(s))).collect();
+        let k = LandmarkName::OuterEyeLeft as usize; // the face's outermost landmark (+x)
+        let centre = model.landmark(LandmarkName::OuterEyeLeft).x;
+        let r = RegressorOptions::default().radius * model.eye_distance();
+        // Two of the 48 training faces (under the 5 % of `UNSEEN_RATE`) lack the patch's outer
+        // rim, so the regression learns a weight for "no surface there".
+        let rimless: Vec<TriMesh> = [0, 24]
+            .iter()
+            .map(|&s| cut(&faces[s].0, centre + 0.6 * r))
+            .collect();
+        let samples: Vec<(&TriMesh, [DVec3; 5], DAffine3)> = faces[..48]
+            .iter()
+            .enumerate()
+            .map(|(s, (m, l))| {
+                let m = match s {
+                    0 => &rimless[0],
+                    24 => &rimless[1],
+                    _ => m,
+                };
+                (m, *l, DAffine3::IDENTITY)
+            })
+            .collect();
+        let reg = LandmarkRegressor::train(&model, &samples, &RegressorOptions::default()).unwrap();
+        let c = reg.patches[k].center[0];
+        assert!((c - centre).abs() < 1e-9 && (reg.patches[k].radius - r).abs() < 1e-9);
+        let id = DAffine3::IDENTITY;
+        let (mut err_scan, mut err_mesh) = (0.0, 0.0);
+        for (m, _) in &faces[48..] {
+            let full = reg.predict(m, &id, false);
+            // The outer rim of the patch (about a seventh of its disc) is lost, as a turned head
+            // loses it: on a scan its inputs take the training mean.
+            let part = cut(m, c + 0.6 * r);
+            let as_scan = reg.predict(&part, &id, true);
+            let as_mesh = reg.predict(&part, &id, false);
+            let want = full[k].unwrap();
+            err_scan += (as_scan[k].unwrap() - want).length();
+            err_mesh += (as_mesh[k].unwrap() - want).length();
+            // Patches away from the cut see the same inputs either way.
+            for j in [
+                LandmarkName::OuterEyeRight as usize,
+                LandmarkName::NoseTip as usize,
+            ] {
+                assert_eq!(as_scan[j], full[j], "landmark {j}");
+            }
+            // Most of the patch lost: not regressed on a scan (the template search stays).
+            let most = cut(m, c - 0.1 * r);
+            assert_eq!(reg.predict(&most, &id, true)[k], None);
+            assert!(reg.predict(&most, &id, false)[k].is_some());
+        }
+        assert!(
+            err_scan < 0.5 * err_mesh,
+            "imputed {err_scan} vs read as shape {err_mesh}"
         );
     }
 

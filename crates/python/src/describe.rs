@@ -54,7 +54,7 @@ fn snap(mesh: &TriMesh, p: DVec3, what: &str) -> PyResult<Source> {
 /// Resolves reference points as `bipolar describe` does: a vertex index; an `(x, y, z)` point
 /// snapped to the nearest surface point; a landmark name looked up in `given` (any spelling
 /// `landmarks::LandmarkName::parse` knows, or equal ignoring case) or, without `given`,
-/// detected with `landmarks::detect_with` and the default model (once for all names; units
+/// detected with `landmarks::detect_seen_from` and the default model (once for all names; units
 /// from the face size, seen from `toward_viewer` when given, as a range grid is from `+z`).
 pub(crate) fn references(
     py: Python<'_>,
@@ -98,14 +98,8 @@ pub(crate) fn references(
             if detected.is_none() {
                 let t = Instant::now();
                 let model = landmarks::GenericModel::default_model().map_err(errors::landmarks)?;
-                let options = landmarks::DetectOptions {
-                    mesh_units_per_model_unit: landmarks::mesh_units_per_model_unit(mesh, &model)
-                        .map_err(errors::landmarks)?,
-                    toward_viewer,
-                    ..landmarks::DetectOptions::default()
-                };
                 let lm = py
-                    .detach(|| landmarks::detect_with(mesh, &model, &options))
+                    .detach(|| landmarks::detect_seen_from(mesh, &model, toward_viewer))
                     .map_err(errors::landmarks)?;
                 *in_library += t.elapsed();
                 detected = Some(lm);

@@ -142,7 +142,8 @@ const SCAN_MAX_INCIDENCE_DEG: f64 = 60.0;
 
 /// The default of `--ref-search`: 2 mm raised bipolar with detected landmarks from 0.656 to
 /// 0.750 (16 identities) and from 0.550 to 0.690 (50) and kept or raised it with ground truth;
-/// 3 mm lowered it with ground truth (docs/scans.md, "Reference-point search").
+/// 1.2 and 3 mm differ from it by one probe on 16 identities (docs/scans.md, "Reference-point
+/// search").
 const SCAN_REF_SEARCH_MM: f64 = 2.0;
 
 /// Default of `--curve-samples`.
@@ -366,13 +367,8 @@ fn describe_face(
     })
 }
 
-/// The distance of two bipolar descriptors, `None` when it fails.
-fn shapedist_dist(a: &bipolar::Descriptor, b: &bipolar::Descriptor) -> Option<f64> {
-    dist(a, b).ok().filter(|v| v.is_finite())
-}
-
 /// Directions of the reference-point search around each outer eye corner.
-const SEARCH_DIRECTIONS: usize = 6;
+pub(super) const SEARCH_DIRECTIONS: usize = 6;
 
 /// Bipolar descriptors of a face from its outer eye corners moved by `rho` in
 /// [`SEARCH_DIRECTIONS`] directions of their tangent planes (`bipolar::reference_candidates`,
@@ -572,17 +568,16 @@ fn score_one(
     elastic: &ElasticOptions,
 ) -> f64 {
     match k {
-        0 => {
-            let base = dist(&x.bip, &y.bip).unwrap_or(f64::NAN);
-            match &y.bip {
-                Ok(yb) => x
-                    .bip_alt
-                    .iter()
-                    .filter_map(|a| shapedist_dist(a, yb))
-                    .fold(base, |m, v| if m.is_nan() || v < m { v } else { m }),
-                Err(_) => base,
-            }
-        }
+        // With a reference-point search: the least distance over the probe's descriptors
+        // (`f64::min` skips a failed one).
+        0 => match &y.bip {
+            Ok(yb) => x
+                .bip_alt
+                .iter()
+                .filter_map(|a| dist(a, yb).ok())
+                .fold(dist(&x.bip, &y.bip).unwrap_or(f64::NAN), f64::min),
+            Err(_) => f64::NAN,
+        },
         1 => dist(&x.pol, &y.pol).unwrap_or(f64::NAN),
         2 => icp_score(pts, &x.lm_pos, loc, &y.lm_pos),
         3 => match (&x.facial, &y.facial) {

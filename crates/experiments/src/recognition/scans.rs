@@ -1,7 +1,7 @@
 //! `cargo xtask recognition --scans`: the benchmark on range scans. Faces sampled from the ICT
 //! model are scanned by `rangescan`, cleaned by `scanprep` (crop around the nose tip) and
 //! described on the cleaned scans with the ground-truth landmarks the scanner projected and with
-//! the landmarks `landmarks::detect` finds. Gallery: neutral frontal scans at the `--scan-*`
+//! the landmarks `landmarks::detect_with` finds (seen from the scanner). Gallery: neutral frontal scans at the `--scan-*`
 //! settings; probes: the other expressions, each under a random yaw of 0-45 degrees (either
 //! side) and a random noise level. Sweeps rescan one probe expression of the first
 //! `--sweep-identities` identities at several noise levels, pitches and yaws (the other settings
@@ -11,7 +11,8 @@
 use super::{
     describe_face, elastic_options, icp_points, iso_levels_of, median, order_stat, results_table,
     roc_figure, score_row, summarize, time_comparisons, time_descriptions, timed_pairs,
-    write_summary, Args, DescribeOptions, Described, Lm, Metrics, Row, SCORES, TIMED_FACES,
+    write_summary, Args, DescribeOptions, Described, Lm, Metrics, Row, SCORES, SEARCH_DIRECTIONS,
+    TIMED_FACES,
 };
 use crate::pipeline::{bar, resolve_methods};
 use crate::report::{line_plot, Report, Series};
@@ -487,7 +488,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         "Recognition benchmark on range scans of sampled ICT faces",
     )?;
     rep.para(&format!(
-        "{identities} identities x {expressions} faces (seed {}). Gallery: {} neutral frontal scans ({}). Probes: {} scans of the other expressions, each under a random yaw of 0-45 degrees to either side and a noise of {} mm (other settings as the gallery). Scans by `rangescan` (orthographic), cleaned by `scanprep` (spikes, holes up to 10 mm, small components, crop of {} mm around the true nose tip{}). Geodesics: {}. Bipolar descriptor: static area, N = {} levels between the outer eye corners, {}; single pole: {} sectors around the nose tip; ICP: about {} probe vertices onto the gallery surface from the 3-landmark alignment, 10 % trimmed, score = RMS closest-point distance (mm); facial curves: N level curves of the nose-tip field up to D, elastic distance ({} segments per curve, one start-point candidate, one alternation), root sum of squares; iso-curvature: {} levels per principal field (quantiles of the first gallery scan) in the geodesic disc of radius D around the nose tip, normalised RMS closest-point distance after an ICP started from the 3-landmark alignment. Times, single thread (one-thread pool after the parallel work): per comparison the mean over up to 24 probe x gallery pairs per group and landmark set; per description the median over the first 6 gallery scans (ground truth) of the fields a representation needs plus its build. Ground-truth landmarks: the model's landmark vertices carried through the scanner, at the nearest vertex of the cleaned scan (a landmark the scanner does not see is a failure); detected: `landmarks::detect` on the cleaned scan.",
+        "{identities} identities x {expressions} faces (seed {}). Gallery: {} neutral frontal scans ({}). Probes: {} scans of the other expressions, each under a random yaw of 0-45 degrees to either side and a noise of {} mm (other settings as the gallery). Scans by `rangescan` (orthographic), cleaned by `scanprep` (spikes, holes up to 10 mm, small components, crop of {} mm around the true nose tip{}). Geodesics: {}. Bipolar descriptor: static area, N = {} levels between the outer eye corners, {}; single pole: {} sectors around the nose tip; ICP: about {} probe vertices onto the gallery surface from the 3-landmark alignment, 10 % trimmed, score = RMS closest-point distance (mm); facial curves: N level curves of the nose-tip field up to D, elastic distance ({} segments per curve, one start-point candidate, one alternation), root sum of squares; iso-curvature: {} levels per principal field (quantiles of the first gallery scan) in the geodesic disc of radius D around the nose tip, normalised RMS closest-point distance after an ICP started from the 3-landmark alignment. Times, single thread (one-thread pool after the parallel work): per comparison the mean over up to 24 probe x gallery pairs per group and landmark set; per description the median over the first 6 gallery scans (ground truth) of the fields a representation needs plus its build. Ground-truth landmarks: the model's landmark vertices carried through the scanner, at the nearest vertex of the cleaned scan (a landmark the scanner does not see is a failure); detected: `landmarks::detect_with` on the cleaned scan, seen from the scanner (+z).",
         args.seed,
         gallery.len(),
         base.label(),
@@ -513,7 +514,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
             ),
         } + &dopt
             .ref_search
-            .map(|r| format!(", each probe also described from its outer eye corners moved by {r} mm in 6 directions (`bipolar::reference_candidates`), its score the least distance over the 49 descriptors"))
+            .map(|r| format!(", each probe also described from its outer eye corners moved by {r} mm in {SEARCH_DIRECTIONS} directions (`bipolar::reference_candidates`), its score the least distance over these descriptors and its own"))
             .unwrap_or_default(),
         args.res.sectors,
         args.icp_points,
