@@ -21,6 +21,8 @@
 //!   into the scan frame and classified ([`Visibility`]): visible, occluded (a surface nearer
 //!   to the scanner along its ray), in a hole, dropped at a grazing angle, cut by the border,
 //!   or outside the grid.
+//! * Visibility ([`visible_faces`]): the faces of a mesh a scanner would measure from a given
+//!   direction (occlusion and an incidence limit), as a mask of the mesh itself.
 //!
 //! Library code never panics on user input: bad options or meshes the grid cannot hold end in
 //! [`ScanError`].
@@ -28,11 +30,13 @@
 mod artifacts;
 mod camera;
 mod render;
+mod visibility;
 
 pub use artifacts::{
     Artifacts, Border, DepthNoise, GrazingDropout, Holes, Outliers, Quantisation, Spikes,
 };
 pub use camera::{HeadPose, Projection};
+pub use visibility::visible_faces;
 
 use camera::Camera;
 use mesh_io::BntGrid;

@@ -110,6 +110,17 @@ pub struct Args {
     /// distance over the 49.
     #[arg(long, default_value_t = SCAN_REF_SEARCH_MM)]
     pub ref_search: f64,
+    /// View matching of the bipolar score (`--scans`; degrees): when a probe's scanner
+    /// direction, carried into a gallery face's frame by the landmark alignment, is more than
+    /// this angle from the gallery scan's own, the gallery face is described again on the part
+    /// of it a scanner would see from the probe's direction (`rangescan::visible_faces`,
+    /// incidence up to 75 degrees), so that both sides miss the same surface.
+    #[arg(long, default_value_t = SCAN_VIEW_MATCH_DEG)]
+    pub view_match: f64,
+    /// No view matching (`--scans`): every probe is compared with the gallery face's one
+    /// description.
+    #[arg(long)]
+    pub no_view_match: bool,
 }
 
 /// One sampled face.
@@ -145,6 +156,16 @@ const SCAN_MAX_INCIDENCE_DEG: f64 = 60.0;
 /// 1.2 and 3 mm differ from it by one probe on 16 identities (docs/scans.md, "Reference-point
 /// search").
 const SCAN_REF_SEARCH_MM: f64 = 2.0;
+
+/// The default of `--view-match` (degrees).
+const SCAN_VIEW_MATCH_DEG: f64 = 10.0;
+
+/// Incidence (degrees) beyond which a view-matched gallery face loses its faces: the middle of
+/// the structured-light scanner model's grazing dropouts (70-80 degrees).
+const VIEW_MATCH_INCIDENCE_DEG: f64 = 75.0;
+
+/// Sample spacing (mm) of the z-buffer of the view matching: the scans' pitch.
+const VIEW_MATCH_PITCH_MM: f64 = 0.5;
 
 /// Default of `--curve-samples`.
 const CURVE_SAMPLES: usize = 50;
@@ -187,6 +208,8 @@ struct Described {
     /// The iso-curvature network's points prepared for ICP (the network itself is not kept).
     iso: Result<PreparedSet, String>,
     lm_pos: [DVec3; 3],
+    /// A gallery face's mesh and settings for view matching (`None` for probes and when off).
+    view: Option<Box<ViewSource>>,
     /// Wall time of each description (bipolar, single pole, facial curves, iso-curvature): the
     /// geodesic fields it needs (both corners; the nose tip) and its own build.
     secs: [f64; 4],
@@ -209,10 +232,12 @@ struct DescribeOptions {
     /// Reference-point search radius (mesh units) of the probes' bipolar descriptors (`None`:
     /// one descriptor from the given corners).
     ref_search: Option<f64>,
+    /// View matching of the gallery faces (`Args::view_match`, degrees; `None`: off).
+    view_match: Option<f64>,
 }
 
-/// The three fields of a face cut off at 1.4 |q - r| (corners r, q; nose tip), D, and the wall
-/// time of the corner fields and of the nose field.
+/// The fields of a face cut off at 1.4 |q - r| (corners r, q; nose tip, when asked for: else
+/// `un` is empty), D, and the wall time of the corner fields and of the nose field.
 struct Fields {
     ur: Vec<f64>,
     uq: Vec<f64>,
@@ -221,7 +246,12 @@ struct Fields {
     secs: [f64; 2],
 }
 
-fn fields(mesh: &TriMesh, solver: &dyn geodesic::GeodesicSolver, lm: Lm) -> Result<Fields, String> {
+fn fields(
+    mesh: &TriMesh,
+    solver: &dyn geodesic::GeodesicSolver,
+    lm: Lm,
+    nose: bool,
+) -> Result<Fields, String> {
     if lm.r == lm.q {
         return Err(format!(
             "the two outer eye corners are the same vertex {}",
@@ -240,7 +270,7 @@ fn fields(mesh: &TriMesh, solver: &dyn geodesic::GeodesicSolver, lm: Lm) -> Resu
     let (ur, uq) = (field(lm.r)?, field(lm.q)?);
     let t_corners = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let un = field(lm.nose)?;
+    let un = if nose { field(lm.nose)? } else { Vec::new() };
     let t_nose = t.elapsed().as_secs_f64();
     let d = 0.5 * (ur[lm.q as usize] + uq[lm.r as usize]);
     if !d.is_finite() || d <= 0.0 {
@@ -265,7 +295,7 @@ fn iso_levels_of(
     lm: Lm,
     count: usize,
 ) -> Result<IsoLevels> {
-    let f = fields(mesh, solver, lm).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let f = fields(mesh, solver, lm, true).map_err(|e| anyhow::anyhow!("{e}"))?;
     reference_iso_levels(&Surface::new(mesh.clone()), &f.un, f.d, count)
         .context("iso-curvature levels of the reference face")
 }
@@ -282,7 +312,7 @@ fn describe_face(
     lm: Lm,
     o: &DescribeOptions,
 ) -> Result<Described, String> {
-    let f = fields(mesh, solver, lm)?;
+    let f = fields(mesh, solver, lm, true)?;
     let (r, q, nose) = (
         mesh.position(lm.r),
         mesh.position(lm.q),
@@ -358,6 +388,7 @@ fn describe_face(
         facial,
         iso,
         lm_pos: [r, q, nose],
+        view: None,
         secs: [
             t_corners + t_bip,
             t_nose + t_pol,
@@ -444,6 +475,108 @@ fn moved_corner_descriptors(
         }
     }
     out
+}
+
+/// What a gallery face needs to be described again as a probe's scanner would see it.
+#[derive(Debug)]
+struct ViewSource {
+    mesh: TriMesh,
+    lm: Lm,
+    method: geodesic::Method,
+    /// The gallery's own description settings.
+    opts: DescribeOptions,
+    /// Below this angle (degrees) between the two scanner directions the face's own
+    /// description is used.
+    min_angle_deg: f64,
+}
+
+impl ViewSource {
+    /// The bipolar descriptor of the part of the gallery face a scanner would measure from the
+    /// probe's scanner direction (+z in the probe's frame, carried into the gallery's frame by
+    /// the rigid fit of the probe's landmarks `probe_lm` onto the gallery's), with the gallery's
+    /// own options; its points must also be within the incidence limit from the probe's
+    /// direction. `None` when the directions are within `min_angle_deg` or a step fails (the
+    /// caller then uses the face's own description).
+    fn describe_from(&self, probe_lm: &[DVec3; 3]) -> Option<bipolar::Descriptor> {
+        let m = &self.mesh;
+        let own = [self.lm.r, self.lm.q, self.lm.nose].map(|v| m.position(v));
+        let fit = fit_rigid(probe_lm, &own, None)?;
+        let toward = (fit.matrix3 * crate::scans::SCANNER_SIDE).normalize_or_zero();
+        if toward
+            .angle_between(crate::scans::SCANNER_SIDE)
+            .to_degrees()
+            < self.min_angle_deg
+        {
+            return None;
+        }
+        let seen =
+            rangescan::visible_faces(m, toward, VIEW_MATCH_PITCH_MM, VIEW_MATCH_INCIDENCE_DEG)
+                .ok()?;
+        let tris = m
+            .triangles()
+            .iter()
+            .zip(&seen)
+            .filter(|(_, &s)| s)
+            .map(|(t, _)| *t)
+            .collect();
+        let (cut, map) = scanprep::compact(m.positions(), tris, "view matching").ok()?;
+        // A landmark whose faces are all gone is placed as a probe's ground truth is: on the
+        // nearest vertex left, within `MAX_SNAP_MM`.
+        let mut lm = [0u32; 3];
+        for (k, v) in [self.lm.r, self.lm.q, self.lm.nose].into_iter().enumerate() {
+            lm[k] = match map[v as usize] {
+                u32::MAX => match crate::scans::nearest_vertex(&cut, m.position(v)) {
+                    Some((w, d)) if d <= crate::scans::MAX_SNAP_MM => w,
+                    _ => return None,
+                },
+                w => w,
+            };
+        }
+        let lm = Lm {
+            r: lm[0],
+            q: lm[1],
+            nose: lm[2],
+        };
+        let solver = geodesic::new_solver(&cut, self.method).ok()?;
+        let f = fields(&cut, solver.as_ref(), lm, false).ok()?;
+        let (r, q, nose) = (
+            cut.position(lm.r),
+            cut.position(lm.q),
+            cut.position(lm.nose),
+        );
+        let refs = Refs {
+            ur: f.ur,
+            uq: f.uq,
+            d: f.d,
+            r,
+            q,
+            nose,
+            frame: face_frame(&cut, r, q, nose),
+        };
+        let seen = match self.opts.max_incidence_deg {
+            Some(deg) => {
+                let own = scanprep::incidence_mask(&cut, crate::scans::SCANNER_SIDE, deg).ok()?;
+                let probe = scanprep::incidence_mask(&cut, toward, deg).ok()?;
+                Some(
+                    own.iter()
+                        .zip(&probe)
+                        .map(|(a, b)| *a && *b)
+                        .collect::<Vec<bool>>(),
+                )
+            }
+            None => None,
+        };
+        bipolar(
+            &cut,
+            &refs,
+            self.opts.levels,
+            Region::Static,
+            DescriptorRule::CrateAll,
+            self.opts.boundary_margin,
+            seen.as_deref(),
+        )
+        .ok()
+    }
 }
 
 /// Identification/verification figures of one score matrix.
@@ -570,12 +703,19 @@ fn score_one(
     match k {
         // With a reference-point search: the least distance over the probe's descriptors
         // (`f64::min` skips a failed one).
+        // With view matching, against the gallery face as the probe's scanner would see it.
         0 => match &y.bip {
-            Ok(yb) => x
-                .bip_alt
-                .iter()
-                .filter_map(|a| dist(a, yb).ok())
-                .fold(dist(&x.bip, &y.bip).unwrap_or(f64::NAN), f64::min),
+            Ok(own) => {
+                let matched = y.view.as_ref().and_then(|v| v.describe_from(&x.lm_pos));
+                let yb = matched.as_ref().unwrap_or(own);
+                x.bip_alt.iter().filter_map(|a| dist(a, yb).ok()).fold(
+                    x.bip
+                        .as_ref()
+                        .ok()
+                        .map_or(f64::NAN, |b| dist(b, yb).unwrap_or(f64::NAN)),
+                    f64::min,
+                )
+            }
             Err(_) => f64::NAN,
         },
         1 => dist(&x.pol, &y.pol).unwrap_or(f64::NAN),
@@ -933,6 +1073,7 @@ pub fn run(args: Args) -> Result<()> {
         boundary_margin: None,
         max_incidence_deg: None,
         ref_search: None,
+        view_match: None,
     };
     let elastic = elastic_options(args.curve_samples);
     // Landmark detection.

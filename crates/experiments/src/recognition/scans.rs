@@ -11,12 +11,14 @@
 use super::{
     describe_face, elastic_options, icp_points, iso_levels_of, median, order_stat, results_table,
     roc_figure, score_row, summarize, time_comparisons, time_descriptions, timed_pairs,
-    write_summary, Args, DescribeOptions, Described, Lm, Metrics, Row, SCORES, SEARCH_DIRECTIONS,
-    TIMED_FACES,
+    write_summary, Args, DescribeOptions, Described, Lm, Metrics, Row, ViewSource, SCORES,
+    SEARCH_DIRECTIONS, TIMED_FACES, VIEW_MATCH_INCIDENCE_DEG,
 };
 use crate::pipeline::{bar, resolve_methods};
 use crate::report::{line_plot, Report, Series};
-use crate::scans::{sample_weights, scan_face, scan_seed, FaceSpec, ScanSetOptions, ScanSettings};
+use crate::scans::{
+    sample_weights, scan_face, scan_seed, FaceSpec, ScanSetOptions, ScanSettings, MAX_SNAP_MM,
+};
 use crate::walk::Walker;
 use anyhow::{bail, Context, Result};
 use facecurves::ElasticOptions;
@@ -178,7 +180,7 @@ fn describe_spec(
     face.desc = match geodesic::new_solver(&s.mesh, method) {
         Ok(solver) => {
             let walker = Walker::new(&s.mesh);
-            lms.map(|lm| {
+            lms.clone().map(|lm| {
                 lm.and_then(|[r, q, nose]| {
                     describe_face(&s.mesh, solver.as_ref(), &walker, Lm { r, q, nose }, dopt)
                 })
@@ -190,6 +192,19 @@ fn describe_spec(
         ],
     };
     face.secs[3] = t.elapsed().as_secs_f64();
+    if let (true, Some(min_angle_deg)) = (keep_mesh, dopt.view_match) {
+        for (d, lm) in face.desc.iter_mut().zip(lms) {
+            if let (Ok(d), Ok([r, q, nose])) = (d, lm) {
+                d.view = Some(Box::new(ViewSource {
+                    mesh: s.mesh.clone(),
+                    lm: Lm { r, q, nose },
+                    method,
+                    opts: dopt.clone(),
+                    min_angle_deg,
+                }));
+            }
+        }
+    }
     if keep_mesh {
         face.mesh = Some(s.mesh);
     }
@@ -349,6 +364,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         boundary_margin: (args.boundary_margin > 0.0).then_some(args.boundary_margin),
         max_incidence_deg: (args.max_incidence > 0.0).then_some(args.max_incidence),
         ref_search: (args.ref_search > 0.0).then_some(args.ref_search),
+        view_match: (!args.no_view_match).then_some(args.view_match),
     };
     let elastic = elastic_options(args.curve_samples);
     // Specs: gallery, main probes, sweeps (each face its own scan seed).
@@ -515,7 +531,11 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         } + &dopt
             .ref_search
             .map(|r| format!(", each probe also described from its outer eye corners moved by {r} mm in {SEARCH_DIRECTIONS} directions (`bipolar::reference_candidates`), its score the least distance over these descriptors and its own"))
-            .unwrap_or_default(),
+            .unwrap_or_default()
+            + &dopt
+                .view_match
+                .map(|a| format!("; view matching: where a probe's scanner direction, carried into a gallery scan's frame by the 3-landmark alignment, is more than {a} degrees from the gallery's own, the gallery scan is described again on the faces a scanner would measure from that direction (`rangescan::visible_faces`, incidence up to {VIEW_MATCH_INCIDENCE_DEG} degrees; landmarks whose faces are all gone moved to the nearest vertex left, within {MAX_SNAP_MM} mm), so a bipolar comparison includes that description"))
+                .unwrap_or_default(),
         args.res.sectors,
         args.icp_points,
         args.curve_samples,
