@@ -336,6 +336,13 @@ def scan(
     artifacts: Literal["none", "structured-light"] = "none",
     seed: int = 0,
 ) -> Tuple[Mesh, Dict[str, Any]]: ...
+def visible_faces(
+    mesh: Union[Mesh, PathLike],
+    toward_viewer: ArrayLike,
+    *,
+    pitch: Optional[float] = None,
+    max_incidence: float = 75.0,
+) -> npt.NDArray[np.bool_]: ...
 def clean(
     mesh: Union[Mesh, PathLike],
     *,

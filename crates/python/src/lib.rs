@@ -66,6 +66,7 @@ fn _bipolar(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(landmark::detect_landmarks, m)?)?;
     m.add_function(wrap_pyfunction!(scan::scan, m)?)?;
     m.add_function(wrap_pyfunction!(scan::clean, m)?)?;
+    m.add_function(wrap_pyfunction!(scan::visible_faces, m)?)?;
     m.add_function(wrap_pyfunction!(curves::facial_curves, m)?)?;
     m.add_function(wrap_pyfunction!(curves::iso_curvature_curves, m)?)?;
     m.add_function(wrap_pyfunction!(curves::facial_curves_distance, m)?)?;

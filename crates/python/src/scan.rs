@@ -144,3 +144,30 @@ pub fn clean<'py>(
     let loaded = mesh_io::LoadedMesh::new(c.mesh);
     Ok((PyMesh { loaded }, report))
 }
+
+/// Which faces of ``mesh`` a range scanner looking from ``toward_viewer`` (the direction from
+/// the surface to the scanner, in the mesh's frame; parallel rays) would measure: a face whose
+/// normal is within ``max_incidence`` degrees of that direction and none of whose vertices is
+/// hidden behind nearer surface (``rangescan::visible_faces``). ``pitch`` is the sample spacing
+/// of the occlusion z-buffer in mesh units (default: a third of the mean edge length). Returns a
+/// bool array, one entry per face: ``mesh.faces[mask]`` is the part such a scan would hold.
+/// Used to compare a probe scan with a gallery face as the probe's scanner would have seen it
+/// (docs/scans.md, "View matching").
+#[pyfunction]
+#[pyo3(signature = (mesh, toward_viewer, *, pitch=None, max_incidence=75.0))]
+pub fn visible_faces<'py>(
+    py: Python<'py>,
+    mesh: &Bound<'py, PyAny>,
+    toward_viewer: &Bound<'py, PyAny>,
+    pitch: Option<f64>,
+    max_incidence: f64,
+) -> PyResult<Bound<'py, numpy::PyArray1<bool>>> {
+    let m = mesh_arg(mesh)?;
+    let mesh = m.mesh();
+    let toward: DVec3 = convert::point(toward_viewer, "toward_viewer")?;
+    let pitch = pitch.unwrap_or_else(|| mesh.mean_edge_length() / 3.0);
+    let seen = py
+        .detach(|| rangescan::visible_faces(mesh, toward, pitch, max_incidence))
+        .map_err(errors::scan)?;
+    Ok(convert::vec_out(py, seen))
+}
