@@ -41,7 +41,8 @@ pub struct DetectOptions {
     /// For a range scan: the direction from the surface toward the scanner, in the mesh's
     /// frame (any length). The rims of what the scanner did not see (holes and borders whose
     /// vertices face away from it by more than [`GRAZING_RIM_DEG`]: grazing dropouts, the far
-    /// side of a turned head, the shadow of the nose) then bound unobserved surface, and the
+    /// side of a turned head; and those with surface in front of them: the cheek hidden by the
+    /// nose) then bound unobserved surface, and the
     /// local template search scores a landmark on the part of its template that is observed
     /// instead of counting the rest as mismatch. `None` (a mesh, not a scan): every point
     /// counts. The rims of the eye openings face the scanner and are not affected. With a
@@ -55,13 +56,19 @@ pub struct DetectOptions {
 /// structured-light scanners of `rangescan` start dropping samples at 70 degrees).
 pub const GRAZING_RIM_DEG: f64 = 65.0;
 
-/// Per vertex: whether it is on a boundary edge and faces away from `toward_viewer` by more
-/// than [`GRAZING_RIM_DEG`] (all `false` without a direction).
+/// Per vertex: whether it is on a rim of surface the scanner did not see (all `false` without a
+/// direction): a boundary vertex that faces away from `toward_viewer` by more than
+/// [`GRAZING_RIM_DEG`] (a grazing dropout, the far side of a turned head), or one with surface
+/// in front of it, that is a vertex within two of its mean edge lengths across the viewing
+/// direction and nearer to the scanner by more than `depth_gap` (the cheek beside the nose of a
+/// turned head, hidden by the nose).
 fn unseen_rims(
     mesh: &TriMesh,
-    nrm: &[DVec3],
+    idx: &SurfaceIndex,
     toward_viewer: Option<DVec3>,
+    depth_gap: f64,
 ) -> Result<Vec<bool>, LandmarkError> {
+    let nrm = &idx.nrm;
     let mut out = vec![false; nrm.len()];
     let Some(v) = toward_viewer else {
         return Ok(out);
@@ -73,10 +80,27 @@ fn unseen_rims(
     })?;
     let cos = GRAZING_RIM_DEG.to_radians().cos();
     let topo = meshcore::Topology::new(mesh);
+    let mut rim = vec![false; nrm.len()];
     for e in topo.edges().iter().filter(|e| e.is_boundary()) {
         for k in e.v {
+            rim[k as usize] = true;
             out[k as usize] = nrm[k as usize].dot(v) < cos;
         }
+    }
+    // Occlusion rims: the depth map's discontinuities seen from the scanner.
+    let (e1, e2) = v.any_orthonormal_pair();
+    let flat: Vec<[f64; 2]> = idx.pos.iter().map(|p| [p.dot(e1), p.dot(e2)]).collect();
+    let tree: kiddo::ImmutableKdTree<f64, 2> = kiddo::ImmutableKdTree::new_from_slice(&flat);
+    for b in 0..rim.len() {
+        if !rim[b] || out[b] {
+            continue;
+        }
+        let r = 4.0 * idx.reach[b];
+        let depth = idx.pos[b].dot(v);
+        out[b] = tree
+            .within_unsorted::<kiddo::SquaredEuclidean>(&flat[b], r * r)
+            .iter()
+            .any(|n| idx.pos[n.item as usize].dot(v) > depth + depth_gap);
     }
     Ok(out)
 }
@@ -309,7 +333,7 @@ pub fn detect_with(
     let debug = std::env::var_os("LANDMARKS_DEBUG").is_some();
     let clock = std::time::Instant::now();
     let mut idx = surface_index(mesh_m);
-    idx.unseen_rim = unseen_rims(mesh_m, &idx.nrm, options.toward_viewer)?;
+    idx.unseen_rim = unseen_rims(mesh_m, &idx, options.toward_viewer, p.inlier_distance)?;
     let adj = VertexAdjacency::new(mesh_m);
     // Candidates come from the curvature at vertices about a sixth of the curvature radius
     // apart: every vertex of a mesh as coarse as the training faces, a subsample of a dense scan
@@ -827,4 +851,63 @@ fn refine(
         }
     }
     (best.1, best.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use meshcore::{shapes, Topology};
+
+    /// What a scanner along +z measures of a plate hovering 5 units over a plane: the plane
+    /// over [0, 20]^2 with the plate's shadow [8, 12]^2 cut out, and the plate (its vertices
+    /// after the plane's `n` ones).
+    fn plate_over_shadowed_plane() -> (TriMesh, usize) {
+        let inside = |x: f64, y: f64| (x - 10.0).abs() < 2.0 && (y - 10.0).abs() < 2.0;
+        let plane = shapes::grid_plane(20, 1.0, 0.0, 0.0, 0, |c| inside(c.x, c.y));
+        let plate = shapes::grid_plane(4, 1.0, 8.0, 0.0, 0, |_| false);
+        let n = plane.n_vertices();
+        let mut pos = plane.positions().to_vec();
+        pos.extend(plate.positions().iter().map(|p| *p + DVec3::Z * 5.0));
+        let mut tris = plane.triangles().to_vec();
+        tris.extend(plate.triangles().iter().map(|t| t.map(|v| v + n as u32)));
+        (TriMesh::new(pos, tris).unwrap(), n)
+    }
+
+    #[test]
+    fn rims_with_surface_in_front_of_them_are_unseen() {
+        let (mesh, n) = plate_over_shadowed_plane();
+        let idx = surface_index(&mesh);
+        let rims = unseen_rims(&mesh, &idx, Some(DVec3::Z), 1.0).unwrap();
+        let topo = Topology::new(&mesh);
+        let mut boundary: Vec<u32> = topo
+            .edges()
+            .iter()
+            .filter(|e| e.is_boundary())
+            .flat_map(|e| e.v)
+            .collect();
+        boundary.sort_unstable();
+        boundary.dedup();
+        let mut shadow_rim = 0;
+        for &b in &boundary {
+            let p = mesh.position(b);
+            // The rim of the plate's shadow on the plane has the plate in front of it; the
+            // plane's outer border and the plate's own border have nothing in front.
+            let expected =
+                (b as usize) < n && (p.x - 10.0).abs() <= 2.0 && (p.y - 10.0).abs() <= 2.0;
+            assert_eq!(rims[b as usize], expected, "boundary vertex {b} at {p:?}");
+            shadow_rim += usize::from(expected);
+        }
+        assert_eq!(shadow_rim, 16);
+        // Interior vertices are never rims; without a direction nothing is.
+        assert_eq!(rims.iter().filter(|&&r| r).count(), 16);
+        assert!(unseen_rims(&mesh, &idx, None, 1.0)
+            .unwrap()
+            .iter()
+            .all(|&r| !r));
+        // A depth gap larger than the plate's height: the shadow's rim is an ordinary border.
+        assert!(unseen_rims(&mesh, &idx, Some(DVec3::Z), 6.0)
+            .unwrap()
+            .iter()
+            .all(|&r| !r));
+    }
 }
