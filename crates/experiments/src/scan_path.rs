@@ -1,7 +1,7 @@
 //! `cargo xtask scan-path`: wall time of each step of the whole path for one range scan: read
 //! the `.bnt`, clean it (`scanprep::clean`, defaults), detect the landmarks
-//! (`landmarks::detect_seen_from`, seen from +z), describe it (`bipolar::describe` with the exact solver from the two
-//! detected outer eye corners, as `bipolar describe scan.bnt --ref-a outer-eye-right --ref-b
+//! (`landmarks::detect_seen_from`, seen from +z), describe it (`bipolar::describe` with the
+//! exact solver from the two detected outer eye corners, as `bipolar describe scan.bnt --ref-a outer-eye-right --ref-b
 //! outer-eye-left` does). Without `--bnt` it scans the ICT neutral face (structured-light
 //! artifacts) at `--pitch` and writes the scan into the output folder first.
 

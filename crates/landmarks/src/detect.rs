@@ -42,9 +42,8 @@ pub struct DetectOptions {
     /// frame (any length). The rims of what the scanner did not see (holes and borders whose
     /// vertices face away from it by more than [`GRAZING_RIM_DEG`]: grazing dropouts, the far
     /// side of a turned head; and those with surface in front of them: the cheek hidden by the
-    /// nose) then bound unobserved surface, and the
-    /// local template search scores a landmark on the part of its template that is observed
-    /// instead of counting the rest as mismatch. `None` (a mesh, not a scan): every point
+    /// nose) then bound unobserved surface, and the local template search scores a landmark on
+    /// the part of its template that is observed instead of counting the rest as mismatch. `None` (a mesh, not a scan): every point
     /// counts. The rims of the eye openings face the scanner and are not affected. With a
     /// direction the learned regression also reads surface missing where the training faces
     /// had it as unobserved rather than as shape.

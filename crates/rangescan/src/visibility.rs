@@ -9,7 +9,8 @@ use meshcore::{DQuat, DVec3, TriMesh};
 /// surface to the scanner, any length; orthographic rays) would measure: a face is seen when
 /// its normal is within `max_incidence_deg` of that direction (so back faces never are) and
 /// none of its three vertices is hidden, that is, no other triangle lies nearer to the scanner
-/// along the vertex's ray by more than a quarter of `pitch`.
+/// along the vertex's ray by more than twice `pitch` (depth differences within two samples are
+/// taken as the surface's own relief: noise and small folds at grazing angles).
 ///
 /// Occlusion is found with a z-buffer of sample spacing `pitch` (mesh units; about a third of
 /// the mesh's edge length or finer): each vertex is tested against the triangles that are

@@ -157,7 +157,8 @@ const SCAN_MAX_INCIDENCE_DEG: f64 = 60.0;
 /// search").
 const SCAN_REF_SEARCH_MM: f64 = 2.0;
 
-/// The default of `--view-match` (degrees).
+/// The default of `--view-match` (degrees). Not tuned: below it a probe is near frontal, its
+/// scanner saw what the gallery's did, and the gallery's own description is used.
 const SCAN_VIEW_MATCH_DEG: f64 = 10.0;
 
 /// Incidence (degrees) beyond which a view-matched gallery face loses its faces: the middle of
@@ -300,6 +301,25 @@ fn iso_levels_of(
         .context("iso-curvature levels of the reference face")
 }
 
+/// The benchmark's bipolar descriptor on `mesh` from `refs`: static area, rule `All`, the
+/// options' levels and band, and the vertex mask `seen`.
+fn static_bipolar(
+    mesh: &TriMesh,
+    refs: &Refs,
+    o: &DescribeOptions,
+    seen: Option<&[bool]>,
+) -> Result<bipolar::Descriptor, bipolar::BipolarError> {
+    bipolar(
+        mesh,
+        refs,
+        o.levels,
+        Region::Static,
+        DescriptorRule::CrateAll,
+        o.boundary_margin,
+        seen,
+    )
+}
+
 /// The four descriptions of one face for one landmark set: bipolar (static area, grid
 /// reading), single pole, facial curves and iso-curvature. Only the static lens (within D of
 /// both corners, D ~ 1.1 |q - r|) and radii up to D from the nose tip are used: the fields are
@@ -337,16 +357,8 @@ fn describe_face(
         ),
         None => None,
     };
-    let bip = bipolar(
-        mesh,
-        &refs,
-        o.levels,
-        Region::Static,
-        DescriptorRule::CrateAll,
-        o.boundary_margin,
-        seen.as_deref(),
-    )
-    .map_err(|e| format!("bipolar descriptor: {e}"));
+    let bip = static_bipolar(mesh, &refs, o, seen.as_deref())
+        .map_err(|e| format!("bipolar descriptor: {e}"));
     let bip_alt = match o.ref_search {
         Some(rho) if bip.is_ok() => {
             moved_corner_descriptors(mesh, solver, lm, &refs, rho, o, seen.as_deref())
@@ -461,15 +473,7 @@ fn moved_corner_descriptors(
                 nose: refs.nose,
                 frame: face_frame(mesh, pr, pq, refs.nose),
             };
-            if let Ok(b) = bipolar(
-                mesh,
-                &moved,
-                o.levels,
-                Region::Static,
-                DescriptorRule::CrateAll,
-                o.boundary_margin,
-                seen,
-            ) {
+            if let Ok(b) = static_bipolar(mesh, &moved, o, seen) {
                 out.push(b);
             }
         }
@@ -566,16 +570,7 @@ impl ViewSource {
             }
             None => None,
         };
-        bipolar(
-            &cut,
-            &refs,
-            self.opts.levels,
-            Region::Static,
-            DescriptorRule::CrateAll,
-            self.opts.boundary_margin,
-            seen.as_deref(),
-        )
-        .ok()
+        static_bipolar(&cut, &refs, &self.opts, seen.as_deref()).ok()
     }
 }
 
@@ -708,13 +703,10 @@ fn score_one(
             Ok(own) => {
                 let matched = y.view.as_ref().and_then(|v| v.describe_from(&x.lm_pos));
                 let yb = matched.as_ref().unwrap_or(own);
-                x.bip_alt.iter().filter_map(|a| dist(a, yb).ok()).fold(
-                    x.bip
-                        .as_ref()
-                        .ok()
-                        .map_or(f64::NAN, |b| dist(b, yb).unwrap_or(f64::NAN)),
-                    f64::min,
-                )
+                x.bip_alt
+                    .iter()
+                    .filter_map(|a| dist(a, yb).ok())
+                    .fold(dist(&x.bip, yb).unwrap_or(f64::NAN), f64::min)
             }
             Err(_) => f64::NAN,
         },

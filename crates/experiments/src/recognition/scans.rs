@@ -1,8 +1,8 @@
 //! `cargo xtask recognition --scans`: the benchmark on range scans. Faces sampled from the ICT
 //! model are scanned by `rangescan`, cleaned by `scanprep` (crop around the nose tip) and
 //! described on the cleaned scans with the ground-truth landmarks the scanner projected and with
-//! the landmarks `landmarks::detect_with` finds (seen from the scanner). Gallery: neutral frontal scans at the `--scan-*`
-//! settings; probes: the other expressions, each under a random yaw of 0-45 degrees (either
+//! the landmarks `landmarks::detect_with` finds (seen from the scanner). Gallery: neutral
+//! frontal scans at the `--scan-*` settings; probes: the other expressions, each under a random yaw of 0-45 degrees (either
 //! side) and a random noise level. Sweeps rescan one probe expression of the first
 //! `--sweep-identities` identities at several noise levels, pitches and yaws (the other settings
 //! those of the gallery) against the same gallery. Every failure (a landmark not found or not on
