@@ -538,11 +538,13 @@ fn thread_cpu_ns() -> Option<u64> {
     s.split_whitespace().next()?.parse().ok()
 }
 
-/// Outcome of one scanned test face: per landmark the error in mm (`inf`: not found), or why
-/// the truth is not on the cleaned scan; the detector's error message.
+/// Outcome of one scanned test face: per landmark the error in mm (`inf`: not found, the face
+/// or the landmark), or why the truth is not on the cleaned scan; why the detector reported a
+/// landmark unseen; the detector's error message.
 struct ScanOutcome {
     name: String,
     errors: [Result<f64, String>; 5],
+    unseen: [Option<String>; 5],
     not_found: Option<String>,
     valid_samples: usize,
     vertices: usize,
@@ -615,13 +617,23 @@ fn run_scans(
             let t = &f.truth[n as usize];
             match (&t.vertex, &f.detected) {
                 (Err(why), _) => Err(why.clone()),
-                (Ok(_), Ok(d)) => Ok((d.get(n).position - t.position).length()),
+                (Ok(_), Ok(d)) => Ok(d
+                    .get(n)
+                    .map_or(f64::INFINITY, |l| (l.position - t.position).length())),
                 (Ok(_), Err(_)) => Ok(f64::INFINITY),
             }
+        });
+        let unseen = LandmarkName::ALL.map(|n| {
+            f.detected
+                .as_ref()
+                .ok()
+                .and_then(|d| d.get(n).err())
+                .map(|u| u.to_string())
         });
         outcomes.push(ScanOutcome {
             name: spec.name.clone(),
             errors,
+            unseen,
             not_found: f.detected.as_ref().err().cloned(),
             valid_samples: f.valid_samples,
             vertices: f.mesh.n_vertices(),
@@ -653,6 +665,7 @@ fn run_scans(
         .flat_map(|o| {
             LandmarkName::ALL
                 .iter()
+                .filter(|&&n| o.unseen[n as usize].is_none())
                 .filter_map(|&n| match &o.errors[n as usize] {
                     Ok(e) if *e > 10.0 => Some((o.name.clone(), format!("{n} {e:.1} mm off"))),
                     Err(why) => Some((o.name.clone(), format!("{n} reported but {why}"))),
@@ -673,6 +686,19 @@ fn run_scans(
         .collect();
     let n = outcomes.len();
     let nf_rate = not_found.len() as f64 / n as f64;
+    // Landmarks of found faces reported unseen: where the truth is not on the cleaned scan
+    // (right) and where it is (a landmark not found).
+    let reported_unseen = |truth_on_scan: bool| -> usize {
+        outcomes
+            .iter()
+            .map(|o| {
+                (0..5)
+                    .filter(|&k| o.unseen[k].is_some() && o.errors[k].is_ok() == truth_on_scan)
+                    .count()
+            })
+            .sum()
+    };
+    let (unseen_right, unseen_missed) = (reported_unseen(false), reported_unseen(true));
     let unseen: usize = outcomes
         .iter()
         .map(|o| o.errors.iter().filter(|e| e.is_err()).count())
@@ -726,6 +752,9 @@ fn run_scans(
     for (name, e) in not_found.iter().take(20) {
         println!("  {name}: {e}");
     }
+    println!(
+        "landmarks of found faces reported unseen: {unseen_right} whose truth is not on the cleaned scan, {unseen_missed} whose truth is (counted as not found above)"
+    );
     println!("silent wrong landmarks: {}", silent.len());
     for (name, w) in silent.iter().take(20) {
         println!("  {name}: {w}");
@@ -783,6 +812,7 @@ fn run_scans(
         "not_found_rate": nf_rate,
         "silent_wrong": silent.iter().map(|(f, w)| serde_json::json!({"face": f, "what": w})).collect::<Vec<_>>(),
         "truth_not_on_cleaned_scan": unseen,
+        "reported_unseen": {"truth_not_on_scan": unseen_right, "truth_on_scan": unseen_missed},
         "scan_failures": scan_failures,
         "targets": targets.iter().map(|(w, ok)| serde_json::json!({"target": w, "met": ok})).collect::<Vec<_>>(),
         "seconds": secs,
@@ -799,9 +829,16 @@ fn run_scans(
         let e: Vec<String> = o
             .errors
             .iter()
-            .map(|e| match e {
-                Ok(x) => format!("{x:.2}"),
-                Err(why) => format!("unseen: {}", why.replace(',', ";")),
+            .zip(&o.unseen)
+            .map(|(e, u)| {
+                let reported = u
+                    .as_deref()
+                    .map(|u| format!(" (reported unseen: {u})"))
+                    .unwrap_or_default();
+                match e {
+                    Ok(x) => format!("{x:.2}{reported}"),
+                    Err(why) => format!("unseen: {why}{reported}").replace(',', ";"),
+                }
             })
             .collect();
         csv += &format!(

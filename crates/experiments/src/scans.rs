@@ -10,7 +10,7 @@
 use anyhow::Result;
 use facemodel::FaceModel;
 use indicatif::ProgressBar;
-use landmarks::{DetectOptions, GenericModel, LandmarkName, Landmarks};
+use landmarks::{DetectOptions, GenericModel, LandmarkName, VisibleLandmarks};
 use meshcore::{DVec3, TriMesh};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -173,8 +173,9 @@ pub struct ScannedFace {
     pub mesh: TriMesh,
     /// Ground truth, in [`LandmarkName::ALL`] order.
     pub truth: [Truth; 5],
-    /// Landmarks detected on the cleaned scan, or the detector's error message.
-    pub detected: Result<Landmarks, String>,
+    /// Landmarks detected on the cleaned scan (`landmarks::detect_visible`: those the scanner
+    /// did not see are reported unseen), or the detector's error message.
+    pub detected: Result<VisibleLandmarks, String>,
     /// Step times.
     pub times: StepTimes,
 }
@@ -193,19 +194,6 @@ impl ScannedFace {
             v(LandmarkName::OuterEyeRight)?,
             v(LandmarkName::OuterEyeLeft)?,
             v(LandmarkName::NoseTip)?,
-        ])
-    }
-
-    /// Detected vertices of the outer eye corners and the nose tip, or the detector's error.
-    pub fn detected_vertices(&self) -> Result<[u32; 3], String> {
-        let d = self
-            .detected
-            .as_ref()
-            .map_err(|e| format!("detection: {e}"))?;
-        Ok([
-            d.outer_eye_right.vertex,
-            d.outer_eye_left.vertex,
-            d.nose_tip.vertex,
         ])
     }
 }
@@ -380,7 +368,7 @@ pub fn scan_face(
     let detected = match &options.detect {
         Some(o) => landmarks::mesh_units_per_model_unit(seen_by_detector, generic)
             .and_then(|s| {
-                landmarks::detect_with(
+                landmarks::detect_visible(
                     seen_by_detector,
                     generic,
                     &DetectOptions {
@@ -391,13 +379,7 @@ pub fn scan_face(
             })
             .map(|mut found| {
                 // The same vertices, at their places on the scan.
-                for l in [
-                    &mut found.outer_eye_right,
-                    &mut found.inner_eye_right,
-                    &mut found.inner_eye_left,
-                    &mut found.outer_eye_left,
-                    &mut found.nose_tip,
-                ] {
+                for l in found.landmarks.iter_mut().flatten() {
                     l.position = mesh.position(l.vertex);
                 }
                 found

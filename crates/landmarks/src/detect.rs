@@ -7,7 +7,7 @@
 use crate::curvature::{curvatures_at, CurvatureOptions, VertexAdjacency};
 use crate::geom::{icp, score, FitScore, SurfaceIndex};
 use crate::model::GenericModel;
-use crate::{Landmark, LandmarkError, LandmarkName, Landmarks};
+use crate::{Landmark, LandmarkError, LandmarkName, Landmarks, Unseen, VisibleLandmarks};
 use meshcore::linalg::{fit_rigid, rigid_inverse};
 use meshcore::{DAffine3, DMat3, DQuat, DVec3, TriMesh};
 use rayon::prelude::*;
@@ -102,6 +102,15 @@ fn unseen_rims(
             .any(|n| idx.pos[n.item as usize].dot(v) > depth + depth_gap);
     }
     Ok(out)
+}
+
+/// Whether a vertex on an unseen rim ([`unseen_rims`]) lies within `reach` of `p`.
+fn near_unseen_rim(idx: &SurfaceIndex, p: DVec3, reach: f64) -> bool {
+    let r2 = reach * reach;
+    idx.unseen_rim
+        .iter()
+        .zip(&idx.pos)
+        .any(|(&rim, q)| rim && (*q - p).length_squared() <= r2)
 }
 
 impl Default for DetectOptions {
@@ -253,13 +262,13 @@ fn diverse(sorted: Vec<Hypothesis>, keys: [DVec3; 3], radius: f64, max: usize) -
 }
 
 /// A finely fitted pose with its confidence, symmetry and (once computed) its refined landmarks
-/// with their weakest local agreement.
+/// with their local agreements.
 #[derive(Debug, Clone, Copy)]
 struct Verified {
     h: Hypothesis,
     conf: f64,
     sym: f64,
-    refined: Option<([Landmark; 5], f64)>,
+    refined: Option<([Landmark; 5], [f64; 5])>,
 }
 
 /// Detects the five landmarks with the default options, the mesh in any of mm, cm or m: its
@@ -310,6 +319,41 @@ pub fn detect_with(
     model: &GenericModel,
     options: &DetectOptions,
 ) -> Result<Landmarks, LandmarkError> {
+    detect_impl(mesh, model, options, false)?.complete()
+}
+
+/// Least local template agreement of a landmark beside unseen surface for [`detect_visible`]
+/// to place it when the face has unseen landmarks. At 45 degrees of yaw, the far outer eye
+/// corners placed 13-18 mm off had agreements of 0.855-0.877 (above the 0.85 of
+/// [`DetectOptions::min_local_agreement`]).
+pub const RIM_AGREEMENT: f64 = 0.9;
+
+/// Least number of landmarks [`detect_visible`] must place (the nose tip among them).
+pub const MIN_PLACED: usize = 3;
+
+/// Detects the landmarks of a face the scanner may not have seen whole: as [`detect_with`],
+/// but a landmark that is not on the input is reported as [`Unseen`] (with the reason)
+/// instead of rejecting the fitted face, which must still place the nose tip and at least
+/// [`MIN_PLACED`] landmarks, each agreeing with its template. A landmark is unseen when
+/// surface nearer to the scanner covers the fitted face's landmark by more than the model's
+/// inlier distance (only with [`DetectOptions::toward_viewer`]: the far inner eye corner
+/// behind the nose of a turned head), or when too little of the surface expected around it is
+/// on the input ([`DetectOptions::min_landmark_coverage`]: a hole, the border of the scan).
+pub fn detect_visible(
+    mesh: &TriMesh,
+    model: &GenericModel,
+    options: &DetectOptions,
+) -> Result<VisibleLandmarks, LandmarkError> {
+    detect_impl(mesh, model, options, true)
+}
+
+/// [`detect_with`] (`partial` false: every landmark must be placed) or [`detect_visible`].
+fn detect_impl(
+    mesh: &TriMesh,
+    model: &GenericModel,
+    options: &DetectOptions,
+    partial: bool,
+) -> Result<VisibleLandmarks, LandmarkError> {
     model.validate()?;
     let s = options.mesh_units_per_model_unit;
     if !(s.is_finite() && s > 0.0) {
@@ -533,7 +577,7 @@ pub fn detect_with(
                 let r = *f
                     .refined
                     .get_or_insert_with(|| refine_all(&idx, model, &f.h.t, f.conf, debug));
-                if r.1 >= options.min_local_agreement {
+                if weakest(&r.1, &[None; 5]) >= options.min_local_agreement {
                     break;
                 }
             }
@@ -554,7 +598,15 @@ pub fn detect_with(
     // The best-fitting pose that passes the three checks (fit confidence, mirror symmetry, local
     // template agreement at every landmark), in increasing order of fit cost.
     let mut rejected: Option<(String, f64)> = None;
-    for f in &mut fits {
+    // A partial detection takes the first fit that places every landmark, as `detect_with`
+    // does, and only when there is none the first that places enough of them.
+    let passes: &[bool] = if partial { &[false, true] } else { &[false] };
+    let n_fits = fits.len();
+    for (&partial, k) in passes
+        .iter()
+        .flat_map(|p| std::iter::repeat(p).zip(0..n_fits))
+    {
+        let f = &mut fits[k];
         let why = if f.conf < options.min_confidence {
             Some(format!(
                 "the best fit of the generic face covers {:.0} % of it (rms {:.3} model units; confidence {:.2} < {:.2})",
@@ -575,9 +627,26 @@ pub fn detect_with(
             rejected.get_or_insert((why, f.conf * f.sym));
             continue;
         }
-        let (out, local) = *f
+        let (out, agreement) = *f
             .refined
             .get_or_insert_with(|| refine_all(&idx, model, &f.h.t, f.conf, debug));
+        let predicted = L::ALL.map(|n| f.h.t.transform_point3(model.landmark(n)));
+        // Partial detection: a landmark that borders surface the scanner did not see (an unseen
+        // rim within its template's reach) and agrees with its template less than
+        // [`RIM_AGREEMENT`] is unseen, not a mismatch of the pose.
+        let mut unseen: [Option<Unseen>; 5] = [None; 5];
+        if partial {
+            for k in 0..5 {
+                if agreement[k] < RIM_AGREEMENT.max(options.min_local_agreement)
+                    && near_unseen_rim(&idx, out[k].position, model.patches[k].reach())
+                {
+                    unseen[k] = Some(Unseen::Unobserved {
+                        agreement: agreement[k],
+                    });
+                }
+            }
+        }
+        let local = weakest(&agreement, &unseen);
         if local < options.min_local_agreement {
             rejected.get_or_insert((
                 format!(
@@ -605,41 +674,61 @@ pub fn detect_with(
         // Every landmark must sit on the input: one the fitted face puts where the input has
         // no surface (occluded, in a hole, cropped) lands on the nearest rim vertex, a silent
         // wrong point; the template around a reported point then finds little surface.
+        // In a partial detection such a landmark is unseen; otherwise the pose is rejected.
+        let mut bare = None;
         if options.min_landmark_coverage > 0.0 {
-            let bare = L::ALL.into_iter().find_map(|name| {
+            for name in L::ALL {
                 let k = name as usize;
+                if unseen[k].is_some() {
+                    continue;
+                }
                 let c = coverage(&idx, &model.patches[k], &best.t, out[k].position, tau);
-                (c < options.min_landmark_coverage).then_some((name, c))
-            });
-            if let Some((name, c)) = bare {
-                rejected.get_or_insert((
-                    format!(
-                        "{name} is not on the surface: only {:.0} % of the surface expected around it was found (at least {:.0} % needed); it is occluded, in a hole or outside the scan",
-                        100.0 * c,
-                        100.0 * options.min_landmark_coverage
-                    ),
-                    f.conf * c,
-                ));
-                continue;
+                if c < options.min_landmark_coverage {
+                    unseen[k] = Some(Unseen::Bare { coverage: c });
+                    bare = bare.or(Some((name, c)));
+                }
             }
         }
-        let out = out.map(|l| Landmark {
-            position: mesh.position(l.vertex),
-            ..l
-        });
+        if let (false, Some((name, c))) = (partial, bare) {
+            rejected.get_or_insert((
+                format!(
+                    "{name} is not on the surface: only {:.0} % of the surface expected around it was found (at least {:.0} % needed); it is occluded, in a hole or outside the scan",
+                    100.0 * c,
+                    100.0 * options.min_landmark_coverage
+                ),
+                f.conf * c,
+            ));
+            continue;
+        }
+        let placed = unseen.iter().filter(|u| u.is_none()).count();
+        if let Some(u) = unseen[L::NoseTip as usize] {
+            rejected.get_or_insert((format!("nose_tip is not on the surface: {u}"), 0.0));
+            continue;
+        }
+        if placed < MIN_PLACED {
+            rejected.get_or_insert((
+                format!("only {placed} of the 5 landmarks are on the surface (at least {MIN_PLACED} needed)"),
+                0.0,
+            ));
+            continue;
+        }
         let pose = DAffine3::from_mat3_translation(best.t.matrix3, best.t.translation * s);
         if debug {
             eprintln!(
-                "[{:.1} ms] landmarks placed and checked",
+                "[{:.1} ms] landmarks placed and checked; unseen {unseen:?}",
                 clock.elapsed().as_secs_f64() * 1e3
             );
         }
-        return Ok(Landmarks {
-            outer_eye_right: out[L::OuterEyeRight as usize],
-            inner_eye_right: out[L::InnerEyeRight as usize],
-            inner_eye_left: out[L::InnerEyeLeft as usize],
-            outer_eye_left: out[L::OuterEyeLeft as usize],
-            nose_tip: out[L::NoseTip as usize],
+        let landmarks = std::array::from_fn(|k| match unseen[k] {
+            Some(u) => Err(u),
+            None => Ok(Landmark {
+                position: mesh.position(out[k].vertex),
+                ..out[k]
+            }),
+        });
+        return Ok(VisibleLandmarks {
+            landmarks,
+            predicted: predicted.map(|p| p * s),
             confidence: f.conf,
             fit_rms: best.fit.rms * s,
             inlier_fraction: best.fit.inlier_fraction,
@@ -652,15 +741,15 @@ pub fn detect_with(
 }
 
 /// Local template refinement of the five landmarks predicted by the pose `t`: the landmarks
-/// (positions in model units, confidences `conf_fit` times the local agreement) and the
-/// weakest local agreement.
+/// (positions in model units, confidences `conf_fit` times the local agreement) and each one's
+/// local agreement.
 fn refine_all(
     idx: &SurfaceIndex,
     model: &GenericModel,
     t: &DAffine3,
     conf_fit: f64,
     debug: bool,
-) -> ([Landmark; 5], f64) {
+) -> ([Landmark; 5], [f64; 5]) {
     use LandmarkName as L;
     let p = &model.params;
     let mut out = [Landmark {
@@ -668,7 +757,7 @@ fn refine_all(
         position: DVec3::ZERO,
         confidence: 0.0,
     }; 5];
-    let mut weakest = 1.0_f64;
+    let mut agreement = [0.0; 5];
     for name in L::ALL {
         let pred = t.transform_point3(model.landmark(name));
         let tpl = model.patches[name as usize].pairs();
@@ -689,14 +778,23 @@ fn refine_all(
                 c_local
             );
         }
-        weakest = weakest.min(c_local);
+        agreement[name as usize] = c_local;
         out[name as usize] = Landmark {
             vertex: v,
             position: idx.pos[v as usize],
             confidence: (conf_fit * c_local).clamp(0.0, 1.0),
         };
     }
-    (out, weakest)
+    (out, agreement)
+}
+
+/// The weakest of the local agreements of the landmarks not marked in `skip`.
+fn weakest(agreement: &[f64; 5], skip: &[Option<Unseen>; 5]) -> f64 {
+    agreement
+        .iter()
+        .zip(skip)
+        .filter(|(_, u)| u.is_none())
+        .fold(1.0_f64, |w, (a, _)| w.min(*a))
 }
 
 /// Landmarks placed by the learned regression of the model for the accepted pose `t`: the

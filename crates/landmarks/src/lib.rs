@@ -25,8 +25,8 @@ mod regress;
 
 pub use curvature::{curvedness, shape_index, Curvature, CurvatureOptions};
 pub use detect::{
-    detect, detect_seen_from, detect_with, mesh_units_per_model_unit, DetectOptions,
-    GRAZING_RIM_DEG,
+    detect, detect_seen_from, detect_visible, detect_with, mesh_units_per_model_unit,
+    DetectOptions, GRAZING_RIM_DEG, MIN_PLACED, RIM_AGREEMENT,
 };
 pub use model::{DetectParams, GenericModel, Template, TrainOptions};
 pub use regress::{LandmarkRegressor, RegressorOptions, RegressorPatch};
@@ -162,6 +162,91 @@ impl Landmarks {
     /// Positions in [`LandmarkName::ALL`] order.
     pub fn positions(&self) -> [DVec3; 5] {
         LandmarkName::ALL.map(|n| self.get(n).position)
+    }
+}
+
+/// Why [`detect_visible`] did not place a landmark of a face it found.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Unseen {
+    /// The landmark borders surface the scanner did not see (a rim of a dropout or of a part
+    /// hidden behind nearer surface, [`DetectOptions::toward_viewer`]) and what was seen
+    /// around it does not match its template: local agreement `agreement`, below
+    /// [`DetectOptions::min_local_agreement`].
+    Unobserved {
+        /// The landmark's local template agreement.
+        agreement: f64,
+    },
+    /// Only the share `coverage` of the surface expected around the landmark is on the input
+    /// (a hole, a dropout, the border of the scan).
+    Bare {
+        /// Share of the landmark's template that found the input surface.
+        coverage: f64,
+    },
+}
+
+impl std::fmt::Display for Unseen {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Unseen::Unobserved { agreement } => write!(
+                f,
+                "beside surface the scanner did not see, and what it saw does not match the landmark's template (agreement {agreement:.2})"
+            ),
+            Unseen::Bare { coverage } => write!(
+                f,
+                "only {:.0} % of the surface expected around it was found (in a hole or outside the scan)",
+                100.0 * coverage
+            ),
+        }
+    }
+}
+
+/// The landmarks of a face that the scanner may not have seen whole ([`detect_visible`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct VisibleLandmarks {
+    /// Per landmark in [`LandmarkName::ALL`] order: placed, or why not.
+    pub landmarks: [Result<Landmark, Unseen>; 5],
+    /// Where the fitted generic face puts each landmark (input units), seen or not: not a point
+    /// of the input.
+    pub predicted: [DVec3; 5],
+    /// Overall confidence in `[0, 1]` of the generic face fit.
+    pub confidence: f64,
+    /// RMS distance of the fitted generic face surface (inliers), input units.
+    pub fit_rms: f64,
+    /// Share of the generic face surface that found the input surface.
+    pub inlier_fraction: f64,
+    /// Mirror symmetry of the fit in `[0, 1]` (see [`Landmarks::symmetry`]).
+    pub symmetry: f64,
+    /// Rigid motion from the model's canonical frame to the input (see
+    /// [`Landmarks::model_to_mesh`]).
+    pub model_to_mesh: DAffine3,
+}
+
+impl VisibleLandmarks {
+    /// The landmark of a given name, or why it was not placed.
+    pub fn get(&self, name: LandmarkName) -> Result<&Landmark, Unseen> {
+        self.landmarks[name as usize].as_ref().map_err(|u| *u)
+    }
+
+    /// All five landmarks, or [`LandmarkError::NotFound`] naming the first one not placed.
+    pub fn complete(&self) -> Result<Landmarks, LandmarkError> {
+        let get = |n: LandmarkName| {
+            self.get(n).copied().map_err(|u| LandmarkError::NotFound {
+                reason: format!("{n} is not on the surface: {u}"),
+                best_score: self.confidence,
+            })
+        };
+        Ok(Landmarks {
+            outer_eye_right: get(LandmarkName::OuterEyeRight)?,
+            inner_eye_right: get(LandmarkName::InnerEyeRight)?,
+            inner_eye_left: get(LandmarkName::InnerEyeLeft)?,
+            outer_eye_left: get(LandmarkName::OuterEyeLeft)?,
+            nose_tip: get(LandmarkName::NoseTip)?,
+            confidence: self.confidence,
+            fit_rms: self.fit_rms,
+            inlier_fraction: self.inlier_fraction,
+            symmetry: self.symmetry,
+            model_to_mesh: self.model_to_mesh,
+        })
     }
 }
 

@@ -123,6 +123,14 @@ impl Template {
             .map(|p| (DVec3::new(p[0], p[1], p[2]), DVec3::new(p[3], p[4], p[5])))
             .collect()
     }
+
+    /// The farthest a point lies from the origin (for a landmark template: from the landmark).
+    pub fn reach(&self) -> f64 {
+        self.points
+            .iter()
+            .map(|p| DVec3::new(p[0], p[1], p[2]).length())
+            .fold(0.0, f64::max)
+    }
 }
 
 /// The generic face model (serialisable to JSON).

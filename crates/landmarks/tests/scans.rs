@@ -4,8 +4,8 @@
 //! mismatch. Skipped without the shared paper set.
 
 use landmarks::{
-    detect_with, io, mesh_units_per_model_unit, DetectOptions, GenericModel, LandmarkError,
-    LandmarkName,
+    detect_visible, detect_with, io, mesh_units_per_model_unit, DetectOptions, GenericModel,
+    LandmarkError, LandmarkName,
 };
 use meshcore::{DAffine3, DQuat, DVec3, TriMesh};
 use rangescan::{Artifacts, HeadPose, ScanOptions};
@@ -129,4 +129,83 @@ fn a_viewing_direction_that_is_no_direction_is_an_error() {
             other => panic!("{bad}: expected InvalidOption, got {other:?}"),
         }
     }
+}
+
+/// A head turned so far that the far inner eye corner hides behind the nose: `detect_with`
+/// finds no face with all five landmarks; `detect_visible` finds it, reports the hidden ones
+/// unseen with a reason and places the others near the truth, and only with the viewing
+/// direction (without it the far side is mismatch, not unseen surface).
+#[test]
+fn landmarks_a_turned_head_hides_are_reported_unseen() {
+    let model = GenericModel::default_model().unwrap();
+    for (name, yaw) in [("id6_neutral", 50.0), ("id2_neutral", 50.0)] {
+        let Some((mesh, truth)) = scanned(name, yaw, 3) else {
+            return;
+        };
+        let case = format!("{name} at {yaw} degrees");
+        let with_view = options(&mesh, &model, Some(DVec3::Z));
+        assert!(
+            detect_with(&mesh, &model, &with_view).is_err(),
+            "{case}: all five found"
+        );
+        let found =
+            detect_visible(&mesh, &model, &with_view).unwrap_or_else(|e| panic!("{case}: {e}"));
+        let unseen: Vec<LandmarkName> = LandmarkName::ALL
+            .into_iter()
+            .filter(|&n| found.get(n).is_err())
+            .collect();
+        assert!(!unseen.is_empty(), "{case}: nothing unseen");
+        // The far side is the one turned away from the scanner (larger x after a positive yaw
+        // turns the subject's left away).
+        let far_left = truth[LandmarkName::OuterEyeLeft as usize].z
+            < truth[LandmarkName::OuterEyeRight as usize].z;
+        let near_corner = if far_left {
+            LandmarkName::OuterEyeRight
+        } else {
+            LandmarkName::OuterEyeLeft
+        };
+        for n in [near_corner, LandmarkName::NoseTip] {
+            assert!(!unseen.contains(&n), "{case}: {n} unseen");
+        }
+        for n in LandmarkName::ALL {
+            if let Ok(l) = found.get(n) {
+                let err = (l.position - truth[n as usize]).length();
+                assert!(err < 5.0, "{case}: {n} {err:.2} mm from the truth");
+            }
+            // Where the fitted face puts every landmark, seen or not.
+            let off = (found.predicted[n as usize] - truth[n as usize]).length();
+            assert!(off < 10.0, "{case}: {n} predicted {off:.1} mm off");
+        }
+        let why = found.get(unseen[0]).unwrap_err().to_string();
+        assert!(
+            why.contains("did not see") || why.contains("surface"),
+            "{why}"
+        );
+        // complete() names the first unseen landmark.
+        match found.complete() {
+            Err(LandmarkError::NotFound { reason, .. }) => {
+                assert!(reason.contains(unseen[0].key()), "{reason}")
+            }
+            other => panic!("{case}: expected NotFound, got {other:?}"),
+        }
+        // Without the viewing direction the far side is not excused.
+        assert!(
+            detect_visible(&mesh, &model, &options(&mesh, &model, None)).is_err(),
+            "{case}: found without the viewing direction"
+        );
+    }
+}
+
+/// On a frontal scan every landmark is seen: `detect_visible` places the same five points as
+/// `detect_with`.
+#[test]
+fn a_frontal_scan_has_no_unseen_landmark() {
+    let model = GenericModel::default_model().unwrap();
+    let Some((mesh, _)) = scanned("id4_neutral", 0.0, 5) else {
+        return;
+    };
+    let o = options(&mesh, &model, Some(DVec3::Z));
+    let all = detect_with(&mesh, &model, &o).unwrap();
+    let visible = detect_visible(&mesh, &model, &o).unwrap();
+    assert_eq!(visible.complete().unwrap(), all);
 }

@@ -28,7 +28,7 @@ use crate::walk::Walker;
 use anyhow::{bail, Context, Result};
 use bipolar::PolarDescriptor;
 use facecurves::{ElasticOptions, FacialCurvesDescriptor, IsoLevels};
-use facemodel::{face_frame, random_rigid_motion, FaceModel};
+use facemodel::{face_frame, random_rigid_motion, FaceFrame, FaceModel};
 use geodesic::{SolveOptions, Source};
 use meshcore::linalg::fit_rigid;
 use meshcore::{DVec3, FaceLocator, Surface, TriMesh};
@@ -121,6 +121,15 @@ pub struct Args {
     /// description.
     #[arg(long)]
     pub no_view_match: bool,
+    /// Side pairs of the bipolar score (`--scans`; degrees): a probe whose eye line is turned
+    /// from its scanner by more than this is compared by the bipolar descriptor of its outer
+    /// eye corner nearer the scanner and its nose tip (the gallery faces are described by
+    /// both side pairs), not by its two corners, whose far one its scanner barely saw.
+    #[arg(long, default_value_t = SCAN_SIDE_PAIR_DEG)]
+    pub side_pair: f64,
+    /// No side pairs (`--scans`): every probe is compared by its outer eye corners.
+    #[arg(long)]
+    pub no_side_pair: bool,
 }
 
 /// One sampled face.
@@ -137,6 +146,85 @@ struct Lm {
     r: u32,
     q: u32,
     nose: u32,
+    /// An outer eye corner that is not on the surface (its vertex above is not used): only the
+    /// other corner's side pair can describe the face.
+    lost: Option<Lost>,
+}
+
+/// An outer eye corner that is not on the surface, and where it is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Lost {
+    /// The right corner (r); else the left (q).
+    right: bool,
+    position: DVec3,
+}
+
+impl Lm {
+    /// The three landmarks without a lost corner.
+    fn new(r: u32, q: u32, nose: u32) -> Self {
+        Lm {
+            r,
+            q,
+            nose,
+            lost: None,
+        }
+    }
+
+    /// Positions of r, q and the nose tip (a lost corner's true position).
+    fn positions(self, mesh: &TriMesh) -> [DVec3; 3] {
+        let mut p = [self.r, self.q, self.nose].map(|v| mesh.position(v));
+        if let Some(l) = self.lost {
+            p[usize::from(!l.right)] = l.position;
+        }
+        p
+    }
+
+    /// The two poles of `pair`, in the places of r and q.
+    fn poles(self, pair: Pair) -> (u32, u32) {
+        match pair {
+            Pair::Corners => (self.r, self.q),
+            Pair::RightNose => (self.r, self.nose),
+            Pair::LeftNose => (self.q, self.nose),
+        }
+    }
+}
+
+/// The two poles of a bipolar descriptor: the outer eye corners (the paper's), or one outer eye
+/// corner with the nose tip. The discriminant indexes [`Described::bip`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Pair {
+    Corners = 0,
+    /// The right outer eye corner (r) and the nose tip.
+    RightNose = 1,
+    /// The left outer eye corner (q) and the nose tip.
+    LeftNose = 2,
+}
+
+impl Pair {
+    const ALL: [Pair; 3] = [Pair::Corners, Pair::RightNose, Pair::LeftNose];
+
+    /// The pair a probe is compared by: the corners, or, when `limit_deg` is given and the
+    /// face is turned from its scanner (direction [`crate::scans::SCANNER_SIDE`]) by more
+    /// than it, the corner nearer the scanner with the nose tip. The turn is estimated from
+    /// the eye line alone, `asin(|x . scanner|)` (x: the unit eye line r to q), so a pitch of
+    /// the head barely changes it.
+    /// A face with a lost corner has only the other corner's pair.
+    fn for_probe(r: DVec3, q: DVec3, limit_deg: Option<f64>, lost: Option<Lost>) -> Pair {
+        match lost {
+            Some(l) if l.right => return Pair::LeftNose,
+            Some(_) => return Pair::RightNose,
+            None => {}
+        }
+        let Some(limit) = limit_deg else {
+            return Pair::Corners;
+        };
+        let s = (q - r).normalize_or_zero().dot(crate::scans::SCANNER_SIDE);
+        match s.abs().clamp(0.0, 1.0).asin().to_degrees() {
+            t if t <= limit => Pair::Corners,
+            _ if s > 0.0 => Pair::LeftNose,
+            _ => Pair::RightNose,
+        }
+    }
 }
 
 /// Default of `--scan-edge`, mm.
@@ -160,6 +248,9 @@ const SCAN_REF_SEARCH_MM: f64 = 2.0;
 /// The default of `--view-match` (degrees). Not tuned: below it a probe is near frontal, its
 /// scanner saw what the gallery's did, and the gallery's own description is used.
 const SCAN_VIEW_MATCH_DEG: f64 = 10.0;
+
+/// The default of `--side-pair` (degrees).
+const SCAN_SIDE_PAIR_DEG: f64 = 30.0;
 
 /// Incidence (degrees) beyond which a view-matched gallery face loses its faces: the middle of
 /// the structured-light scanner model's grazing dropouts (70-80 degrees).
@@ -201,8 +292,12 @@ fn elastic_options(samples: usize) -> ElasticOptions {
 /// Per face and landmark set: descriptors, landmark positions and description times.
 #[derive(Debug)]
 struct Described {
-    bip: Result<bipolar::Descriptor, String>,
-    /// Bipolar descriptors from moved corners (`DescribeOptions::ref_search`; else empty).
+    /// Bipolar descriptors, one per [`Pair`] (indexed by its discriminant).
+    bip: [Result<bipolar::Descriptor, String>; 3],
+    /// The pair this face is compared by as a probe ([`Pair::for_probe`]).
+    pair: Pair,
+    /// Bipolar descriptors of `pair` from moved poles (`DescribeOptions::ref_search`; else
+    /// empty).
     bip_alt: Vec<bipolar::Descriptor>,
     pol: PolarDescriptor,
     facial: Result<FacialCurvesDescriptor, String>,
@@ -235,6 +330,9 @@ struct DescribeOptions {
     ref_search: Option<f64>,
     /// View matching of the gallery faces (`Args::view_match`, degrees; `None`: off).
     view_match: Option<f64>,
+    /// Probes turned by more than this (degrees) are compared by the bipolar descriptor of
+    /// their nearer corner and the nose tip (`Args::side_pair`; `None`: always the corners).
+    side_pair_deg: Option<f64>,
 }
 
 /// The fields of a face cut off at 1.4 |q - r| (corners r, q; nose tip, when asked for: else
@@ -253,38 +351,107 @@ fn fields(
     lm: Lm,
     nose: bool,
 ) -> Result<Fields, String> {
-    if lm.r == lm.q {
+    if lm.lost.is_none() && lm.r == lm.q {
         return Err(format!(
             "the two outer eye corners are the same vertex {}",
             lm.r
         ));
     }
+    let [pr, pq, _] = lm.positions(mesh);
     let cut = SolveOptions {
-        max_distance: Some(1.4 * (mesh.position(lm.q) - mesh.position(lm.r)).length()),
+        max_distance: Some(1.4 * (pq - pr).length()),
     };
-    let field = |v: u32| {
+    let field = |v: u32, lost: bool| {
+        if lost {
+            return Ok(Vec::new());
+        }
         solver
             .distances(&[Source::Vertex(v)], &cut)
             .map_err(|e| format!("geodesic field: {e}"))
     };
+    let lost_right = lm.lost.map(|l| l.right);
     let t = Instant::now();
-    let (ur, uq) = (field(lm.r)?, field(lm.q)?);
+    let (ur, uq) = (
+        field(lm.r, lost_right == Some(true))?,
+        field(lm.q, lost_right == Some(false))?,
+    );
     let t_corners = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let un = if nose { field(lm.nose)? } else { Vec::new() };
+    let un = if nose {
+        field(lm.nose, false)?
+    } else {
+        Vec::new()
+    };
     let t_nose = t.elapsed().as_secs_f64();
-    let d = 0.5 * (ur[lm.q as usize] + uq[lm.r as usize]);
-    if !d.is_finite() || d <= 0.0 {
-        return Err(format!(
-            "the geodesic distance between the outer eye corners is {d} (not reachable within 1.4 times their distance)"
-        ));
-    }
+    let d = match lm.lost {
+        Some(_) => f64::NAN,
+        None => 0.5 * (ur[lm.q as usize] + uq[lm.r as usize]),
+    };
     Ok(Fields {
         ur,
         uq,
         un,
         d,
         secs: [t_corners, t_nose],
+    })
+}
+
+impl Fields {
+    /// D, the geodesic distance between the outer eye corners, or why there is none.
+    fn scale(&self, lm: Lm) -> Result<f64, String> {
+        if lm.lost.is_some() {
+            return Err("an outer eye corner is not on the surface".into());
+        }
+        let d = self.d;
+        if !d.is_finite() || d <= 0.0 {
+            return Err(format!(
+                "the geodesic distance between the outer eye corners is {d} (not reachable within 1.4 times their distance)"
+            ));
+        }
+        Ok(d)
+    }
+}
+
+/// The reference fields of `pair` on a face with fields `f` (the nose tip's needed for a side
+/// pair) and landmark frame `frame`; the two poles stand in `Refs`' r and q, D is their
+/// geodesic distance. The frame and the nose tip stay the landmarks' own for every pair, so
+/// the static area of a side pair is its lens above the nose tip's horizontal plane.
+fn pair_refs(
+    mesh: &TriMesh,
+    f: &Fields,
+    lm: Lm,
+    pair: Pair,
+    frame: FaceFrame,
+) -> Result<Refs, String> {
+    let (ua, ub) = match pair {
+        Pair::Corners => (&f.ur, &f.uq),
+        Pair::RightNose => (&f.ur, &f.un),
+        Pair::LeftNose => (&f.uq, &f.un),
+    };
+    if ua.is_empty() || ub.is_empty() {
+        return Err(format!(
+            "{pair:?}: a pole has no geodesic field (an outer eye corner not on the surface)"
+        ));
+    }
+    let (a, b) = lm.poles(pair);
+    let d = match pair {
+        Pair::Corners => f.scale(lm)?,
+        _ => 0.5 * (ua[b as usize] + ub[a as usize]),
+    };
+    if !(d.is_finite() && d > 0.0) {
+        return Err(format!(
+            "{pair:?}: the geodesic distance between the poles is {d} (not reachable within the fields' cut-off)"
+        ));
+    }
+    let [_, _, nose] = lm.positions(mesh);
+    Ok(Refs {
+        ur: ua.clone(),
+        uq: ub.clone(),
+        d,
+        r: mesh.position(a),
+        q: mesh.position(b),
+        nose,
+        frame,
     })
 }
 
@@ -297,7 +464,8 @@ fn iso_levels_of(
     count: usize,
 ) -> Result<IsoLevels> {
     let f = fields(mesh, solver, lm, true).map_err(|e| anyhow::anyhow!("{e}"))?;
-    reference_iso_levels(&Surface::new(mesh.clone()), &f.un, f.d, count)
+    let d = f.scale(lm).map_err(|e| anyhow::anyhow!("{e}"))?;
+    reference_iso_levels(&Surface::new(mesh.clone()), &f.un, d, count)
         .context("iso-curvature levels of the reference face")
 }
 
@@ -333,22 +501,9 @@ fn describe_face(
     o: &DescribeOptions,
 ) -> Result<Described, String> {
     let f = fields(mesh, solver, lm, true)?;
-    let (r, q, nose) = (
-        mesh.position(lm.r),
-        mesh.position(lm.q),
-        mesh.position(lm.nose),
-    );
+    let [r, q, nose] = lm.positions(mesh);
     let [t_corners, t_nose] = f.secs;
-    let d = f.d;
-    let refs = Refs {
-        ur: f.ur,
-        uq: f.uq,
-        d,
-        r,
-        q,
-        nose,
-        frame: face_frame(mesh, r, q, nose),
-    };
+    let frame = face_frame(mesh, r, q, nose);
     let t = Instant::now();
     let seen = match o.max_incidence_deg {
         Some(deg) => Some(
@@ -357,44 +512,57 @@ fn describe_face(
         ),
         None => None,
     };
-    let bip = static_bipolar(mesh, &refs, o, seen.as_deref())
-        .map_err(|e| format!("bipolar descriptor: {e}"));
-    let bip_alt = match o.ref_search {
-        Some(rho) if bip.is_ok() => {
-            moved_corner_descriptors(mesh, solver, lm, &refs, rho, o, seen.as_deref())
+    let pair = Pair::for_probe(r, q, o.side_pair_deg, lm.lost);
+    let mut bip_alt = Vec::new();
+    let bip = Pair::ALL.map(|p| {
+        let refs = pair_refs(mesh, &f, lm, p, frame)?;
+        let b = static_bipolar(mesh, &refs, o, seen.as_deref())
+            .map_err(|e| format!("bipolar descriptor: {e}"))?;
+        if p == pair {
+            bip_alt = moved_pole_descriptors(mesh, solver, lm, p, &refs, o, seen.as_deref());
         }
-        _ => Vec::new(),
-    };
+        Ok(b)
+    });
     let t_bip = t.elapsed().as_secs_f64();
+    // The descriptions scaled by D need both corners.
+    let scale = f.scale(lm);
+    let d = scale.clone().unwrap_or(f64::NAN);
     let opts = PolarOptions {
         step: d / f64::from(o.levels),
         levels: o.levels,
         sectors: o.sectors,
     };
     let t = Instant::now();
-    let pol = polar_descriptor(walker, &f.un, Pole::Vertex(lm.nose), 0.5 * (r + q), &opts)
-        .unwrap_or_else(|_| polar::empty(&opts));
+    let pol = match scale {
+        Ok(_) => polar_descriptor(walker, &f.un, Pole::Vertex(lm.nose), 0.5 * (r + q), &opts)
+            .unwrap_or_else(|_| polar::empty(&opts)),
+        Err(_) => polar::empty(&opts),
+    };
     let t_pol = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let surface = Surface::new(mesh.clone());
     let t_surface = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let facial =
-        facial_curves(&surface, &f.un, d, o.levels).map_err(|e| format!("facial curves: {e}"));
+    let facial = scale.clone().and_then(|d| {
+        facial_curves(&surface, &f.un, d, o.levels).map_err(|e| format!("facial curves: {e}"))
+    });
     let t_facial = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let iso = match &o.iso_levels {
-        Some(l) => iso_curves(&surface, &f.un, d, l)
-            .map_err(|e| format!("iso-curvature: {e}"))
-            .and_then(|c| {
-                iso_point_set(&c, Which::B, Some(ISO_POINTS))
-                    .map_err(|e| format!("iso-curvature points: {e}"))
-            }),
+        Some(l) => scale.and_then(|d| {
+            iso_curves(&surface, &f.un, d, l)
+                .map_err(|e| format!("iso-curvature: {e}"))
+                .and_then(|c| {
+                    iso_point_set(&c, Which::B, Some(ISO_POINTS))
+                        .map_err(|e| format!("iso-curvature points: {e}"))
+                })
+        }),
         None => Err("iso-curvature: no levels".to_string()),
     };
     let t_iso = t.elapsed().as_secs_f64();
     Ok(Described {
         bip,
+        pair,
         bip_alt,
         pol,
         facial,
@@ -413,23 +581,29 @@ fn describe_face(
 /// Directions of the reference-point search around each outer eye corner.
 pub(super) const SEARCH_DIRECTIONS: usize = 6;
 
-/// Bipolar descriptors of a face from its outer eye corners moved by `rho` in
-/// [`SEARCH_DIRECTIONS`] directions of their tangent planes (`bipolar::reference_candidates`,
-/// the first toward the other corner; each corner at its place or moved: 48 pairs), with the
-/// options of the face's own descriptor; pairs whose fields or descriptor fail are left out.
-fn moved_corner_descriptors(
+/// Bipolar descriptors of a face from the poles of `pair` (with reference fields `refs`) moved
+/// by the search radius `o.ref_search` (none without it) in [`SEARCH_DIRECTIONS`] directions
+/// of their tangent planes (`bipolar::reference_candidates`, the first toward the other pole;
+/// each pole at its place or moved: 48 pairs), with the options of the face's own descriptor;
+/// pairs whose fields or descriptor fail are left out. Moved corners get the frame of their
+/// new eye line; a side pair keeps the landmarks' frame.
+fn moved_pole_descriptors(
     mesh: &TriMesh,
     solver: &dyn geodesic::GeodesicSolver,
     lm: Lm,
+    pair: Pair,
     refs: &Refs,
-    rho: f64,
     o: &DescribeOptions,
     seen: Option<&[bool]>,
 ) -> Vec<bipolar::Descriptor> {
+    let Some(rho) = o.ref_search else {
+        return Vec::new();
+    };
+    let (a, b) = lm.poles(pair);
     let around = |v: u32, other: DVec3| {
         bipolar::reference_candidates(mesh, v, other, rho, SEARCH_DIRECTIONS).unwrap_or_default()
     };
-    let (rs, qs) = (around(lm.r, refs.q), around(lm.q, refs.r));
+    let (rs, qs) = (around(a, refs.q), around(b, refs.r));
     let cut = SolveOptions {
         max_distance: Some(1.4 * (refs.q - refs.r).length() + 4.0 * rho),
     };
@@ -446,10 +620,7 @@ fn moved_corner_descriptors(
             })
             .collect()
     };
-    let (fr, fq) = (
-        fields_of(&rs, lm.r, &refs.ur),
-        fields_of(&qs, lm.q, &refs.uq),
-    );
+    let (fr, fq) = (fields_of(&rs, a, &refs.ur), fields_of(&qs, b, &refs.uq));
     let mut out = Vec::new();
     for (i, &r) in rs.iter().enumerate() {
         for (j, &q) in qs.iter().enumerate() {
@@ -471,7 +642,10 @@ fn moved_corner_descriptors(
                 r: pr,
                 q: pq,
                 nose: refs.nose,
-                frame: face_frame(mesh, pr, pq, refs.nose),
+                frame: match pair {
+                    Pair::Corners => face_frame(mesh, pr, pq, refs.nose),
+                    _ => refs.frame,
+                },
             };
             if let Ok(b) = static_bipolar(mesh, &moved, o, seen) {
                 out.push(b);
@@ -495,13 +669,13 @@ struct ViewSource {
 }
 
 impl ViewSource {
-    /// The bipolar descriptor of the part of the gallery face a scanner would measure from the
+    /// The bipolar descriptor (poles `pair`) of the part of the gallery face a scanner would measure from the
     /// probe's scanner direction (+z in the probe's frame, carried into the gallery's frame by
     /// the rigid fit of the probe's landmarks `probe_lm` onto the gallery's), with the gallery's
     /// own options; its points must also be within the incidence limit from the probe's
     /// direction. `None` when the directions are within `min_angle_deg` or a step fails (the
     /// caller then uses the face's own description).
-    fn describe_from(&self, probe_lm: &[DVec3; 3]) -> Option<bipolar::Descriptor> {
+    fn describe_from(&self, probe_lm: &[DVec3; 3], pair: Pair) -> Option<bipolar::Descriptor> {
         let m = &self.mesh;
         let own = [self.lm.r, self.lm.q, self.lm.nose].map(|v| m.position(v));
         let fit = fit_rigid(probe_lm, &own, None)?;
@@ -536,27 +710,15 @@ impl ViewSource {
                 w => w,
             };
         }
-        let lm = Lm {
-            r: lm[0],
-            q: lm[1],
-            nose: lm[2],
-        };
+        let lm = Lm::new(lm[0], lm[1], lm[2]);
         let solver = geodesic::new_solver(&cut, self.method).ok()?;
-        let f = fields(&cut, solver.as_ref(), lm, false).ok()?;
+        let f = fields(&cut, solver.as_ref(), lm, pair != Pair::Corners).ok()?;
         let (r, q, nose) = (
             cut.position(lm.r),
             cut.position(lm.q),
             cut.position(lm.nose),
         );
-        let refs = Refs {
-            ur: f.ur,
-            uq: f.uq,
-            d: f.d,
-            r,
-            q,
-            nose,
-            frame: face_frame(&cut, r, q, nose),
-        };
+        let refs = pair_refs(&cut, &f, lm, pair, face_frame(&cut, r, q, nose)).ok()?;
         let seen = match self.opts.max_incidence_deg {
             Some(deg) => {
                 let own = scanprep::incidence_mask(&cut, crate::scans::SCANNER_SIDE, deg).ok()?;
@@ -699,14 +861,18 @@ fn score_one(
         // With a reference-point search: the least distance over the probe's descriptors
         // (`f64::min` skips a failed one).
         // With view matching, against the gallery face as the probe's scanner would see it.
-        0 => match &y.bip {
+        // The gallery face is described by the probe's pair.
+        0 => match &y.bip[x.pair as usize] {
             Ok(own) => {
-                let matched = y.view.as_ref().and_then(|v| v.describe_from(&x.lm_pos));
+                let matched = y
+                    .view
+                    .as_ref()
+                    .and_then(|v| v.describe_from(&x.lm_pos, x.pair));
                 let yb = matched.as_ref().unwrap_or(own);
-                x.bip_alt
-                    .iter()
-                    .filter_map(|a| dist(a, yb).ok())
-                    .fold(dist(&x.bip, yb).unwrap_or(f64::NAN), f64::min)
+                x.bip_alt.iter().filter_map(|a| dist(a, yb).ok()).fold(
+                    dist(&x.bip[x.pair as usize], yb).unwrap_or(f64::NAN),
+                    f64::min,
+                )
             }
             Err(_) => f64::NAN,
         },
@@ -1013,6 +1179,7 @@ pub fn run(args: Args) -> Result<()> {
     }
     let out = args.io.out.out_dir("recognition");
     let gt = Lm {
+        lost: None,
         r: model.landmark_id("right_eye_outer")?,
         q: model.landmark_id("left_eye_outer")?,
         nose: model.landmark_id("nose_tip")?,
@@ -1066,6 +1233,7 @@ pub fn run(args: Args) -> Result<()> {
         max_incidence_deg: None,
         ref_search: None,
         view_match: None,
+        side_pair_deg: None,
     };
     let elastic = elastic_options(args.curve_samples);
     // Landmark detection.
@@ -1075,10 +1243,12 @@ pub fn run(args: Args) -> Result<()> {
     let detected: Vec<Option<Lm>> = samples
         .par_iter()
         .map(|s| {
-            let r = landmarks::detect(&s.mesh, &generic).ok().map(|l| Lm {
-                r: l.outer_eye_right.vertex,
-                q: l.outer_eye_left.vertex,
-                nose: l.nose_tip.vertex,
+            let r = landmarks::detect(&s.mesh, &generic).ok().map(|l| {
+                Lm::new(
+                    l.outer_eye_right.vertex,
+                    l.outer_eye_left.vertex,
+                    l.nose_tip.vertex,
+                )
             });
             pb.inc(1);
             r
@@ -1201,6 +1371,7 @@ pub fn run(args: Args) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use meshcore::DQuat;
 
     #[test]
     fn eer_and_rank1_on_known_scores() {
@@ -1225,6 +1396,96 @@ mod tests {
         // Perfect separation gives EER 0; NaN counts as a failure.
         let (r, e, ..) = metrics(&[vec![0.1, f64::NAN], vec![0.9, 0.2]], &[0, 1], &gid);
         assert_eq!((r, e), (1.0, 0.0));
+    }
+
+    #[test]
+    fn a_turned_probe_takes_the_corner_nearer_its_scanner() {
+        // Eye line along x, 100 mm, turned about the vertical y axis; the scanner looks down z.
+        let eyes = |yaw_deg: f64| {
+            let t = DQuat::from_rotation_y(yaw_deg.to_radians());
+            (
+                t * DVec3::new(-50.0, 0.0, 0.0),
+                t * DVec3::new(50.0, 0.0, 0.0),
+            )
+        };
+        let pick = |yaw: f64, limit: Option<f64>| {
+            let (r, q) = eyes(yaw);
+            Pair::for_probe(r, q, limit, None)
+        };
+        assert_eq!(pick(0.0, Some(30.0)), Pair::Corners);
+        assert_eq!(pick(25.0, Some(30.0)), Pair::Corners);
+        assert_eq!(pick(-25.0, Some(30.0)), Pair::Corners);
+        assert_eq!(pick(40.0, None), Pair::Corners);
+        // Turned by 40 degrees: the corner with the larger z faces the scanner.
+        for yaw in [35.0, 40.0, -35.0, -40.0] {
+            let (r, q) = eyes(yaw);
+            let near = if q.z > r.z {
+                Pair::LeftNose
+            } else {
+                Pair::RightNose
+            };
+            assert_eq!(pick(yaw, Some(30.0)), near, "yaw {yaw}");
+        }
+        // A pitch of the head (about x) barely moves the estimate.
+        let nod = DQuat::from_rotation_x(0.4);
+        let (r, q) = eyes(20.0);
+        assert_eq!(
+            Pair::for_probe(nod * r, nod * q, Some(30.0), None),
+            Pair::Corners
+        );
+        // A lost corner leaves the other's pair, whatever the turn.
+        let lost = |right| {
+            Some(Lost {
+                right,
+                position: DVec3::ZERO,
+            })
+        };
+        let (r, q) = eyes(0.0);
+        assert_eq!(Pair::for_probe(r, q, None, lost(true)), Pair::LeftNose);
+        assert_eq!(
+            Pair::for_probe(r, q, Some(30.0), lost(false)),
+            Pair::RightNose
+        );
+    }
+
+    #[test]
+    fn side_pairs_on_a_plane() {
+        // A flat 100 x 60 mm sheet, 2 mm squares: geodesic distance = straight distance.
+        let m = meshcore::shapes::grid(50, 30, meshcore::shapes::Diagonals::Alternating, |i, j| {
+            DVec3::new(2.0 * i as f64, 2.0 * j as f64, 0.0)
+        })
+        .unwrap();
+        let at = |i: u32, j: u32| j * 51 + i;
+        let lm = Lm::new(at(5, 20), at(45, 20), at(25, 5));
+        let solver = geodesic::new_solver(&m, geodesic::Method::Exact).unwrap();
+        let f = fields(&m, solver.as_ref(), lm, true).unwrap();
+        let [r, q, nose] = lm.positions(&m);
+        let frame = face_frame(&m, r, q, nose);
+        let corners = pair_refs(&m, &f, lm, Pair::Corners, frame).unwrap();
+        assert!((corners.d - 80.0).abs() < 1e-9, "{}", corners.d);
+        for (pair, corner) in [(Pair::RightNose, r), (Pair::LeftNose, q)] {
+            let side = pair_refs(&m, &f, lm, pair, frame).unwrap();
+            assert!((side.d - (corner - nose).length()).abs() < 1e-9, "{pair:?}");
+            assert_eq!((side.r, side.q, side.nose), (corner, nose, nose));
+            // The frame stays the landmarks' own.
+            assert_eq!(side.frame, frame);
+        }
+        // The left corner lost: its true place still sets the frame; only the right pair.
+        let lost = Lm {
+            q: lm.nose,
+            lost: Some(Lost {
+                right: false,
+                position: q,
+            }),
+            ..lm
+        };
+        assert_eq!(lost.positions(&m), [r, q, nose]);
+        let f = fields(&m, solver.as_ref(), lost, true).unwrap();
+        assert!(f.uq.is_empty() && f.scale(lost).is_err());
+        assert!(pair_refs(&m, &f, lost, Pair::Corners, frame).is_err());
+        assert!(pair_refs(&m, &f, lost, Pair::LeftNose, frame).is_err());
+        let side = pair_refs(&m, &f, lost, Pair::RightNose, frame).unwrap();
+        assert!((side.d - (r - nose).length()).abs() < 1e-9);
     }
 
     #[test]

@@ -11,13 +11,14 @@
 use super::{
     describe_face, elastic_options, icp_points, iso_levels_of, median, order_stat, results_table,
     roc_figure, score_row, summarize, time_comparisons, time_descriptions, timed_pairs,
-    write_summary, Args, DescribeOptions, Described, Lm, Metrics, Row, ViewSource, SCORES,
+    write_summary, Args, DescribeOptions, Described, Lm, Lost, Metrics, Row, ViewSource, SCORES,
     SEARCH_DIRECTIONS, TIMED_FACES, VIEW_MATCH_INCIDENCE_DEG,
 };
 use crate::pipeline::{bar, resolve_methods};
 use crate::report::{line_plot, Report, Series};
 use crate::scans::{
-    sample_weights, scan_face, scan_seed, FaceSpec, ScanSetOptions, ScanSettings, MAX_SNAP_MM,
+    sample_weights, scan_face, scan_seed, FaceSpec, ScanSetOptions, ScanSettings, ScannedFace,
+    MAX_SNAP_MM,
 };
 use crate::walk::Walker;
 use anyhow::{bail, Context, Result};
@@ -120,6 +121,78 @@ fn process(
     out
 }
 
+/// The reference landmarks from the vertices of the outer eye corners and the nose tip (or why
+/// each is missing) and the corners' places (`at`: true or predicted): all three, or, with
+/// `allow_lost`, one corner missing (kept at its place: [`Lost`]; its vertex in [`Lm`] is the
+/// nose tip's, unused). Otherwise the first missing one's reason.
+fn lm_from(
+    [r, q, nose]: [Result<u32, String>; 3],
+    at: [DVec3; 2],
+    allow_lost: bool,
+) -> Result<Lm, String> {
+    let lost = |right: bool| {
+        Some(Lost {
+            right,
+            position: at[usize::from(!right)],
+        })
+    };
+    match (r, q, nose?) {
+        (Ok(r), Ok(q), nose) => Ok(Lm::new(r, q, nose)),
+        (Err(_), Ok(q), nose) if allow_lost => Ok(Lm {
+            r: nose,
+            q,
+            nose,
+            lost: lost(true),
+        }),
+        (Ok(r), Err(_), nose) if allow_lost => Ok(Lm {
+            r,
+            q: nose,
+            nose,
+            lost: lost(false),
+        }),
+        (Err(e), _, _) | (_, Err(e), _) => Err(e),
+    }
+}
+
+/// The ground-truth landmarks of a scan ([`lm_from`]; a corner off the cleaned scan, see
+/// [`ScannedFace::truth_vertices`], may be lost).
+fn truth_lm(s: &ScannedFace, allow_lost: bool) -> Result<Lm, String> {
+    use landmarks::LandmarkName as L;
+    let v = |n: L| {
+        s.truth[n as usize]
+            .vertex
+            .as_ref()
+            .map(|x| x.0)
+            .map_err(|e| format!("ground-truth {n}: {e}"))
+    };
+    let at = |n: L| s.truth[n as usize].position;
+    lm_from(
+        [v(L::OuterEyeRight), v(L::OuterEyeLeft), v(L::NoseTip)],
+        [at(L::OuterEyeRight), at(L::OuterEyeLeft)],
+        allow_lost,
+    )
+}
+
+/// The detected landmarks of a scan ([`lm_from`]; a corner the detector reported unseen may be
+/// lost, at the place the fitted face predicts).
+fn detected_lm(s: &ScannedFace, allow_lost: bool) -> Result<Lm, String> {
+    use landmarks::LandmarkName as L;
+    let d = s.detected.as_ref().map_err(|e| format!("detection: {e}"))?;
+    let v = |n: L| {
+        d.get(n)
+            .map(|l| l.vertex)
+            .map_err(|u| format!("detection: {n} {u}"))
+    };
+    lm_from(
+        [v(L::OuterEyeRight), v(L::OuterEyeLeft), v(L::NoseTip)],
+        [
+            d.predicted[L::OuterEyeRight as usize],
+            d.predicted[L::OuterEyeLeft as usize],
+        ],
+        allow_lost,
+    )
+}
+
 #[allow(clippy::too_many_arguments)]
 fn describe_spec(
     model: &FaceModel,
@@ -160,7 +233,11 @@ fn describe_spec(
     if let (Ok(d), Ok(t)) = (&s.detected, s.truth_vertices()) {
         let _ = t;
         use landmarks::LandmarkName as L;
-        let e = |n: L| (d.get(n).position - s.truth[n as usize].position).length();
+        let e = |n: L| {
+            d.get(n).map_or(f64::INFINITY, |l| {
+                (l.position - s.truth[n as usize].position).length()
+            })
+        };
         face.det_err = Some([e(L::OuterEyeRight), e(L::OuterEyeLeft), e(L::NoseTip)]);
     }
     let t = Instant::now();
@@ -175,15 +252,14 @@ fn describe_spec(
     } else {
         dopt
     };
-    let lms = [s.truth_vertices(), s.detected_vertices()];
-    face.gt_lm = lms[0].as_ref().ok().map(|&[r, q, nose]| Lm { r, q, nose });
+    let allow_lost = dopt.side_pair_deg.is_some();
+    let lms = [truth_lm(&s, allow_lost), detected_lm(&s, allow_lost)];
+    face.gt_lm = lms[0].as_ref().ok().copied();
     face.desc = match geodesic::new_solver(&s.mesh, method) {
         Ok(solver) => {
             let walker = Walker::new(&s.mesh);
             lms.clone().map(|lm| {
-                lm.and_then(|[r, q, nose]| {
-                    describe_face(&s.mesh, solver.as_ref(), &walker, Lm { r, q, nose }, dopt)
-                })
+                lm.and_then(|lm| describe_face(&s.mesh, solver.as_ref(), &walker, lm, dopt))
             })
         }
         Err(e) => [
@@ -194,10 +270,10 @@ fn describe_spec(
     face.secs[3] = t.elapsed().as_secs_f64();
     if let (true, Some(min_angle_deg)) = (keep_mesh, dopt.view_match) {
         for (d, lm) in face.desc.iter_mut().zip(lms) {
-            if let (Ok(d), Ok([r, q, nose])) = (d, lm) {
+            if let (Ok(d), Ok(lm @ Lm { lost: None, .. })) = (d, lm) {
                 d.view = Some(Box::new(ViewSource {
                     mesh: s.mesh.clone(),
-                    lm: Lm { r, q, nose },
+                    lm,
                     method,
                     opts: dopt.clone(),
                     min_angle_deg,
@@ -305,7 +381,7 @@ fn failures(faces: &[Face], group: &str) -> Vec<[String; 4]> {
             let what: Vec<String> = match &f.desc[k] {
                 Err(e) => vec![e.clone()],
                 Ok(d) => [
-                    d.bip.as_ref().err(),
+                    d.bip[d.pair as usize].as_ref().err(),
                     d.facial.as_ref().err(),
                     d.iso.as_ref().err(),
                 ]
@@ -365,6 +441,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         max_incidence_deg: (args.max_incidence > 0.0).then_some(args.max_incidence),
         ref_search: (args.ref_search > 0.0).then_some(args.ref_search),
         view_match: (!args.no_view_match).then_some(args.view_match),
+        side_pair_deg: (!args.no_side_pair).then_some(args.side_pair),
     };
     let elastic = elastic_options(args.curve_samples);
     // Specs: gallery, main probes, sweeps (each face its own scan seed).
@@ -439,7 +516,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         dopt.iso_levels = Some(iso_levels_of(
             &first.mesh,
             solver.as_ref(),
-            Lm { r, q, nose },
+            Lm::new(r, q, nose),
             args.iso_levels,
         )?);
     }
