@@ -70,3 +70,22 @@ def test_describe_names_the_corners_of_a_turned_scan():
     assert len(d) > 0
     with pytest.raises(errors.LandmarksNotFoundError):
         bipolar.describe(bipolar.Mesh(scan.vertices, scan.triangles), "outer-eye-right", "outer-eye-left")
+
+
+def test_landmarks_the_scanner_did_not_see_are_reported_unseen():
+    face = bipolar.read_mesh(PAPER_SET / "id6_neutral.obj")
+    # Turned by 50 degrees: the far inner eye corner hides behind the nose.
+    scan, _ = bipolar.scan(face, pitch=1.0, yaw=50.0, artifacts="structured-light", seed=3)
+    lm = bipolar.detect_landmarks(scan)
+    assert lm["unseen"], lm
+    assert set(lm["landmarks"]) | set(lm["unseen"]) == set(bipolar.LANDMARK_NAMES)
+    assert not set(lm["landmarks"]) & set(lm["unseen"])
+    assert "nose_tip" in lm["landmarks"]
+    for why in lm["unseen"].values():
+        assert "did not see" in why or "surface" in why, why
+    # Describing from an unseen landmark is an error naming it, not a point nearby.
+    name = sorted(lm["unseen"])[0]
+    with pytest.raises(errors.LandmarksNotFoundError, match=f"{name} is not found"):
+        bipolar.describe(scan, name.replace("_", "-"), "nose-tip", levels=10)
+    # A frontal face has nothing unseen.
+    assert bipolar.detect_landmarks(face)["unseen"] == {}

@@ -1,7 +1,7 @@
 //! `bipolar landmarks`: automatic detection of the outer and inner eye corners and the nose tip.
 
 use anyhow::Context;
-use landmarks::{detect_with, io, DetectOptions, GenericModel, LandmarkName};
+use landmarks::{detect_visible, io, DetectOptions, GenericModel, LandmarkName};
 use std::path::PathBuf;
 
 /// Arguments of `bipolar landmarks`.
@@ -59,7 +59,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         toward_viewer: crate::load::toward_scanner(&args.mesh),
         ..DetectOptions::default()
     };
-    let lm = detect_with(&loaded.mesh, &model, &opts)
+    // A landmark the scanner did not see is reported as not found, with the reason.
+    let lm = detect_visible(&loaded.mesh, &model, &opts)
         .with_context(|| format!("landmark detection on {}", args.mesh.display()))?;
     println!(
         "{}: face found, confidence {:.2} (fit rms {:.4}, {:.0} % of the generic face matched)",
@@ -69,23 +70,26 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         100.0 * lm.inlier_fraction
     );
     for n in LandmarkName::ALL {
-        let l = lm.get(n);
-        println!(
-            "  {:<16} vertex {:>7}  ({:.4}, {:.4}, {:.4})  confidence {:.2}",
-            n.key(),
-            l.vertex,
-            l.position.x,
-            l.position.y,
-            l.position.z,
-            l.confidence
-        );
+        match lm.get(n) {
+            Ok(l) => println!(
+                "  {:<16} vertex {:>7}  ({:.4}, {:.4}, {:.4})  confidence {:.2}",
+                n.key(),
+                l.vertex,
+                l.position.x,
+                l.position.y,
+                l.position.z,
+                l.confidence
+            ),
+            Err(u) => println!("  {:<16} not found: {u}", n.key()),
+        }
     }
     if let Some(p) = &args.out {
         mesh_io::write_landmarks_json(p, &io::to_json_file(&lm))?;
         println!("wrote {}", p.display());
     }
     if let Some(p) = &args.lm3 {
-        mesh_io::write_lm3(p, &io::to_lm3_file(&lm))?;
+        let (file, notes) = io::to_lm3_file(&lm);
+        mesh_io::write_lm3_with_notes(p, &file, &notes)?;
         println!("wrote {}", p.display());
     }
     Ok(())

@@ -53,7 +53,7 @@ pub struct Resolver<'a> {
     fraction: f64,
     given: Option<(PathBuf, mesh_io::Landmarks3d)>,
     locator: OnceCell<FaceLocator<'a>>,
-    detected: OnceCell<landmarks::Landmarks>,
+    detected: OnceCell<landmarks::VisibleLandmarks>,
     toward_scanner: Option<DVec3>,
 }
 
@@ -136,7 +136,9 @@ impl<'a> Resolver<'a> {
                     self.detected.get_or_init(|| d)
                 }
             };
-            let lm = found.get(name);
+            let lm = found
+                .get(name)
+                .map_err(|u| anyhow::anyhow!("{what}: the landmark {name} is not found: {u}"))?;
             eprintln!(
                 "{name}: detected at vertex {} (confidence {:.2})",
                 lm.vertex, lm.confidence

@@ -108,3 +108,56 @@ fn a_range_grid_is_read_as_seen_from_its_scanner() {
         "{err}"
     );
 }
+
+#[test]
+fn a_landmark_the_scanner_did_not_see_is_not_found_with_its_reason() {
+    let Some((mesh, dir)) = common::paper_face_and_tempdir("id6_neutral.obj") else {
+        return;
+    };
+    // Turned by 50 degrees: the far inner eye corner hides behind the nose.
+    let bnt = dir.path().join("turned.bnt");
+    common::bipolar(&[
+        "scan",
+        arg(&mesh),
+        "--out",
+        arg(&bnt),
+        "--pitch",
+        "1",
+        "--yaw",
+        "50",
+        "--artifacts",
+        "structured-light",
+        "--seed",
+        "3",
+    ])
+    .success();
+    let lm3 = dir.path().join("found.lm3");
+    let out = bipolar(&[arg(&bnt), "--lm3", arg(&lm3)]).success().stdout;
+    assert!(out.contains("face found"), "{out}");
+    let unseen: Vec<&str> = out
+        .lines()
+        .filter(|l| l.contains("not found:"))
+        .filter_map(|l| l.split_whitespace().next())
+        .collect();
+    assert!(!unseen.is_empty(), "nothing reported unseen: {out}");
+    // The .lm3 file lists the placed landmarks and names the unseen ones in its notes.
+    let text = std::fs::read_to_string(&lm3).unwrap();
+    assert!(text.contains("not found"), "{text}");
+    // Describing from an unseen landmark is an error naming it, not a point nearby.
+    let name = unseen[0].replace('_', "-");
+    let err = common::bipolar(&[
+        "describe",
+        arg(&bnt),
+        "--ref-a",
+        &name,
+        "--ref-b",
+        "nose-tip",
+        "--out",
+        arg(&dir.path().join("d.json")),
+    ])
+    .failure();
+    assert!(
+        err.contains("is not found") && err.contains(unseen[0]),
+        "{err}"
+    );
+}

@@ -116,7 +116,8 @@ pub fn run(args: Args) -> Result<()> {
         t.push(Instant::now());
         // As `bipolar landmarks` reads a `.bnt`: units from the face size, seen from +z.
         let lm =
-            landmarks::detect_seen_from(&cleaned.mesh, &generic, Some(crate::scans::SCANNER_SIDE))?;
+            landmarks::detect_seen_from(&cleaned.mesh, &generic, Some(crate::scans::SCANNER_SIDE))?
+                .complete()?;
         t.push(Instant::now());
         let n_vertices = cleaned.mesh.n_vertices();
         let solver = geodesic::new_solver(&cleaned.mesh, geodesic::Method::Exact)?;

@@ -275,22 +275,31 @@ struct Verified {
 /// units are recognised from the size of the face ([`mesh_units_per_model_unit`]). Positions
 /// are returned in the mesh's own units.
 pub fn detect(mesh: &TriMesh, model: &GenericModel) -> Result<Landmarks, LandmarkError> {
-    detect_seen_from(mesh, model, None)
+    detect_with(mesh, model, &default_options(mesh, model, None)?)
 }
 
-/// [`detect`] on a range scan seen from `toward_viewer` (the direction toward the scanner,
-/// [`DetectOptions::toward_viewer`]; `None`: a mesh, as [`detect`]).
+/// [`detect_visible`] with the default options (units as [`detect`]) on a range scan seen
+/// from `toward_viewer` (the direction toward the scanner, [`DetectOptions::toward_viewer`];
+/// `None`: a mesh, whose landmarks can still be unseen for want of surface).
 pub fn detect_seen_from(
     mesh: &TriMesh,
     model: &GenericModel,
     toward_viewer: Option<DVec3>,
-) -> Result<Landmarks, LandmarkError> {
-    let options = DetectOptions {
+) -> Result<VisibleLandmarks, LandmarkError> {
+    detect_visible(mesh, model, &default_options(mesh, model, toward_viewer)?)
+}
+
+/// The default options with the mesh's units and a viewing direction.
+fn default_options(
+    mesh: &TriMesh,
+    model: &GenericModel,
+    toward_viewer: Option<DVec3>,
+) -> Result<DetectOptions, LandmarkError> {
+    Ok(DetectOptions {
         mesh_units_per_model_unit: mesh_units_per_model_unit(mesh, model)?,
         toward_viewer,
         ..DetectOptions::default()
-    };
-    detect_with(mesh, model, &options)
+    })
 }
 
 /// Mesh units per model unit for a face-sized `mesh`: the mesh's units recognised from its size

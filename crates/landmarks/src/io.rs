@@ -2,7 +2,7 @@
 //! ([`mesh_io::read_landmark_file`], [`mesh_io::write_lm3`], [`mesh_io::write_landmarks_json`],
 //! [`mesh_io::read_ict_landmarks`]); this module converts between them and [`Landmarks`].
 
-use crate::{LandmarkError, LandmarkName, Landmarks};
+use crate::{LandmarkError, LandmarkName, VisibleLandmarks};
 use mesh_io::Landmarks3d;
 use meshcore::DVec3;
 
@@ -27,18 +27,17 @@ pub fn select_five(points: &Landmarks3d, source: &str) -> Result<[DVec3; 5], Lan
 }
 
 /// Detected landmarks as the landmark JSON of `bipolar landmarks`: keys [`LandmarkName::key`],
-/// with vertex and confidence per landmark and the fit's `confidence`, `fit_rms`,
-/// `inlier_fraction` and `symmetry` (write with [`mesh_io::write_landmarks_json`]).
-pub fn to_json_file(lm: &Landmarks) -> Landmarks3d {
+/// with vertex and confidence per placed landmark (an unseen one is left out) and the fit's
+/// `confidence`, `fit_rms`, `inlier_fraction` and `symmetry` (write with
+/// [`mesh_io::write_landmarks_json`]). A [`crate::Landmarks`] converts with `.into()`.
+pub fn to_json_file(lm: &VisibleLandmarks) -> Landmarks3d {
     let mut out = Landmarks3d::default();
     for n in LandmarkName::ALL {
-        let l = lm.get(n);
-        out.push(n.key(), l.position, Some(l.vertex));
+        if let Ok(l) = lm.get(n) {
+            out.push(n.key(), l.position, Some(l.vertex));
+            out.confidences.push(Some(l.confidence));
+        }
     }
-    out.confidences = LandmarkName::ALL
-        .iter()
-        .map(|&n| Some(lm.get(n).confidence))
-        .collect();
     out.attributes = vec![
         ("confidence".into(), lm.confidence),
         ("fit_rms".into(), lm.fit_rms),
@@ -48,11 +47,16 @@ pub fn to_json_file(lm: &Landmarks) -> Landmarks3d {
     out
 }
 
-/// Detected landmarks with their Bosphorus `.lm3` labels (write with [`mesh_io::write_lm3`]).
-pub fn to_lm3_file(lm: &Landmarks) -> Landmarks3d {
+/// Detected landmarks with their Bosphorus `.lm3` labels, and one note per unseen landmark
+/// naming it and why (write with [`mesh_io::write_lm3_with_notes`]).
+pub fn to_lm3_file(lm: &VisibleLandmarks) -> (Landmarks3d, Vec<String>) {
     let mut out = Landmarks3d::default();
+    let mut notes = Vec::new();
     for n in LandmarkName::ALL {
-        out.push(n.lm3_label(), lm.get(n).position, None);
+        match lm.get(n) {
+            Ok(l) => out.push(n.lm3_label(), l.position, None),
+            Err(u) => notes.push(format!("{} not found: {u}", n.lm3_label())),
+        }
     }
-    out
+    (out, notes)
 }

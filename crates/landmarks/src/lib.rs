@@ -221,6 +221,21 @@ pub struct VisibleLandmarks {
     pub model_to_mesh: DAffine3,
 }
 
+/// Five placed landmarks, none unseen (`predicted` holds their positions).
+impl From<Landmarks> for VisibleLandmarks {
+    fn from(l: Landmarks) -> Self {
+        VisibleLandmarks {
+            landmarks: LandmarkName::ALL.map(|n| Ok(*l.get(n))),
+            predicted: l.positions(),
+            confidence: l.confidence,
+            fit_rms: l.fit_rms,
+            inlier_fraction: l.inlier_fraction,
+            symmetry: l.symmetry,
+            model_to_mesh: l.model_to_mesh,
+        }
+    }
+}
+
 impl VisibleLandmarks {
     /// The landmark of a given name, or why it was not placed.
     pub fn get(&self, name: LandmarkName) -> Result<&Landmark, Unseen> {

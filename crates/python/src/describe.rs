@@ -64,7 +64,7 @@ pub(crate) fn references(
     given: Option<&[(String, DVec3)]>,
     in_library: &mut Duration,
 ) -> PyResult<Vec<Source>> {
-    let mut detected: Option<landmarks::Landmarks> = None;
+    let mut detected: Option<landmarks::VisibleLandmarks> = None;
     let mut out = Vec::with_capacity(specs.len());
     for (what, spec) in specs {
         if spec.is_instance_of::<PyString>() {
@@ -105,7 +105,13 @@ pub(crate) fn references(
                 detected = Some(lm);
             }
             if let Some(lm) = &detected {
-                out.push(Source::Vertex(lm.get(name).vertex));
+                let l = lm.get(name).map_err(|u| {
+                    errors::landmarks(landmarks::LandmarkError::NotFound {
+                        reason: format!("{what}: the landmark {name} is not found: {u}"),
+                        best_score: lm.confidence,
+                    })
+                })?;
+                out.push(Source::Vertex(l.vertex));
             }
             continue;
         }

@@ -20,8 +20,10 @@ pub fn names() -> Vec<&'static str> {
 /// fails (default: the library's); ``toward_viewer``: for a range scan, the direction toward
 /// the scanner (3 numbers), so that what the scanner did not see (grazing dropouts, the far
 /// side of a turned head) counts as unobserved rather than as a mismatch (default: ``+z`` for
-/// a range grid's mesh, from a ``.bnt`` file or ``scan``; none for other meshes). Returns a dict: one entry per landmark name
-/// (``{"vertex", "position", "confidence"}``) under ``"landmarks"``, and ``confidence``,
+/// a range grid's mesh, from a ``.bnt`` file or ``scan``; none for other meshes). Returns a dict: one entry per placed landmark
+/// (``{"vertex", "position", "confidence"}``) under ``"landmarks"``; under ``"unseen"`` the
+/// landmarks the scanner did not see (hidden, in a hole), each with the reason, when the face
+/// was found without them (``landmarks::detect_visible``); and ``confidence``,
 /// ``fit_rms``, ``inlier_fraction``, ``symmetry``, ``model_to_mesh`` (4 x 4 rigid motion).
 /// Raises ``LandmarksNotFoundError`` when the mesh does not fit a face.
 #[pyfunction]
@@ -56,19 +58,25 @@ pub fn detect_landmarks<'py>(
         ..DetectOptions::default()
     };
     let lm = py
-        .detach(|| landmarks::detect_with(mesh, &model, &opts))
+        .detach(|| landmarks::detect_visible(mesh, &model, &opts))
         .map_err(errors::landmarks)?;
     let out = PyDict::new(py);
     let each = PyDict::new(py);
+    let unseen = PyDict::new(py);
     for n in LandmarkName::ALL {
-        let l = lm.get(n);
-        let d = PyDict::new(py);
-        d.set_item("vertex", l.vertex)?;
-        d.set_item("position", vec_out(py, l.position.to_array().to_vec()))?;
-        d.set_item("confidence", l.confidence)?;
-        each.set_item(n.key(), d)?;
+        match lm.get(n) {
+            Ok(l) => {
+                let d = PyDict::new(py);
+                d.set_item("vertex", l.vertex)?;
+                d.set_item("position", vec_out(py, l.position.to_array().to_vec()))?;
+                d.set_item("confidence", l.confidence)?;
+                each.set_item(n.key(), d)?;
+            }
+            Err(u) => unseen.set_item(n.key(), u.to_string())?,
+        }
     }
     out.set_item("landmarks", each)?;
+    out.set_item("unseen", unseen)?;
     out.set_item("confidence", lm.confidence)?;
     out.set_item("fit_rms", lm.fit_rms)?;
     out.set_item("inlier_fraction", lm.inlier_fraction)?;
