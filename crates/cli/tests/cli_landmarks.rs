@@ -2,6 +2,7 @@
 
 mod common;
 use common::{arg, Run};
+use std::path::{Path, PathBuf};
 
 fn bipolar(args: &[&str]) -> Run {
     common::bipolar_cmd("landmarks", args)
@@ -71,28 +72,35 @@ fn a_face_in_millimetres_needs_no_scale_flag() {
     bipolar(&[arg(&mm), "--scale", "1"]).failure();
 }
 
+/// `bipolar scan` of `mesh` turned by `yaw` degrees (1 mm pitch, structured-light artifacts,
+/// seed `seed`) into `dir/turned.bnt`.
+fn scan_turned(mesh: &Path, dir: &Path, yaw: &str, seed: &str) -> PathBuf {
+    let bnt = dir.join("turned.bnt");
+    common::bipolar(&[
+        "scan",
+        arg(mesh),
+        "--out",
+        arg(&bnt),
+        "--pitch",
+        "1",
+        "--yaw",
+        yaw,
+        "--artifacts",
+        "structured-light",
+        "--seed",
+        seed,
+    ])
+    .success();
+    bnt
+}
+
 #[test]
 fn a_range_grid_is_read_as_seen_from_its_scanner() {
     let Some((mesh, dir)) = common::paper_face_and_tempdir("id4_neutral.obj") else {
         return;
     };
     // A head turned by 35 degrees: the scanner loses the far side around the far eye corner.
-    let bnt = dir.path().join("turned.bnt");
-    common::bipolar(&[
-        "scan",
-        arg(&mesh),
-        "--out",
-        arg(&bnt),
-        "--pitch",
-        "1",
-        "--yaw",
-        "35",
-        "--artifacts",
-        "structured-light",
-        "--seed",
-        "7",
-    ])
-    .success();
+    let bnt = scan_turned(&mesh, dir.path(), "35", "7");
     // As a range grid, the missing surface is unobserved: the face is found.
     let out = bipolar(&[arg(&bnt)]).success().stdout;
     assert!(
@@ -115,22 +123,7 @@ fn a_landmark_the_scanner_did_not_see_is_not_found_with_its_reason() {
         return;
     };
     // Turned by 50 degrees: the far inner eye corner hides behind the nose.
-    let bnt = dir.path().join("turned.bnt");
-    common::bipolar(&[
-        "scan",
-        arg(&mesh),
-        "--out",
-        arg(&bnt),
-        "--pitch",
-        "1",
-        "--yaw",
-        "50",
-        "--artifacts",
-        "structured-light",
-        "--seed",
-        "3",
-    ])
-    .success();
+    let bnt = scan_turned(&mesh, dir.path(), "50", "3");
     let lm3 = dir.path().join("found.lm3");
     let out = bipolar(&[arg(&bnt), "--lm3", arg(&lm3)]).success().stdout;
     assert!(out.contains("face found"), "{out}");

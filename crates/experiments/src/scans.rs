@@ -181,19 +181,21 @@ pub struct ScannedFace {
 }
 
 impl ScannedFace {
+    /// The ground-truth vertex of landmark `n`, or why it is not on the cleaned scan.
+    pub fn truth_vertex(&self, n: LandmarkName) -> Result<u32, String> {
+        self.truth[n as usize]
+            .vertex
+            .as_ref()
+            .map(|x| x.0)
+            .map_err(|e| format!("ground-truth {n}: {e}"))
+    }
+
     /// Ground-truth vertices of the outer eye corners and the nose tip, or why one is missing.
     pub fn truth_vertices(&self) -> Result<[u32; 3], String> {
-        let v = |n: LandmarkName| {
-            self.truth[n as usize]
-                .vertex
-                .as_ref()
-                .map(|x| x.0)
-                .map_err(|e| format!("ground-truth {n}: {e}"))
-        };
         Ok([
-            v(LandmarkName::OuterEyeRight)?,
-            v(LandmarkName::OuterEyeLeft)?,
-            v(LandmarkName::NoseTip)?,
+            self.truth_vertex(LandmarkName::OuterEyeRight)?,
+            self.truth_vertex(LandmarkName::OuterEyeLeft)?,
+            self.truth_vertex(LandmarkName::NoseTip)?,
         ])
     }
 }

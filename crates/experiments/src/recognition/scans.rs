@@ -158,13 +158,7 @@ fn lm_from(
 /// [`ScannedFace::truth_vertices`], may be lost).
 fn truth_lm(s: &ScannedFace, allow_lost: bool) -> Result<Lm, String> {
     use landmarks::LandmarkName as L;
-    let v = |n: L| {
-        s.truth[n as usize]
-            .vertex
-            .as_ref()
-            .map(|x| x.0)
-            .map_err(|e| format!("ground-truth {n}: {e}"))
-    };
+    let v = |n: L| s.truth_vertex(n);
     let at = |n: L| s.truth[n as usize].position;
     lm_from(
         [v(L::OuterEyeRight), v(L::OuterEyeLeft), v(L::NoseTip)],
