@@ -1,6 +1,7 @@
 //! Landmarks and landmark files. The files themselves are read and written by `mesh-io`
 //! ([`mesh_io::read_landmark_file`], [`mesh_io::write_lm3`], [`mesh_io::write_landmarks_json`],
-//! [`mesh_io::read_ict_landmarks`]); this module converts between them and [`Landmarks`].
+//! [`mesh_io::read_ict_landmarks`]); this module converts between them and
+//! [`crate::VisibleLandmarks`] (or [`crate::Landmarks`]).
 
 use crate::{LandmarkError, LandmarkName, VisibleLandmarks};
 use mesh_io::Landmarks3d;
