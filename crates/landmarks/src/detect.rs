@@ -340,14 +340,16 @@ pub const RIM_AGREEMENT: f64 = 0.9;
 /// Least number of landmarks [`detect_visible`] must place (the nose tip among them).
 pub const MIN_PLACED: usize = 3;
 
-/// Detects the landmarks of a face the scanner may not have seen whole: as [`detect_with`],
-/// but a landmark that is not on the input is reported as [`Unseen`] (with the reason)
-/// instead of rejecting the fitted face, which must still place the nose tip and at least
-/// [`MIN_PLACED`] landmarks, each agreeing with its template. A landmark is unseen when
-/// surface nearer to the scanner covers the fitted face's landmark by more than the model's
-/// inlier distance (only with [`DetectOptions::toward_viewer`]: the far inner eye corner
-/// behind the nose of a turned head), or when too little of the surface expected around it is
-/// on the input ([`DetectOptions::min_landmark_coverage`]: a hole, the border of the scan).
+/// Detects the landmarks of a face the scanner may not have seen whole. A fitted face that
+/// places all five is taken first, as [`detect_with`] takes it (same points). Only when there
+/// is none, a landmark that is not on the input is reported as [`Unseen`] (with the reason)
+/// instead of rejecting the fit, which must still place the nose tip and at least
+/// [`MIN_PLACED`] landmarks, each agreeing with its template. A landmark is unseen when it
+/// borders surface the scanner did not see (an unseen rim within its template's reach; only
+/// with [`DetectOptions::toward_viewer`]: the far inner eye corner behind the nose of a turned
+/// head) and agrees with its template less than [`RIM_AGREEMENT`] ([`Unseen::Unobserved`]),
+/// or when too little of the surface expected around it is on the input
+/// ([`DetectOptions::min_landmark_coverage`]: a hole, the border of the scan; [`Unseen::Bare`]).
 pub fn detect_visible(
     mesh: &TriMesh,
     model: &GenericModel,

@@ -170,8 +170,8 @@ impl Landmarks {
 pub enum Unseen {
     /// The landmark borders surface the scanner did not see (a rim of a dropout or of a part
     /// hidden behind nearer surface, [`DetectOptions::toward_viewer`]) and what was seen
-    /// around it does not match its template: local agreement `agreement`, below
-    /// [`DetectOptions::min_local_agreement`].
+    /// around it does not match its template well enough: local agreement `agreement`, below
+    /// [`RIM_AGREEMENT`].
     Unobserved {
         /// The landmark's local template agreement.
         agreement: f64,
