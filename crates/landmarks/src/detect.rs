@@ -43,10 +43,10 @@ pub struct DetectOptions {
     /// vertices face away from it by more than [`GRAZING_RIM_DEG`]: grazing dropouts, the far
     /// side of a turned head; and those with surface in front of them: the cheek hidden by the
     /// nose) then bound unobserved surface, and the local template search scores a landmark on
-    /// the part of its template that is observed instead of counting the rest as mismatch. `None` (a mesh, not a scan): every point
-    /// counts. The rims of the eye openings face the scanner and are not affected. With a
-    /// direction the learned regression also reads surface missing where the training faces
-    /// had it as unobserved rather than as shape.
+    /// the part of its template that is observed instead of counting the rest as mismatch.
+    /// `None` (a mesh, not a scan): every point counts. The rims of the eye openings face the
+    /// scanner and are not affected. With a direction the learned regression also reads
+    /// surface missing where the training faces had it as unobserved rather than as shape.
     pub toward_viewer: Option<DVec3>,
 }
 
@@ -613,7 +613,7 @@ fn detect_impl(
     // does, and only when there is none the first that places enough of them.
     let passes: &[bool] = if partial { &[false, true] } else { &[false] };
     let n_fits = fits.len();
-    for (&partial, k) in passes
+    for (&allow_unseen, k) in passes
         .iter()
         .flat_map(|p| std::iter::repeat(p).zip(0..n_fits))
     {
@@ -646,7 +646,7 @@ fn detect_impl(
         // rim within its template's reach) and agrees with its template less than
         // [`RIM_AGREEMENT`] is unseen, not a mismatch of the pose.
         let mut unseen: [Option<Unseen>; 5] = [None; 5];
-        if partial {
+        if allow_unseen {
             for k in 0..5 {
                 if agreement[k] < RIM_AGREEMENT.max(options.min_local_agreement)
                     && near_unseen_rim(&idx, out[k].position, model.patches[k].reach())
@@ -685,7 +685,8 @@ fn detect_impl(
         // Every landmark must sit on the input: one the fitted face puts where the input has
         // no surface (occluded, in a hole, cropped) lands on the nearest rim vertex, a silent
         // wrong point; the template around a reported point then finds little surface.
-        // In a partial detection such a landmark is unseen; otherwise the pose is rejected.
+        // In the pass that allows unseen landmarks such a landmark is unseen; otherwise the
+        // pose is rejected.
         let mut bare = None;
         if options.min_landmark_coverage > 0.0 {
             for name in L::ALL {
@@ -700,7 +701,7 @@ fn detect_impl(
                 }
             }
         }
-        if let (false, Some((name, c))) = (partial, bare) {
+        if let (false, Some((name, c))) = (allow_unseen, bare) {
             rejected.get_or_insert((
                 format!(
                     "{name} is not on the surface: only {:.0} % of the surface expected around it was found (at least {:.0} % needed); it is occluded, in a hole or outside the scan",

@@ -105,9 +105,9 @@ pub struct Args {
     #[arg(long, default_value_t = SCAN_MAX_INCIDENCE_DEG)]
     pub max_incidence: f64,
     /// Reference-point search of the bipolar score (`--scans`; mm, 0: off): each probe is also
-    /// described from its outer eye corners moved by this distance in 6 directions of their
-    /// tangent planes (48 more descriptors), and its score against a gallery face is the least
-    /// distance over the 49.
+    /// described from its two poles (the outer eye corners, or its side pair's corner and nose
+    /// tip) moved by this distance in 6 directions of their tangent planes (48 more
+    /// descriptors), and its score against a gallery face is the least distance over the 49.
     #[arg(long, default_value_t = SCAN_REF_SEARCH_MM)]
     pub ref_search: f64,
     /// View matching of the bipolar score (`--scans`; degrees): when a probe's scanner
