@@ -130,6 +130,11 @@ pub struct Args {
     /// No side pairs (`--scans`): every probe is compared by its outer eye corners.
     #[arg(long)]
     pub no_side_pair: bool,
+    /// The bipolar score of a probe is its distance by its own pole pair alone (the corners,
+    /// or its side pair past `--side-pair`), not the least distance over the three pairs
+    /// (`--scans`).
+    #[arg(long)]
+    pub own_pair_only: bool,
 }
 
 /// One sampled face.
@@ -298,6 +303,8 @@ struct Described {
     bip: [Result<bipolar::Descriptor, String>; 3],
     /// The pair this face is compared by as a probe ([`Pair::for_probe`]).
     pair: Pair,
+    /// Its score is the least distance over the three pairs ([`DescribeOptions::least_pair`]).
+    least_pair: bool,
     /// Bipolar descriptors of `pair` from moved poles (`DescribeOptions::ref_search`; else
     /// empty).
     bip_alt: Vec<bipolar::Descriptor>,
@@ -335,6 +342,9 @@ struct DescribeOptions {
     /// Probes turned by more than this (degrees) are compared by the bipolar descriptor of
     /// their nearer corner and the nose tip (`Args::side_pair`; `None`: always the corners).
     side_pair_deg: Option<f64>,
+    /// The bipolar score is the least distance over the three pole pairs (the probe's own with
+    /// its reference-point search); else the probe's own pair's (`Args::own_pair_only`).
+    least_pair: bool,
 }
 
 /// The fields of a face cut off at 1.4 |q - r| (corners r, q; nose tip, when asked for: else
@@ -565,6 +575,7 @@ fn describe_face(
     Ok(Described {
         bip,
         pair,
+        least_pair: o.least_pair,
         bip_alt,
         pol,
         facial,
@@ -671,13 +682,14 @@ struct ViewSource {
 }
 
 impl ViewSource {
-    /// The bipolar descriptor (poles `pair`) of the part of the gallery face a scanner would measure from the
-    /// probe's scanner direction (+z in the probe's frame, carried into the gallery's frame by
-    /// the rigid fit of the probe's landmarks `probe_lm` onto the gallery's), with the gallery's
-    /// own options; its points must also be within the incidence limit from the probe's
-    /// direction. `None` when the directions are within `min_angle_deg` or a step fails (the
-    /// caller then uses the face's own description).
-    fn describe_from(&self, probe_lm: &[DVec3; 3], pair: Pair) -> Option<bipolar::Descriptor> {
+    /// The bipolar descriptors, one per [`Pair`] (indexed by its discriminant), of the part of
+    /// the gallery face a scanner would measure from the probe's scanner direction (+z in the
+    /// probe's frame, carried into the gallery's frame by the rigid fit of the probe's
+    /// landmarks `probe_lm` onto the gallery's), with the gallery's own options; their points
+    /// must also be within the incidence limit from the probe's direction. `None` when the
+    /// directions are within `min_angle_deg` or the cut fails, and `None` for a pair whose
+    /// description fails (the caller then uses the face's own description).
+    fn describe_from(&self, probe_lm: &[DVec3; 3]) -> Option<[Option<bipolar::Descriptor>; 3]> {
         let m = &self.mesh;
         let own = [self.lm.r, self.lm.q, self.lm.nose].map(|v| m.position(v));
         let fit = fit_rigid(probe_lm, &own, None)?;
@@ -714,13 +726,13 @@ impl ViewSource {
         }
         let lm = Lm::new(lm[0], lm[1], lm[2]);
         let solver = geodesic::new_solver(&cut, self.method).ok()?;
-        let f = fields(&cut, solver.as_ref(), lm, pair != Pair::Corners).ok()?;
+        let f = fields(&cut, solver.as_ref(), lm, true).ok()?;
         let (r, q, nose) = (
             cut.position(lm.r),
             cut.position(lm.q),
             cut.position(lm.nose),
         );
-        let refs = pair_refs(&cut, &f, lm, pair, face_frame(&cut, r, q, nose)).ok()?;
+        let frame = face_frame(&cut, r, q, nose);
         let seen = match self.opts.max_incidence_deg {
             Some(deg) => {
                 let own = scanprep::incidence_mask(&cut, crate::scans::SCANNER_SIDE, deg).ok()?;
@@ -734,7 +746,10 @@ impl ViewSource {
             }
             None => None,
         };
-        static_bipolar(&cut, &refs, &self.opts, seen.as_deref()).ok()
+        Some(Pair::ALL.map(|pair| {
+            let refs = pair_refs(&cut, &f, lm, pair, frame).ok()?;
+            static_bipolar(&cut, &refs, &self.opts, seen.as_deref()).ok()
+        }))
     }
 }
 
@@ -848,6 +863,48 @@ fn icp_points(mesh: &TriMesh, n: usize) -> Vec<DVec3> {
     mesh.positions().iter().step_by(stride).copied().collect()
 }
 
+/// The bipolar distance of a probe `x` to a gallery face `y` by each [`Pair`] (indexed by its
+/// discriminant; NaN where a side has no descriptor or the distance fails). With view matching,
+/// against the gallery face as the probe's scanner would see it. With a reference-point search,
+/// the probe's own pair is the least distance over its descriptors (`f64::min` skips a failed
+/// one).
+fn bipolar_pairs(x: &Described, y: &Described) -> [f64; 3] {
+    let matched = y.view.as_ref().and_then(|v| v.describe_from(&x.lm_pos));
+    Pair::ALL.map(|p| {
+        let i = p as usize;
+        let Ok(own) = &y.bip[i] else {
+            return f64::NAN;
+        };
+        let yb = matched.as_ref().and_then(|m| m[i].as_ref()).unwrap_or(own);
+        let d = dist(&x.bip[i], yb).unwrap_or(f64::NAN);
+        if p == x.pair {
+            x.bip_alt
+                .iter()
+                .filter_map(|a| dist(a, yb).ok())
+                .fold(d, f64::min)
+        } else {
+            d
+        }
+    })
+}
+
+/// The bipolar score of a probe `x` from its distances by each pair `d` ([`bipolar_pairs`]):
+/// the least of them ([`Described::least_pair`]; `f64::min` skips a failed one), else its own
+/// pair's.
+fn bipolar_score(x: &Described, d: [f64; 3]) -> f64 {
+    pair_score(d, x.pair, x.least_pair)
+}
+
+/// The least of the distances by each pair `d` (`least`; NaN ones skipped, NaN when all are),
+/// else the one of the probe's pair `own`.
+fn pair_score(d: [f64; 3], own: Pair, least: bool) -> f64 {
+    if least {
+        d.into_iter().fold(f64::NAN, f64::min)
+    } else {
+        d[own as usize]
+    }
+}
+
 /// Score `k` of [`SCORES`] of a probe (its description `x` and ICP points `pts`) against a
 /// gallery face (`y`, its surface `loc`); NaN when a description is missing or the score
 /// fails.
@@ -860,24 +917,7 @@ fn score_one(
     elastic: &ElasticOptions,
 ) -> f64 {
     match k {
-        // With a reference-point search: the least distance over the probe's descriptors
-        // (`f64::min` skips a failed one).
-        // With view matching, against the gallery face as the probe's scanner would see it.
-        // The gallery face is described by the probe's pair.
-        0 => match &y.bip[x.pair as usize] {
-            Ok(own) => {
-                let matched = y
-                    .view
-                    .as_ref()
-                    .and_then(|v| v.describe_from(&x.lm_pos, x.pair));
-                let yb = matched.as_ref().unwrap_or(own);
-                x.bip_alt.iter().filter_map(|a| dist(a, yb).ok()).fold(
-                    dist(&x.bip[x.pair as usize], yb).unwrap_or(f64::NAN),
-                    f64::min,
-                )
-            }
-            Err(_) => f64::NAN,
-        },
+        0 => bipolar_score(x, bipolar_pairs(x, y)),
         1 => dist(&x.pol, &y.pol).unwrap_or(f64::NAN),
         2 => icp_score(pts, &x.lm_pos, loc, &y.lm_pos),
         3 => match (&x.facial, &y.facial) {
@@ -899,22 +939,33 @@ type Row = [Vec<f64>; 5];
 
 /// Scores of one probe (its description and ICP points) against every gallery face: bipolar,
 /// single pole, ICP, facial curves (elastic distance with `elastic`) and iso-curvature (ICP of
-/// the networks' points from the landmark alignment).
+/// the networks' points from the landmark alignment); with the bipolar distance by each pair
+/// ([`bipolar_pairs`]).
 fn score_row(
     probe: Option<&Described>,
     pts: &[DVec3],
     gallery: &[Option<(&Described, &FaceLocator<'_>)>],
     elastic: &ElasticOptions,
-) -> Row {
-    std::array::from_fn(|k| {
+) -> (Row, Vec<[f64; 3]>) {
+    let pairs: Vec<[f64; 3]> = gallery
+        .iter()
+        .map(|g| match (probe, g) {
+            (Some(x), Some((y, _))) => bipolar_pairs(x, y),
+            _ => [f64::NAN; 3],
+        })
+        .collect();
+    let row = std::array::from_fn(|k| {
         gallery
             .iter()
-            .map(|g| match (probe, g) {
+            .zip(&pairs)
+            .map(|(g, d)| match (probe, g) {
+                (Some(x), Some(_)) if k == 0 => bipolar_score(x, *d),
                 (Some(x), Some((y, loc))) => score_one(k, x, pts, y, loc, elastic),
                 _ => f64::NAN,
             })
             .collect()
-    })
+    });
+    (row, pairs)
 }
 
 /// Faces whose descriptions are timed (single thread).
@@ -1236,6 +1287,7 @@ pub fn run(args: Args) -> Result<()> {
         ref_search: None,
         view_match: None,
         side_pair_deg: None,
+        least_pair: false,
     };
     let elastic = elastic_options(args.curve_samples);
     // Landmark detection.
@@ -1314,7 +1366,7 @@ pub fn run(args: Args) -> Result<()> {
             .par_iter()
             .zip(&probe_pts)
             .map(|(&p, pts)| {
-                let r = score_row(described[p][k].as_ref(), pts, &gal, &elastic);
+                let (r, _) = score_row(described[p][k].as_ref(), pts, &gal, &elastic);
                 pb.inc(1);
                 r
             })
@@ -1448,6 +1500,18 @@ mod tests {
             Pair::for_probe(r, q, Some(30.0), lost(false)),
             Pair::RightNose
         );
+    }
+
+    #[test]
+    fn the_score_is_the_least_pair_distance_or_the_probe_pair() {
+        let nan = f64::NAN;
+        assert_eq!(pair_score([0.3, 0.1, 0.2], Pair::Corners, true), 0.1);
+        assert_eq!(pair_score([nan, 0.4, 0.2], Pair::RightNose, true), 0.2);
+        assert_eq!(pair_score([0.3, nan, nan], Pair::LeftNose, true), 0.3);
+        assert!(pair_score([nan; 3], Pair::Corners, true).is_nan());
+        assert_eq!(pair_score([0.3, 0.1, 0.2], Pair::Corners, false), 0.3);
+        assert_eq!(pair_score([0.3, 0.1, 0.2], Pair::LeftNose, false), 0.2);
+        assert!(pair_score([0.3, nan, 0.2], Pair::RightNose, false).is_nan());
     }
 
     #[test]

@@ -291,21 +291,22 @@ fn score_group(
     probes: &[Face],
     elastic: &ElasticOptions,
     ms_desc: &[f64; 4],
-) -> Result<(Vec<Metrics>, Vec<Vec<String>>)> {
+) -> Result<Scored> {
     let gid: Vec<usize> = gallery.iter().map(|g| g.identity).collect();
     let pid: Vec<usize> = probes.iter().map(|p| p.identity).collect();
     let mut all = Vec::new();
     let mut per_probe = Vec::new();
+    let mut by_pair = Vec::new();
     for (k, set) in SETS.iter().enumerate() {
         let gal: Vec<Option<(&Described, &FaceLocator<'_>)>> = gallery
             .iter()
             .zip(locators)
             .map(|(g, l)| g.desc[k].as_ref().ok().zip(l.as_ref()))
             .collect();
-        let rows: Vec<Row> = probes
+        let (rows, pairs): (Vec<Row>, Vec<Vec<[f64; 3]>>) = probes
             .par_iter()
             .map(|p| score_row(p.desc[k].as_ref().ok(), &p.pts, &gal, elastic))
-            .collect();
+            .unzip();
         let pr: Vec<(Option<&Described>, &[DVec3])> = probes
             .iter()
             .map(|p| (p.desc[k].as_ref().ok(), p.pts.as_slice()))
@@ -317,8 +318,37 @@ fn score_group(
                 per_probe.push(probe_rank(&p.name, p.identity, set, score, &row[j], &gid));
             }
         }
+        for (p, ds) in probes.iter().zip(&pairs) {
+            let Ok(x) = &p.desc[k] else { continue };
+            for (g, d) in gallery.iter().zip(ds) {
+                by_pair.push(
+                    [
+                        p.name.clone(),
+                        p.identity.to_string(),
+                        set.to_string(),
+                        format!("{:?}", x.pair),
+                        g.identity.to_string(),
+                    ]
+                    .into_iter()
+                    .chain(d.iter().map(|v| format!("{v:.6}")))
+                    .collect(),
+                );
+            }
+        }
     }
-    Ok((all, per_probe))
+    Ok(Scored {
+        metrics: all,
+        per_probe,
+        by_pair,
+    })
+}
+
+/// What [`score_group`] gives: the figures, the lines of `probes.csv` and those of
+/// `bipolar-pairs.csv`.
+struct Scored {
+    metrics: Vec<Metrics>,
+    per_probe: Vec<Vec<String>>,
+    by_pair: Vec<Vec<String>>,
 }
 
 /// One line of `probes.csv`: where the probe's own identity ranks among the gallery for one
@@ -438,6 +468,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         ref_search: (args.ref_search > 0.0).then_some(args.ref_search),
         view_match: (!args.no_view_match).then_some(args.view_match),
         side_pair_deg: (!args.no_side_pair).then_some(args.side_pair),
+        least_pair: !(args.no_side_pair || args.own_pair_only),
     };
     let elastic = elastic_options(args.curve_samples);
     // Specs: gallery, main probes, sweeps (each face its own scan seed).
@@ -553,7 +584,11 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         .take(TIMED_FACES)
         .collect();
     let ms_desc = time_descriptions(&first, method, &dopt)?;
-    let (main, per_probe) = score_group(&gallery, &locators, &probes, &elastic, &ms_desc)?;
+    let Scored {
+        metrics: main,
+        per_probe,
+        by_pair,
+    } = score_group(&gallery, &locators, &probes, &elastic, &ms_desc)?;
     let mut fails = failures(&gallery, "gallery");
     fails.extend(failures(&probes, "probes"));
     // Sweeps.
@@ -563,7 +598,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         let mut per_value = Vec::new();
         for (v, specs) in sw.values.iter().zip(groups) {
             let faces = run(specs, false, &format!("sweep {} {v}", sw.name));
-            per_value.push(score_group(&gallery, &locators, &faces, &elastic, &ms_desc)?.0);
+            per_value.push(score_group(&gallery, &locators, &faces, &elastic, &ms_desc)?.metrics);
             fails.extend(failures(&faces, &format!("sweep {} {v}", sw.name)));
             sweep_faces.extend(faces);
         }
@@ -577,7 +612,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         "Recognition benchmark on range scans of sampled ICT faces",
     )?;
     rep.para(&format!(
-        "{identities} identities x {expressions} faces (seed {}). Gallery: {} neutral frontal scans ({}). Probes: {} scans of the other expressions, each under a random yaw of 0-45 degrees to either side and a noise of {} mm (other settings as the gallery). Scans by `rangescan` (orthographic), cleaned by `scanprep` (spikes, holes up to 10 mm, small components, crop of {} mm around the true nose tip{}). Geodesics: {}. Bipolar descriptor: static area, N = {} levels between the outer eye corners, {}; single pole: {} sectors around the nose tip; ICP: about {} probe vertices onto the gallery surface from the 3-landmark alignment, 10 % trimmed, score = RMS closest-point distance (mm); facial curves: N level curves of the nose-tip field up to D, elastic distance ({} segments per curve, one start-point candidate, one alternation), root sum of squares; iso-curvature: {} levels per principal field (quantiles of the first gallery scan) in the geodesic disc of radius D around the nose tip, normalised RMS closest-point distance after an ICP started from the 3-landmark alignment. Times, single thread (one-thread pool after the parallel work): per comparison the mean over up to 24 probe x gallery pairs per group and landmark set; per description the median over the first 6 gallery scans (ground truth) of the fields a representation needs plus its build. Ground-truth landmarks: the model's landmark vertices carried through the scanner, at the nearest vertex of the cleaned scan (a landmark the scanner does not see is a failure); detected: `landmarks::detect_with` on the cleaned scan, seen from the scanner (+z).",
+        "{identities} identities x {expressions} faces (seed {}). Gallery: {} neutral frontal scans ({}). Probes: {} scans of the other expressions, each under a random yaw of 0-45 degrees to either side and a noise of {} mm (other settings as the gallery). Scans by `rangescan` (orthographic), cleaned by `scanprep` (spikes, holes up to 10 mm, small components, crop of {} mm around the true nose tip{}). Geodesics: {}. Bipolar descriptor: static area, N = {} levels between the outer eye corners, {}; single pole: {} sectors around the nose tip; ICP: about {} probe vertices onto the gallery surface from the 3-landmark alignment, 10 % trimmed, score = RMS closest-point distance (mm); facial curves: N level curves of the nose-tip field up to D, elastic distance ({} segments per curve, one start-point candidate, one alternation), root sum of squares; iso-curvature: {} levels per principal field (quantiles of the first gallery scan) in the geodesic disc of radius D around the nose tip, normalised RMS closest-point distance after an ICP started from the 3-landmark alignment. Times, single thread (one-thread pool after the parallel work): per comparison the mean over up to 24 probe x gallery pairs per group and landmark set; per description the median over the first 6 gallery scans (ground truth) of the fields a representation needs plus its build. Ground-truth landmarks: the model's landmark vertices carried through the scanner, at the nearest vertex of the cleaned scan (a landmark the scanner does not see is a failure); detected: `landmarks::detect_visible` on the cleaned scan, seen from the scanner (+z).",
         args.seed,
         gallery.len(),
         base.label(),
@@ -608,6 +643,14 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
             + &dopt
                 .view_match
                 .map(|a| format!("; view matching: where a probe's scanner direction, carried into a gallery scan's frame by the 3-landmark alignment, is more than {a} degrees from the gallery's own, the gallery scan is described again on the faces a scanner would measure from that direction (`rangescan::visible_faces`, incidence up to {VIEW_MATCH_INCIDENCE_DEG} degrees; landmarks whose faces are all gone moved to the nearest vertex left, within {MAX_SNAP_MM} mm), so a bipolar comparison includes that description"))
+                .unwrap_or_default()
+            + &dopt
+                .side_pair_deg
+                .map(|a| format!("; side pairs: every face is also described by each outer eye corner with the nose tip (their lens above the nose tip's horizontal plane); a probe turned by more than {a} degrees (its eye line against its scanner), or with an outer eye corner off the scan, takes its nearer (or remaining) corner's side pair as its own pair, which the reference-point search moves; {}", if dopt.least_pair {
+                    "its score is the least distance over the three pairs (outer eye corners, right corner and nose tip, left corner and nose tip), each view-matched"
+                } else {
+                    "its score is its own pair's distance"
+                }))
                 .unwrap_or_default(),
         args.res.sectors,
         args.icp_points,
@@ -631,6 +674,21 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         &per_probe,
     )?;
     rep.para("Per probe and score: the rank of the probe's own identity in the gallery (1: identified; empty: its genuine comparison failed), its score and the nearest other identity (`probes.csv`).");
+    rep.csv(
+        "bipolar-pairs.csv",
+        &[
+            "probe",
+            "identity",
+            "landmarks",
+            "probe pair",
+            "gallery identity",
+            "corners",
+            "right corner and nose",
+            "left corner and nose",
+        ],
+        &by_pair,
+    )?;
+    rep.para("The bipolar distance of every probe to every gallery face by each pole pair (`bipolar-pairs.csv`; NaN where a side has no descriptor): the probe's own pair is its score.");
     roc_figure(&mut rep, &main, "roc.svg", "ROC on scans (verification)")?;
     // Landmark detection on every scan of the run.
     let everyone: Vec<&Face> = gallery.iter().chain(&probes).chain(&sweep_faces).collect();
