@@ -157,6 +157,22 @@ pub fn bipolar(
     boundary_margin: Option<f64>,
     seen: Option<&[bool]>,
 ) -> Result<bipolar::Descriptor, bipolar::BipolarError> {
+    let surface = bipolar::Surface::new(mesh.clone());
+    bipolar_on(&surface, refs, n, region, rule, boundary_margin, seen)
+}
+
+/// [`bipolar`] on a surface whose topology is already built (for many descriptors of one
+/// mesh).
+pub fn bipolar_on(
+    surface: &bipolar::Surface,
+    refs: &Refs,
+    n: u32,
+    region: Region,
+    rule: DescriptorRule,
+    boundary_margin: Option<f64>,
+    seen: Option<&[bool]>,
+) -> Result<bipolar::Descriptor, bipolar::BipolarError> {
+    let mesh = surface.mesh();
     let step = refs.d / f64::from(n);
     let (max_level, mask) = match region {
         Region::Static => (
@@ -184,9 +200,8 @@ pub fn bipolar(
         },
         ..Default::default()
     };
-    let surface = bipolar::Surface::new(mesh.clone());
     bipolar::describe(
-        &surface,
+        surface,
         bipolar::Fields::Precomputed {
             fields: &[refs.ur.clone(), refs.uq.clone()],
             references: None,

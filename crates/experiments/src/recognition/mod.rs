@@ -19,7 +19,7 @@ use crate::curves::{
 };
 use crate::paths::{ModelArgs, ResolutionArgs};
 use crate::pipeline::{
-    bar, bipolar, dist, resolve_methods, single_thread, DescriptorRule, Refs, Region,
+    bar, bipolar_on, dist, resolve_methods, single_thread, DescriptorRule, Refs, Region,
 };
 use crate::polar::{self, polar_descriptor, PolarOptions, Pole};
 use crate::report::{f4, line_plot, Report, Series};
@@ -481,16 +481,16 @@ fn iso_levels_of(
         .context("iso-curvature levels of the reference face")
 }
 
-/// The benchmark's bipolar descriptor on `mesh` from `refs`: static area, rule `All`, the
+/// The benchmark's bipolar descriptor on `surface` from `refs`: static area, rule `All`, the
 /// options' levels and band, and the vertex mask `seen`.
 fn static_bipolar(
-    mesh: &TriMesh,
+    surface: &Surface,
     refs: &Refs,
     o: &DescribeOptions,
     seen: Option<&[bool]>,
 ) -> Result<bipolar::Descriptor, bipolar::BipolarError> {
-    bipolar(
-        mesh,
+    bipolar_on(
+        surface,
         refs,
         o.levels,
         Region::Static,
@@ -525,13 +525,16 @@ fn describe_face(
         None => None,
     };
     let pair = Pair::for_probe(r, q, o.side_pair_deg, lm.lost);
+    let t_surface = Instant::now();
+    let surface = Surface::new(mesh.clone());
+    let t_surface = t_surface.elapsed().as_secs_f64();
     let mut bip_alt = Vec::new();
     let bip = Pair::ALL.map(|p| {
         let refs = pair_refs(mesh, &f, lm, p, frame)?;
-        let b = static_bipolar(mesh, &refs, o, seen.as_deref())
+        let b = static_bipolar(&surface, &refs, o, seen.as_deref())
             .map_err(|e| format!("bipolar descriptor: {e}"))?;
         if p == pair {
-            bip_alt = moved_pole_descriptors(mesh, solver, lm, p, &refs, o, seen.as_deref());
+            bip_alt = moved_pole_descriptors(&surface, solver, lm, p, &refs, o, seen.as_deref());
         }
         Ok(b)
     });
@@ -551,9 +554,6 @@ fn describe_face(
         Err(_) => polar::empty(&opts),
     };
     let t_pol = t.elapsed().as_secs_f64();
-    let t = Instant::now();
-    let surface = Surface::new(mesh.clone());
-    let t_surface = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let facial = scale.clone().and_then(|d| {
         facial_curves(&surface, &f.un, d, o.levels).map_err(|e| format!("facial curves: {e}"))
@@ -601,7 +601,7 @@ pub(super) const SEARCH_DIRECTIONS: usize = 6;
 /// pairs whose fields or descriptor fail are left out. Moved corners get the frame of their
 /// new eye line; a side pair keeps the landmarks' frame.
 fn moved_pole_descriptors(
-    mesh: &TriMesh,
+    surface: &Surface,
     solver: &dyn geodesic::GeodesicSolver,
     lm: Lm,
     pair: Pair,
@@ -612,6 +612,7 @@ fn moved_pole_descriptors(
     let Some(rho) = o.ref_search else {
         return Vec::new();
     };
+    let mesh = surface.mesh();
     let (a, b) = lm.poles(pair);
     let around = |v: u32, other: DVec3| {
         bipolar::reference_candidates(mesh, v, other, rho, SEARCH_DIRECTIONS).unwrap_or_default()
@@ -660,7 +661,7 @@ fn moved_pole_descriptors(
                     _ => refs.frame,
                 },
             };
-            if let Ok(b) = static_bipolar(mesh, &moved, o, seen) {
+            if let Ok(b) = static_bipolar(surface, &moved, o, seen) {
                 out.push(b);
             }
         }
@@ -712,12 +713,14 @@ impl ViewSource {
             .map(|(t, _)| *t)
             .collect();
         let (cut, map) = scanprep::compact(m.positions(), tris, "view matching").ok()?;
+        let surface = Surface::new(cut);
+        let cut = surface.mesh();
         // A landmark whose faces are all gone is placed as a probe's ground truth is: on the
         // nearest vertex left, within `MAX_SNAP_MM`.
         let mut lm = [0u32; 3];
         for (k, v) in [self.lm.r, self.lm.q, self.lm.nose].into_iter().enumerate() {
             lm[k] = match map[v as usize] {
-                u32::MAX => match crate::scans::nearest_vertex(&cut, m.position(v)) {
+                u32::MAX => match crate::scans::nearest_vertex(cut, m.position(v)) {
                     Some((w, d)) if d <= crate::scans::MAX_SNAP_MM => w,
                     _ => return None,
                 },
@@ -725,18 +728,18 @@ impl ViewSource {
             };
         }
         let lm = Lm::new(lm[0], lm[1], lm[2]);
-        let solver = geodesic::new_solver(&cut, self.method).ok()?;
-        let f = fields(&cut, solver.as_ref(), lm, true).ok()?;
+        let solver = geodesic::new_solver(cut, self.method).ok()?;
+        let f = fields(cut, solver.as_ref(), lm, true).ok()?;
         let (r, q, nose) = (
             cut.position(lm.r),
             cut.position(lm.q),
             cut.position(lm.nose),
         );
-        let frame = face_frame(&cut, r, q, nose);
+        let frame = face_frame(cut, r, q, nose);
         let seen = match self.opts.max_incidence_deg {
             Some(deg) => {
-                let own = scanprep::incidence_mask(&cut, crate::scans::SCANNER_SIDE, deg).ok()?;
-                let probe = scanprep::incidence_mask(&cut, toward, deg).ok()?;
+                let own = scanprep::incidence_mask(cut, crate::scans::SCANNER_SIDE, deg).ok()?;
+                let probe = scanprep::incidence_mask(cut, toward, deg).ok()?;
                 Some(
                     own.iter()
                         .zip(&probe)
@@ -747,8 +750,8 @@ impl ViewSource {
             None => None,
         };
         Some(Pair::ALL.map(|pair| {
-            let refs = pair_refs(&cut, &f, lm, pair, frame).ok()?;
-            static_bipolar(&cut, &refs, &self.opts, seen.as_deref()).ok()
+            let refs = pair_refs(cut, &f, lm, pair, frame).ok()?;
+            static_bipolar(&surface, &refs, &self.opts, seen.as_deref()).ok()
         }))
     }
 }
