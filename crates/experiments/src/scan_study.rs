@@ -257,8 +257,26 @@ fn field_at(mesh: &TriMesh, u: &[f64], sp: &SurfacePoint) -> f64 {
 fn describe_scan(face: &Face, setting: &Setting, args: &Args) -> Result<Described> {
     let t0 = Instant::now();
     let (mesh, lms, hidden) = acquire(face, setting, args.smooth)?;
+    let mut d = describe_mesh(mesh, &lms, &hidden, args, None)?;
+    d.seconds = t0.elapsed().as_secs_f64();
+    Ok(d)
+}
+
+/// The descriptions of an acquired mesh (mm) with landmarks `lms` (r, q, nose; `hidden`: those
+/// the scanner did not see, for the notes). With `view` (another scanner's direction in this
+/// frame: the mesh is a view-matched cut) only the least of the three pole pairs ([`LEAST`]) is
+/// described, its incidence limit holds from both directions, and the single pole is left
+/// empty.
+fn describe_mesh(
+    mesh: TriMesh,
+    lms: &[DVec3; 3],
+    hidden: &[String],
+    args: &Args,
+    view: Option<DVec3>,
+) -> Result<Described> {
+    let t0 = Instant::now();
     let loc = FaceLocator::new(&mesh);
-    let (sp, off) = snap(&loc, &lms, args.landmark_tolerance_mm)?;
+    let (sp, off) = snap(&loc, lms, args.landmark_tolerance_mm)?;
     let pos = sp.map(|s| mesh.point_position(&s).unwrap_or(DVec3::NAN));
     let solver = geodesic::new_solver(&mesh, Method::Exact)?;
     // The static area lies within D of both corners and the polar rays reach D from the nose
@@ -304,11 +322,24 @@ fn describe_scan(face: &Face, setting: &Setting, args: &Args) -> Result<Describe
     let fields = [ur, uq];
     let mut bip = Vec::new();
     let mut sides = Vec::new();
-    for v in &VARIANTS {
-        let seen = match v
-            .max_incidence_deg
-            .map(|deg| incidence_mask(&mesh, crate::scans::SCANNER_SIDE, deg))
-        {
+    for (k, v) in VARIANTS.iter().enumerate() {
+        if view.is_some() && k != LEAST {
+            bip.push(None);
+            sides.push(None);
+            continue;
+        }
+        let seen = match v.max_incidence_deg.map(|deg| {
+            let own = incidence_mask(&mesh, crate::scans::SCANNER_SIDE, deg)?;
+            match view {
+                Some(toward) => {
+                    let other = incidence_mask(&mesh, toward, deg)?;
+                    Ok::<Vec<bool>, scanprep::ScanPrepError>(
+                        own.iter().zip(&other).map(|(a, b)| *a && *b).collect(),
+                    )
+                }
+                None => Ok(own),
+            }
+        }) {
             Some(Err(e)) => {
                 notes.push(format!("{}: {e}", v.name));
                 bip.push(None);
@@ -364,18 +395,21 @@ fn describe_scan(face: &Face, setting: &Setting, args: &Args) -> Result<Describe
             None
         });
     }
-    let walker = geodesic::straightest::Walker::new(&mesh);
-    let polar = polar_descriptor(
-        &walker,
-        &un,
-        Pole::Point(sp[2]),
-        0.5 * (pos[0] + pos[1]),
-        &PolarOptions {
-            step: d / f64::from(args.set.res.levels),
-            levels: args.set.res.levels,
-            sectors: args.set.res.sectors,
-        },
-    )?;
+    let polar_opts = PolarOptions {
+        step: d / f64::from(args.set.res.levels),
+        levels: args.set.res.levels,
+        sectors: args.set.res.sectors,
+    };
+    let polar = match view {
+        Some(_) => crate::polar::empty(&polar_opts),
+        None => polar_descriptor(
+            &geodesic::straightest::Walker::new(&mesh),
+            &un,
+            Pole::Point(sp[2]),
+            0.5 * (pos[0] + pos[1]),
+            &polar_opts,
+        )?,
+    };
     let inside: Vec<DVec3> = (0..mesh.n_vertices())
         .filter(|&v| mask[v])
         .map(|v| mesh.position(v as u32))
@@ -559,13 +593,65 @@ const VARIANTS: [Variant; 9] = {
     ]
 };
 
-/// Names of the distances: the bipolar variants, then the single pole and ICP.
+/// The entry of [`VARIANTS`] with the least of the three pole pairs (the recognition
+/// benchmark's rule), also measured with view matching.
+const LEAST: usize = 8;
+
+/// Name of the view-matched distance (the [`LEAST`] variant of two scans, each cut to what the
+/// other's scanner would have measured when their directions differ by at least
+/// `SCAN_VIEW_MATCH_DEG`).
+const VIEW_MATCHED: &str =
+    "bipolar All, band and incidence over 60 degrees left out, three pole pairs, least, view-matched";
+
+/// Names of the distances: the bipolar variants, the view-matched one, then the single pole
+/// and ICP.
 fn methods() -> Vec<&'static str> {
     VARIANTS
         .iter()
         .map(|v| v.name)
-        .chain(["single pole", "ICP (mm)"])
+        .chain([VIEW_MATCHED, "single pole", "ICP (mm)"])
         .collect()
+}
+
+/// The distance of two scans by variant `k` of [`VARIANTS`] (NaN where either has no
+/// descriptor or the distance fails): the keyed distance, or with side pairs the mean or least
+/// of the three pairs'.
+fn variant_distance(a: &Described, b: &Described, k: usize) -> f64 {
+    let kd = |x: &Option<bipolar::Descriptor>, y: &Option<bipolar::Descriptor>| match (x, y) {
+        (Some(x), Some(y)) => dist(x, y).unwrap_or(f64::NAN),
+        _ => f64::NAN,
+    };
+    let corners = kd(&a.bip[k], &b.bip[k]);
+    match (VARIANTS[k].side_pairs, &a.sides[k], &b.sides[k]) {
+        (None, ..) => corners,
+        (Some(c), Some([ra, la]), Some([rb, lb])) => {
+            let side = |x, y| dist(x, y).unwrap_or(f64::NAN);
+            let all = [corners, side(ra, rb), side(la, lb)];
+            match c {
+                PairCombine::Mean => all.iter().sum::<f64>() / 3.0,
+                PairCombine::Least => all.into_iter().fold(f64::NAN, f64::min),
+            }
+        }
+        (Some(_), ..) => f64::NAN,
+    }
+}
+
+/// The [`LEAST`] distance of two scans with view matching: each is cut to the faces the
+/// other's scanner would have measured (`scans::cut_to_view`, when the two directions differ by
+/// at least `SCAN_VIEW_MATCH_DEG`) and described again; a side whose cut or description fails
+/// keeps its own description.
+fn view_matched_distance(a: &Described, b: &Described, args: &Args) -> f64 {
+    let cut = |x: &Described, y: &Described| {
+        let c = crate::scans::cut_to_view(
+            &x.mesh,
+            &x.landmarks,
+            &y.landmarks,
+            crate::recognition::SCAN_VIEW_MATCH_DEG,
+        )?;
+        describe_mesh(c.mesh, &x.landmarks, &[], args, Some(c.toward)).ok()
+    };
+    let (ca, cb) = (cut(a, b), cut(b, a));
+    variant_distance(ca.as_ref().unwrap_or(a), cb.as_ref().unwrap_or(b), LEAST)
 }
 
 struct Pair {
@@ -664,36 +750,12 @@ pub fn run(args: Args) -> Result<()> {
             } else {
                 Relation::Other
             };
-            let kd = |x: &Option<bipolar::Descriptor>, y: &Option<bipolar::Descriptor>| match (x, y)
-            {
-                (Some(x), Some(y)) => dist(x, y).unwrap_or(f64::NAN),
-                _ => f64::NAN,
-            };
             let icp = 0.5 * (icp_score(da, db, &locators[b]) + icp_score(db, da, &locators[a]));
-            pb.inc(1);
-            // A side-pair variant: the mean of the three pairs' distances.
-            let mut d: Vec<f64> = da
-                .bip
-                .iter()
-                .zip(&db.bip)
-                .zip(da.sides.iter().zip(&db.sides))
-                .zip(&VARIANTS)
-                .map(|(((x, y), (sx, sy)), v)| {
-                    let corners = kd(x, y);
-                    match (v.side_pairs, sx, sy) {
-                        (None, ..) => corners,
-                        (Some(c), Some([ra, la]), Some([rb, lb])) => {
-                            let side = |a, b| dist(a, b).unwrap_or(f64::NAN);
-                            let all = [corners, side(ra, rb), side(la, lb)];
-                            match c {
-                                PairCombine::Mean => all.iter().sum::<f64>() / 3.0,
-                                PairCombine::Least => all.into_iter().fold(f64::NAN, f64::min),
-                            }
-                        }
-                        (Some(_), ..) => f64::NAN,
-                    }
-                })
+            let mut d: Vec<f64> = (0..VARIANTS.len())
+                .map(|k| variant_distance(da, db, k))
                 .collect();
+            d.push(view_matched_distance(da, db, &args));
+            pb.inc(1);
             d.push(dist(&da.polar, &db.polar).unwrap_or(f64::NAN));
             d.push(icp);
             Pair {
@@ -1050,4 +1112,20 @@ fn write_outputs(
     );
     std::fs::write(out.join("report.md"), md)?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_view_matched_variant_is_the_least_of_the_three_pairs() {
+        let v = &VARIANTS[LEAST];
+        assert!(matches!(v.side_pairs, Some(PairCombine::Least)));
+        assert_eq!(v.max_incidence_deg, Some(60.0));
+        assert!(VIEW_MATCHED.starts_with(v.name));
+        let m = methods();
+        assert_eq!(m.len(), VARIANTS.len() + 3);
+        assert_eq!(m[VARIANTS.len()], VIEW_MATCHED);
+    }
 }

@@ -403,6 +403,55 @@ pub fn scan_face(
     })
 }
 
+/// Incidence (degrees) beyond which a view-matched face loses its faces: the middle of the
+/// structured-light scanner model's grazing dropouts (70-80 degrees).
+pub const VIEW_MATCH_INCIDENCE_DEG: f64 = 75.0;
+
+/// Sample spacing (mm) of the z-buffer of the view matching: the scans' pitch.
+pub const VIEW_MATCH_PITCH_MM: f64 = 0.5;
+
+/// The part of a scanned face that another scan's scanner would have measured.
+pub struct ViewCut {
+    /// The faces seen from `toward` (vertices renumbered, unused ones dropped).
+    pub mesh: TriMesh,
+    /// New index of each vertex of the whole face (`u32::MAX`: dropped).
+    pub map: Vec<u32>,
+    /// The other scanner's direction in this face's frame.
+    pub toward: DVec3,
+}
+
+/// View matching: the faces of `mesh` (a scanned face in its own frame, scanner along
+/// [`SCANNER_SIDE`], landmarks `own`: right and left outer eye corners, nose tip) that a scanner
+/// would measure from another scan's direction. That direction is the other scan's
+/// [`SCANNER_SIDE`] carried into this frame by the rigid fit of its landmarks `other` onto
+/// `own`; the faces are those `rangescan::visible_faces` keeps (z-buffer of
+/// [`VIEW_MATCH_PITCH_MM`], incidence up to [`VIEW_MATCH_INCIDENCE_DEG`]). `None` when the two
+/// directions are within `min_angle_deg` (the scans saw the same) or a step fails.
+pub fn cut_to_view(
+    mesh: &TriMesh,
+    own: &[DVec3; 3],
+    other: &[DVec3; 3],
+    min_angle_deg: f64,
+) -> Option<ViewCut> {
+    let fit = meshcore::linalg::fit_rigid(other, own, None)?;
+    let toward = (fit.matrix3 * SCANNER_SIDE).normalize_or_zero();
+    if toward.angle_between(SCANNER_SIDE).to_degrees() < min_angle_deg {
+        return None;
+    }
+    let seen =
+        rangescan::visible_faces(mesh, toward, VIEW_MATCH_PITCH_MM, VIEW_MATCH_INCIDENCE_DEG)
+            .ok()?;
+    let tris = mesh
+        .triangles()
+        .iter()
+        .zip(&seen)
+        .filter(|(_, &s)| s)
+        .map(|(t, _)| *t)
+        .collect();
+    let (mesh, map) = scanprep::compact(mesh.positions(), tris, "view matching").ok()?;
+    Some(ViewCut { mesh, map, toward })
+}
+
 /// The vertex of `mesh` nearest to `p` and its distance (lowest index on ties).
 pub fn nearest_vertex(mesh: &TriMesh, p: DVec3) -> Option<(u32, f64)> {
     mesh.positions()

@@ -253,18 +253,11 @@ const SCAN_REF_SEARCH_MM: f64 = 2.0;
 
 /// The default of `--view-match` (degrees). Not tuned: below it a probe is near frontal, its
 /// scanner saw what the gallery's did, and the gallery's own description is used.
-const SCAN_VIEW_MATCH_DEG: f64 = 10.0;
+pub(crate) const SCAN_VIEW_MATCH_DEG: f64 = 10.0;
 
 /// The default of `--side-pair` (degrees), chosen on 16 identities: 25 moved one probe from
 /// rank 1 to 3 and gained nothing else (docs/scans.md, "Side pairs and lost corners").
 const SCAN_SIDE_PAIR_DEG: f64 = 30.0;
-
-/// Incidence (degrees) beyond which a view-matched gallery face loses its faces: the middle of
-/// the structured-light scanner model's grazing dropouts (70-80 degrees).
-const VIEW_MATCH_INCIDENCE_DEG: f64 = 75.0;
-
-/// Sample spacing (mm) of the z-buffer of the view matching: the scans' pitch.
-const VIEW_MATCH_PITCH_MM: f64 = 0.5;
 
 /// Default of `--curve-samples`.
 const CURVE_SAMPLES: usize = 50;
@@ -693,26 +686,11 @@ impl ViewSource {
     fn describe_from(&self, probe_lm: &[DVec3; 3]) -> Option<[Option<bipolar::Descriptor>; 3]> {
         let m = &self.mesh;
         let own = [self.lm.r, self.lm.q, self.lm.nose].map(|v| m.position(v));
-        let fit = fit_rigid(probe_lm, &own, None)?;
-        let toward = (fit.matrix3 * crate::scans::SCANNER_SIDE).normalize_or_zero();
-        if toward
-            .angle_between(crate::scans::SCANNER_SIDE)
-            .to_degrees()
-            < self.min_angle_deg
-        {
-            return None;
-        }
-        let seen =
-            rangescan::visible_faces(m, toward, VIEW_MATCH_PITCH_MM, VIEW_MATCH_INCIDENCE_DEG)
-                .ok()?;
-        let tris = m
-            .triangles()
-            .iter()
-            .zip(&seen)
-            .filter(|(_, &s)| s)
-            .map(|(t, _)| *t)
-            .collect();
-        let (cut, map) = scanprep::compact(m.positions(), tris, "view matching").ok()?;
+        let crate::scans::ViewCut {
+            mesh: cut,
+            map,
+            toward,
+        } = crate::scans::cut_to_view(m, &own, probe_lm, self.min_angle_deg)?;
         let surface = Surface::new(cut);
         let cut = surface.mesh();
         // A landmark whose faces are all gone is placed as a probe's ground truth is: on the

@@ -14,13 +14,13 @@ use super::{
     describe_face, elastic_options, icp_points, iso_levels_of, median, order_stat, results_table,
     roc_figure, score_row, summarize, time_comparisons, time_descriptions, timed_pairs,
     write_summary, Args, DescribeOptions, Described, Lm, Lost, Metrics, Row, ViewSource, SCORES,
-    SEARCH_DIRECTIONS, TIMED_FACES, VIEW_MATCH_INCIDENCE_DEG,
+    SEARCH_DIRECTIONS, TIMED_FACES,
 };
 use crate::pipeline::{bar, resolve_methods};
 use crate::report::{line_plot, Report, Series};
 use crate::scans::{
     sample_weights, scan_face, scan_seed, FaceSpec, ScanSetOptions, ScanSettings, ScannedFace,
-    MAX_SNAP_MM,
+    MAX_SNAP_MM, VIEW_MATCH_INCIDENCE_DEG,
 };
 use crate::walk::Walker;
 use anyhow::{bail, Context, Result};
