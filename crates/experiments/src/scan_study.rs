@@ -638,8 +638,8 @@ fn variant_distance(a: &Described, b: &Described, k: usize) -> f64 {
 
 /// The [`LEAST`] distance of two scans with view matching: each is cut to the faces the
 /// other's scanner would have measured (`scans::cut_to_view`, when the two directions differ by
-/// at least `SCAN_VIEW_MATCH_DEG`) and described again; a side whose cut or description fails
-/// keeps its own description.
+/// at least `SCAN_VIEW_MATCH_DEG`) and described again; a side whose cut or any of whose three
+/// descriptions fails keeps its own description.
 fn view_matched_distance(a: &Described, b: &Described, args: &Args) -> f64 {
     let cut = |x: &Described, y: &Described| {
         let c = crate::scans::cut_to_view(
@@ -648,7 +648,9 @@ fn view_matched_distance(a: &Described, b: &Described, args: &Args) -> f64 {
             &y.landmarks,
             crate::recognition::SCAN_VIEW_MATCH_DEG,
         )?;
-        describe_mesh(c.mesh, &x.landmarks, &[], args, Some(c.toward)).ok()
+        describe_mesh(c.mesh, &x.landmarks, &[], args, Some(c.toward))
+            .ok()
+            .filter(|d| d.bip[LEAST].is_some() && d.sides[LEAST].is_some())
     };
     let (ca, cb) = (cut(a, b), cut(b, a));
     variant_distance(ca.as_ref().unwrap_or(a), cb.as_ref().unwrap_or(b), LEAST)
@@ -943,20 +945,36 @@ fn write_outputs(
     let _ = writeln!(md, "## Distances\n");
     let _ = writeln!(
         md,
-        "| method | same face: min / median / max (n) | same person | other person | min(other) / max(same face) | scans only |"
+        "The ratio min(other person) / max(same face) over all pairs; over the scans only (no face mesh); and over the neutral rescans: same-face pairs of the neutral faces scanned at other pitch, noise or pose (no face mesh, no depth quantisation) against the other persons in those settings.\n"
     );
-    let _ = writeln!(md, "|---|---|---|---|---|---|");
+    let _ = writeln!(
+        md,
+        "| method | same face: min / median / max (n) | same person | other person | min(other) / max(same face) | scans only | neutral rescans |"
+    );
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|");
     let is_mesh = |p: &Pair| {
         sets[scans[p.a].setting].scan.is_none() || sets[scans[p.b].setting].scan.is_none()
     };
+    // The case: two scans of one neutral face at other pitch, noise or pose (no face
+    // mesh, no depth quantisation), against the other persons in the same settings.
+    let rescan = |p: &Pair| {
+        [p.a, p.b].iter().all(|&i| {
+            sets[scans[i].setting]
+                .scan
+                .is_some_and(|s| s.quant_mm.is_none())
+        }) && (p.rel != Relation::SameFace || faces[scans[p.a].face].expression == "neutral")
+    };
     let mut ratios = Vec::new();
     for (m, name) in methods().iter().enumerate() {
-        let of = |rel: Relation, scans_only: bool| -> Vec<f64> {
+        let subset = |rel: Relation, keep: &dyn Fn(&Pair) -> bool| -> Vec<f64> {
             pairs
                 .iter()
-                .filter(|p| p.rel == rel && !(scans_only && is_mesh(p)))
+                .filter(|p| p.rel == rel && keep(p))
                 .map(|p| p.d[m])
                 .collect()
+        };
+        let of = |rel: Relation, scans_only: bool| -> Vec<f64> {
+            subset(rel, &|p| !(scans_only && is_mesh(p)))
         };
         let fmt = |v: &[f64]| {
             let (lo, med, hi, n) = quantiles(v);
@@ -968,10 +986,15 @@ fn write_outputs(
             other_min / same_max
         };
         let (r_all, r_scans) = (ratio(false), ratio(true));
-        ratios.push((name.to_string(), r_all, r_scans));
+        let r_rescans = {
+            let (_, _, same_max, _) = quantiles(&subset(Relation::SameFace, &rescan));
+            let (other_min, _, _, _) = quantiles(&subset(Relation::Other, &rescan));
+            other_min / same_max
+        };
+        ratios.push((name.to_string(), r_all, r_scans, r_rescans));
         let _ = writeln!(
             md,
-            "| {name} | {} | {} | {} | **{r_all:.3}** | {r_scans:.3} |",
+            "| {name} | {} | {} | {} | **{r_all:.3}** | {r_scans:.3} | {r_rescans:.3} |",
             fmt(&of(Relation::SameFace, false)),
             fmt(&of(Relation::SamePerson, false)),
             fmt(&of(Relation::Other, false)),
@@ -1098,11 +1121,23 @@ fn write_outputs(
     )?;
     let rows: Vec<Vec<String>> = ratios
         .iter()
-        .map(|(n, a, s)| vec![n.to_string(), format!("{a:.4}"), format!("{s:.4}")])
+        .map(|(n, a, s, r)| {
+            vec![
+                n.to_string(),
+                format!("{a:.4}"),
+                format!("{s:.4}"),
+                format!("{r:.4}"),
+            ]
+        })
         .collect();
     write_csv(
         &out.join("ratios.csv"),
-        &["method", "ratio_all_pairs", "ratio_scans_only"],
+        &[
+            "method",
+            "ratio_all_pairs",
+            "ratio_scans_only",
+            "ratio_neutral_rescans",
+        ],
         &rows,
     )?;
     let _ = writeln!(
