@@ -147,23 +147,9 @@ pub enum DescriptorRule {
 /// `D / n`; static region: levels up to n with the static mask; whole: levels up to 2n), built
 /// by `bipolar::describe` (precomputed fields) with `rule`; `boundary_margin` leaves out the
 /// band next to the mesh boundary (`bipolar::DescriptorOptions::boundary_margin`), and `seen`,
-/// when given, keeps only its `true` vertices (with the static mask, both must hold).
+/// when given, keeps only its `true` vertices (with the static mask, both must hold). The
+/// caller builds the surface (mesh and topology) once for all the descriptors of a mesh.
 pub fn bipolar(
-    mesh: &TriMesh,
-    refs: &Refs,
-    n: u32,
-    region: Region,
-    rule: DescriptorRule,
-    boundary_margin: Option<f64>,
-    seen: Option<&[bool]>,
-) -> Result<bipolar::Descriptor, bipolar::BipolarError> {
-    let surface = bipolar::Surface::new(mesh.clone());
-    bipolar_on(&surface, refs, n, region, rule, boundary_margin, seen)
-}
-
-/// [`bipolar`] on a surface whose topology is already built (for many descriptors of one
-/// mesh).
-pub fn bipolar_on(
     surface: &bipolar::Surface,
     refs: &Refs,
     n: u32,

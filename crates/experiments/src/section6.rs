@@ -181,7 +181,7 @@ impl Ctx<'_> {
         let bip = which.bipolar.then(|| {
             self.ok(
                 bipolar(
-                    mesh,
+                    &bipolar::Surface::new(mesh.clone()),
                     refs,
                     n,
                     Region::Static,

@@ -19,7 +19,7 @@ use crate::curves::{
 };
 use crate::paths::{ModelArgs, ResolutionArgs};
 use crate::pipeline::{
-    bar, bipolar_on, dist, resolve_methods, single_thread, DescriptorRule, Refs, Region,
+    bar, bipolar, dist, resolve_methods, single_thread, DescriptorRule, Refs, Region,
 };
 use crate::polar::{self, polar_descriptor, PolarOptions, Pole};
 use crate::report::{f4, line_plot, Report, Series};
@@ -482,7 +482,7 @@ fn static_bipolar(
     o: &DescribeOptions,
     seen: Option<&[bool]>,
 ) -> Result<bipolar::Descriptor, bipolar::BipolarError> {
-    bipolar_on(
+    bipolar(
         surface,
         refs,
         o.levels,

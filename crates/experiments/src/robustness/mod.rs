@@ -133,7 +133,8 @@ impl Ctx<'_> {
         region: Region,
         what: impl FnOnce() -> String,
     ) -> Desc {
-        match bipolar(mesh, refs, n, region, self.args.descriptor, None, None) {
+        let surface = bipolar::Surface::new(mesh.clone());
+        match bipolar(&surface, refs, n, region, self.args.descriptor, None, None) {
             Ok(d) => Some(d),
             Err(e) => {
                 self.failures
