@@ -3,9 +3,11 @@
 //! described on the cleaned scans with the ground-truth landmarks the scanner projected and with
 //! the landmarks `landmarks::detect_visible` places (seen from the scanner). Gallery: neutral
 //! frontal scans at the `--scan-*` settings; probes: the other expressions, each under a random
-//! yaw of 0-45 degrees (either side) and a random noise level. A probe turned past
-//! `--side-pair`, or with an outer eye corner off the scan or unseen, is compared by a side pair
-//! (its other corner with the nose tip). Sweeps rescan one probe expression of the first
+//! yaw of 0-45 degrees (either side) and a random noise level. Every face is described by three
+//! pole pairs (the outer eye corners; each outer corner with the nose tip); a probe turned past
+//! `--side-pair`, or with an outer eye corner off the scan or unseen, takes a side pair as its
+//! own (the pair its reference-point search moves), and its bipolar score is the least distance
+//! over the three pairs (`--own-pair-only`: its own pair's). Sweeps rescan one probe expression of the first
 //! `--sweep-identities` identities at several noise levels, pitches and yaws (the other settings
 //! those of the gallery) against the same gallery. Every failure (a landmark not found or not on
 //! the scan, a descriptor error) is listed with the face's name and counted, never replaced.
