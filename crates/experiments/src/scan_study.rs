@@ -25,7 +25,6 @@ use geodesic::{Method, SolveOptions, Source};
 use meshcore::{DVec3, FaceLocator, SurfacePoint, TriMesh};
 use rangescan::{Artifacts, DepthNoise, HeadPose, Quantisation, ScanOptions};
 use rayon::prelude::*;
-use scanprep::incidence_mask;
 use scanprep::{CleanOptions, Crop, Input};
 use std::fmt::Write as _;
 use std::time::Instant;
@@ -328,18 +327,10 @@ fn describe_mesh(
             sides.push(None);
             continue;
         }
-        let seen = match v.max_incidence_deg.map(|deg| {
-            let own = incidence_mask(&mesh, crate::scans::SCANNER_SIDE, deg)?;
-            match view {
-                Some(toward) => {
-                    let other = incidence_mask(&mesh, toward, deg)?;
-                    Ok::<Vec<bool>, scanprep::ScanPrepError>(
-                        own.iter().zip(&other).map(|(a, b)| *a && *b).collect(),
-                    )
-                }
-                None => Ok(own),
-            }
-        }) {
+        let seen = match v
+            .max_incidence_deg
+            .map(|deg| crate::scans::seen_within(&mesh, view, deg))
+        {
             Some(Err(e)) => {
                 notes.push(format!("{}: {e}", v.name));
                 bip.push(None);

@@ -410,6 +410,24 @@ pub const VIEW_MATCH_INCIDENCE_DEG: f64 = 75.0;
 /// Sample spacing (mm) of the z-buffer of the view matching: the scans' pitch.
 pub const VIEW_MATCH_PITCH_MM: f64 = 0.5;
 
+/// The vertices of a scan seen within `max_incidence_deg` from its own scanner
+/// ([`SCANNER_SIDE`]) and, when given, also from another scanner's direction `toward` (a
+/// view-matched cut: both must hold).
+pub fn seen_within(
+    mesh: &TriMesh,
+    toward: Option<DVec3>,
+    max_incidence_deg: f64,
+) -> Result<Vec<bool>, scanprep::ScanPrepError> {
+    let own = scanprep::incidence_mask(mesh, SCANNER_SIDE, max_incidence_deg)?;
+    Ok(match toward {
+        Some(t) => {
+            let other = scanprep::incidence_mask(mesh, t, max_incidence_deg)?;
+            own.iter().zip(&other).map(|(a, b)| *a && *b).collect()
+        }
+        None => own,
+    })
+}
+
 /// The part of a scanned face that another scan's scanner would have measured.
 pub struct ViewCut {
     /// The faces seen from `toward` (vertices renumbered, unused ones dropped).

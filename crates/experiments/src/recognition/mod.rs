@@ -715,16 +715,7 @@ impl ViewSource {
         );
         let frame = face_frame(cut, r, q, nose);
         let seen = match self.opts.max_incidence_deg {
-            Some(deg) => {
-                let own = scanprep::incidence_mask(cut, crate::scans::SCANNER_SIDE, deg).ok()?;
-                let probe = scanprep::incidence_mask(cut, toward, deg).ok()?;
-                Some(
-                    own.iter()
-                        .zip(&probe)
-                        .map(|(a, b)| *a && *b)
-                        .collect::<Vec<bool>>(),
-                )
-            }
+            Some(deg) => Some(crate::scans::seen_within(cut, Some(toward), deg).ok()?),
             None => None,
         };
         Some(Pair::ALL.map(|pair| {
