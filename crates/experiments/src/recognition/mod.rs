@@ -135,6 +135,11 @@ pub struct Args {
     /// (`--scans`).
     #[arg(long)]
     pub own_pair_only: bool,
+    /// The reference-point search (`--ref-search`) moves the poles of all three pairs, not
+    /// only those of the probe's own pair (`--scans`, with the least over the three pairs):
+    /// 18 moved fields and 144 more descriptors per probe instead of 12 and 48.
+    #[arg(long)]
+    pub search_all_pairs: bool,
 }
 
 /// One sampled face.
@@ -298,9 +303,9 @@ struct Described {
     pair: Pair,
     /// Its score is the least distance over the three pairs ([`DescribeOptions::least_pair`]).
     least_pair: bool,
-    /// Bipolar descriptors of `pair` from moved poles (`DescribeOptions::ref_search`; else
-    /// empty).
-    bip_alt: Vec<bipolar::Descriptor>,
+    /// Bipolar descriptors from moved poles, per [`Pair`] (`DescribeOptions::ref_search`): of
+    /// `pair`, or of all three with [`DescribeOptions::search_all_pairs`]; else empty.
+    bip_alt: [Vec<bipolar::Descriptor>; 3],
     pol: PolarDescriptor,
     facial: Result<FacialCurvesDescriptor, String>,
     /// The iso-curvature network's points prepared for ICP (the network itself is not kept).
@@ -338,6 +343,9 @@ struct DescribeOptions {
     /// The bipolar score is the least distance over the three pole pairs (the probe's own with
     /// its reference-point search); else the probe's own pair's (`Args::own_pair_only`).
     least_pair: bool,
+    /// With `least_pair`, the reference-point search moves the poles of all three pairs, not
+    /// only the probe's own (`Args::search_all_pairs`).
+    search_all_pairs: bool,
 }
 
 /// The fields of a face cut off at 1.4 |q - r| (corners r, q; nose tip, when asked for: else
@@ -521,16 +529,24 @@ fn describe_face(
     let t_surface = Instant::now();
     let surface = Surface::new(mesh.clone());
     let t_surface = t_surface.elapsed().as_secs_f64();
-    let mut bip_alt = Vec::new();
+    let refs = Pair::ALL.map(|p| pair_refs(mesh, &f, lm, p, frame));
     let bip = Pair::ALL.map(|p| {
-        let refs = pair_refs(mesh, &f, lm, p, frame)?;
-        let b = static_bipolar(&surface, &refs, o, seen.as_deref())
-            .map_err(|e| format!("bipolar descriptor: {e}"))?;
-        if p == pair {
-            bip_alt = moved_pole_descriptors(&surface, solver, lm, p, &refs, o, seen.as_deref());
-        }
-        Ok(b)
+        let refs = refs[p as usize].as_ref().map_err(Clone::clone)?;
+        static_bipolar(&surface, refs, o, seen.as_deref())
+            .map_err(|e| format!("bipolar descriptor: {e}"))
     });
+    let all = o.least_pair && o.search_all_pairs;
+    let searched = Pair::ALL.map(|p| p == pair || all);
+    let bip_alt = moved_pole_descriptors(
+        &surface,
+        solver,
+        lm,
+        &refs,
+        searched,
+        all,
+        o,
+        seen.as_deref(),
+    );
     let t_bip = t.elapsed().as_secs_f64();
     // The descriptions scaled by D need both corners.
     let scale = f.scale(lm);
@@ -587,75 +603,123 @@ fn describe_face(
 /// Directions of the reference-point search around each outer eye corner.
 pub(super) const SEARCH_DIRECTIONS: usize = 6;
 
-/// Bipolar descriptors of a face from the poles of `pair` (with reference fields `refs`) moved
-/// by the search radius `o.ref_search` (none without it) in [`SEARCH_DIRECTIONS`] directions
-/// of their tangent planes (`bipolar::reference_candidates`, the first toward the other pole;
-/// each pole at its place or moved: 48 pairs), with the options of the face's own descriptor;
-/// pairs whose fields or descriptor fail are left out. Moved corners get the frame of their
-/// new eye line; a side pair keeps the landmarks' frame.
+/// Bipolar descriptors of a face, per [`Pair`] (indexed by its discriminant), from the poles of
+/// each pair in `searched` (with reference fields `refs`; a pair whose `refs` failed is left
+/// empty) moved by the search radius `o.ref_search` (none without it) in [`SEARCH_DIRECTIONS`]
+/// directions of their tangent planes (`bipolar::reference_candidates`; each pole at its place
+/// or moved: 48 pairs), with the options of the face's own descriptors; pairs whose fields or
+/// descriptor fail are left out. The first direction of a pole points toward the pair's other
+/// pole, or, with `shared_candidates`, the same for every pair: an outer eye corner toward the
+/// other, the nose tip toward their midpoint, so that each landmark's moved fields are solved
+/// once for all pairs. Moved corners get the frame of their new eye line; a side pair keeps
+/// the landmarks' frame.
+#[allow(clippy::too_many_arguments)]
 fn moved_pole_descriptors(
     surface: &Surface,
     solver: &dyn geodesic::GeodesicSolver,
     lm: Lm,
-    pair: Pair,
-    refs: &Refs,
+    refs: &[Result<Refs, String>; 3],
+    searched: [bool; 3],
+    shared_candidates: bool,
     o: &DescribeOptions,
     seen: Option<&[bool]>,
-) -> Vec<bipolar::Descriptor> {
+) -> [Vec<bipolar::Descriptor>; 3] {
+    let mut out: [Vec<bipolar::Descriptor>; 3] = Default::default();
     let Some(rho) = o.ref_search else {
-        return Vec::new();
+        return out;
     };
     let mesh = surface.mesh();
-    let (a, b) = lm.poles(pair);
-    let around = |v: u32, other: DVec3| {
-        bipolar::reference_candidates(mesh, v, other, rho, SEARCH_DIRECTIONS).unwrap_or_default()
+    let search: Vec<(Pair, &Refs)> = Pair::ALL
+        .into_iter()
+        .filter(|p| searched[*p as usize])
+        .filter_map(|p| refs[p as usize].as_ref().ok().map(|r| (p, r)))
+        .collect();
+    let Some(span) = search
+        .iter()
+        .map(|(_, r)| (r.q - r.r).length())
+        .reduce(f64::max)
+    else {
+        return out;
     };
-    let (rs, qs) = (around(a, refs.q), around(b, refs.r));
     let cut = SolveOptions {
-        max_distance: Some(1.4 * (refs.q - refs.r).length() + 4.0 * rho),
+        max_distance: Some(1.4 * span + 4.0 * rho),
     };
-    let field = |v: u32| solver.distances(&[Source::Vertex(v)], &cut).ok();
-    // The given corner keeps its field; each moved one is solved.
-    let fields_of = |vs: &[u32], given: u32, u: &[f64]| -> Vec<Option<Vec<f64>>> {
-        vs.iter()
-            .map(|&v| {
-                if v == given {
-                    Some(u.to_vec())
+    let lm_vertex = [lm.r, lm.q, lm.nose];
+    let [pr, pq, _] = lm.positions(mesh);
+    // A landmark's candidates and their fields, by (landmark, the point its first direction
+    // points toward); the given pole keeps its field, each moved one is solved.
+    type Moved = (Vec<u32>, Vec<Option<Vec<f64>>>);
+    let mut cache: Vec<((usize, [u64; 3]), Moved)> = Vec::new();
+    let mut moved = |k: usize, toward: DVec3, given: &[f64]| -> usize {
+        let key = (k, toward.to_array().map(f64::to_bits));
+        if let Some(i) = cache.iter().position(|(c, _)| *c == key) {
+            return i;
+        }
+        let v = lm_vertex[k];
+        let vs = bipolar::reference_candidates(mesh, v, toward, rho, SEARCH_DIRECTIONS)
+            .unwrap_or_default();
+        let fields = vs
+            .iter()
+            .map(|&w| {
+                if w == v {
+                    Some(given.to_vec())
                 } else {
-                    field(v)
+                    solver.distances(&[Source::Vertex(w)], &cut).ok()
                 }
             })
-            .collect()
+            .collect();
+        cache.push((key, (vs, fields)));
+        cache.len() - 1
     };
-    let (fr, fq) = (fields_of(&rs, a, &refs.ur), fields_of(&qs, b, &refs.uq));
-    let mut out = Vec::new();
-    for (i, &r) in rs.iter().enumerate() {
-        for (j, &q) in qs.iter().enumerate() {
-            if i == 0 && j == 0 {
-                continue;
-            }
-            let (Some(ur), Some(uq)) = (&fr[i], &fq[j]) else {
-                continue;
+    let toward = |k: usize, other: DVec3| match (shared_candidates, k) {
+        (false, _) => other,
+        (true, 0) => pq,
+        (true, 1) => pr,
+        (true, _) => 0.5 * (pr + pq),
+    };
+    let jobs: Vec<(Pair, &Refs, usize, usize)> = search
+        .into_iter()
+        .map(|(pair, refs)| {
+            let (ka, kb) = match pair {
+                Pair::Corners => (0, 1),
+                Pair::RightNose => (0, 2),
+                Pair::LeftNose => (1, 2),
             };
-            let d = 0.5 * (ur[q as usize] + uq[r as usize]);
-            if !(d.is_finite() && d > 0.0) {
-                continue;
-            }
-            let (pr, pq) = (mesh.position(r), mesh.position(q));
-            let moved = Refs {
-                ur: ur.clone(),
-                uq: uq.clone(),
-                d,
-                r: pr,
-                q: pq,
-                nose: refs.nose,
-                frame: match pair {
-                    Pair::Corners => face_frame(mesh, pr, pq, refs.nose),
-                    _ => refs.frame,
-                },
-            };
-            if let Ok(b) = static_bipolar(surface, &moved, o, seen) {
-                out.push(b);
+            let ia = moved(ka, toward(ka, refs.q), &refs.ur);
+            let ib = moved(kb, toward(kb, refs.r), &refs.uq);
+            (pair, refs, ia, ib)
+        })
+        .collect();
+    for (pair, refs, ia, ib) in jobs {
+        let ((rs, fr), (qs, fq)) = (&cache[ia].1, &cache[ib].1);
+        for (i, &r) in rs.iter().enumerate() {
+            for (j, &q) in qs.iter().enumerate() {
+                if i == 0 && j == 0 {
+                    continue;
+                }
+                let (Some(ur), Some(uq)) = (&fr[i], &fq[j]) else {
+                    continue;
+                };
+                let d = 0.5 * (ur[q as usize] + uq[r as usize]);
+                if !(d.is_finite() && d > 0.0) {
+                    continue;
+                }
+                let (pr, pq) = (mesh.position(r), mesh.position(q));
+                let moved = Refs {
+                    ur: ur.clone(),
+                    uq: uq.clone(),
+                    d,
+                    r: pr,
+                    q: pq,
+                    nose: refs.nose,
+                    frame: match pair {
+                        Pair::Corners => face_frame(mesh, pr, pq, refs.nose),
+                        _ => refs.frame,
+                    },
+                };
+                if let Ok(b) = static_bipolar(surface, &moved, o, seen) {
+                    out[pair as usize].push(b);
+                }
             }
         }
     }
@@ -838,7 +902,7 @@ fn icp_points(mesh: &TriMesh, n: usize) -> Vec<DVec3> {
 /// The bipolar distance of a probe `x` to a gallery face `y` by each [`Pair`] (indexed by its
 /// discriminant; NaN where a side has no descriptor or the distance fails). With view matching,
 /// against the gallery face as the probe's scanner would see it. With a reference-point search,
-/// the probe's own pair is the least distance over its descriptors (`f64::min` skips a failed
+/// a searched pair's distance is the least over its descriptors (`f64::min` skips a failed
 /// one).
 fn bipolar_pairs(x: &Described, y: &Described) -> [f64; 3] {
     let matched = y.view.as_ref().and_then(|v| v.describe_from(&x.lm_pos));
@@ -849,14 +913,10 @@ fn bipolar_pairs(x: &Described, y: &Described) -> [f64; 3] {
         };
         let yb = matched.as_ref().and_then(|m| m[i].as_ref()).unwrap_or(own);
         let d = dist(&x.bip[i], yb).unwrap_or(f64::NAN);
-        if p == x.pair {
-            x.bip_alt
-                .iter()
-                .filter_map(|a| dist(a, yb).ok())
-                .fold(d, f64::min)
-        } else {
-            d
-        }
+        x.bip_alt[i]
+            .iter()
+            .filter_map(|a| dist(a, yb).ok())
+            .fold(d, f64::min)
     })
 }
 
@@ -1260,6 +1320,7 @@ pub fn run(args: Args) -> Result<()> {
         view_match: None,
         side_pair_deg: None,
         least_pair: false,
+        search_all_pairs: false,
     };
     let elastic = elastic_options(args.curve_samples);
     // Landmark detection.

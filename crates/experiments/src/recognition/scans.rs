@@ -471,6 +471,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         view_match: (!args.no_view_match).then_some(args.view_match),
         side_pair_deg: (!args.no_side_pair).then_some(args.side_pair),
         least_pair: !(args.no_side_pair || args.own_pair_only),
+        search_all_pairs: args.search_all_pairs,
     };
     let elastic = elastic_options(args.curve_samples);
     // Specs: gallery, main probes, sweeps (each face its own scan seed).
