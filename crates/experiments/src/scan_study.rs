@@ -357,14 +357,28 @@ fn describe_mesh(
             )
             .map_err(|e| format!("{}: {e}", v.name))
         };
-        match describe([&fields[0], &fields[1]], d) {
-            Ok(d) => bip.push(Some(d)),
-            Err(e) => {
-                notes.push(e);
-                bip.push(None);
-            }
+        // A variant described like an earlier one (another distance rule over the same
+        // descriptors) takes that one's descriptors; its side pairs from one that has them.
+        let earlier = |want_sides: bool| {
+            (0..k).find(|&j| {
+                view.is_none()
+                    && VARIANTS[j].same_description(v)
+                    && (!want_sides || VARIANTS[j].side_pairs.is_some())
+            })
+        };
+        match earlier(false) {
+            Some(j) => bip.push(bip[j].clone()),
+            None => match describe([&fields[0], &fields[1]], d) {
+                Ok(d) => bip.push(Some(d)),
+                Err(e) => {
+                    notes.push(e);
+                    bip.push(None);
+                }
+            },
         }
-        sides.push(if v.side_pairs.is_some() {
+        sides.push(if let (Some(_), Some(j)) = (v.side_pairs, earlier(true)) {
+            sides[j].clone()
+        } else if v.side_pairs.is_some() {
             let side = |k: usize| {
                 let dk = d_sides[k];
                 if !(dk.is_finite() && dk > 0.0) {
@@ -482,6 +496,13 @@ enum PairCombine {
 }
 
 impl Variant {
+    /// The two variants build the same descriptors (they may differ in the distance rule).
+    fn same_description(&self, other: &Variant) -> bool {
+        self.isoangle == other.isoangle
+            && self.margin_mm == other.margin_mm
+            && self.max_incidence_deg == other.max_incidence_deg
+    }
+
     fn options(&self) -> bipolar::DescriptorOptions {
         let opts = match self.isoangle {
             None => bipolar::DescriptorOptions {
