@@ -1547,6 +1547,88 @@ mod tests {
         assert!(pair_score([0.3, nan, 0.2], Pair::RightNose, false).is_nan());
     }
 
+    /// A solver that counts the fields it solves.
+    #[derive(Debug)]
+    struct Counting<'a>(
+        &'a dyn geodesic::GeodesicSolver,
+        std::sync::atomic::AtomicUsize,
+    );
+
+    impl geodesic::GeodesicSolver for Counting<'_> {
+        fn method(&self) -> geodesic::Method {
+            self.0.method()
+        }
+        fn n_vertices(&self) -> usize {
+            self.0.n_vertices()
+        }
+        fn distances(
+            &self,
+            sources: &[Source],
+            opts: &SolveOptions,
+        ) -> Result<Vec<f64>, geodesic::GeodesicError> {
+            self.1.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            self.0.distances(sources, opts)
+        }
+    }
+
+    #[test]
+    fn the_search_moves_the_pairs_asked_for_and_solves_each_moved_pole_once() {
+        // A flat 80 x 50 mm sheet, 2 mm squares; poles moved by 4 mm (distinct vertices).
+        let m = meshcore::shapes::grid(40, 25, meshcore::shapes::Diagonals::Alternating, |i, j| {
+            DVec3::new(2.0 * i as f64, 2.0 * j as f64, 0.0)
+        })
+        .unwrap();
+        let at = |i: u32, j: u32| j * 41 + i;
+        let lm = Lm::new(at(8, 16), at(32, 16), at(20, 6));
+        let exact = geodesic::new_solver(&m, geodesic::Method::Exact).unwrap();
+        let f = fields(&m, exact.as_ref(), lm, true).unwrap();
+        let [r, q, nose] = lm.positions(&m);
+        let frame = face_frame(&m, r, q, nose);
+        let refs = Pair::ALL.map(|p| pair_refs(&m, &f, lm, p, frame));
+        let o = DescribeOptions {
+            levels: 8,
+            sectors: 8,
+            iso_levels: None,
+            boundary_margin: None,
+            max_incidence_deg: None,
+            ref_search: Some(4.0),
+            view_match: None,
+            side_pair_deg: None,
+            least_pair: true,
+            search_all_pairs: true,
+        };
+        let surface = Surface::new(m.clone());
+        let run = |searched: [bool; 3], shared: bool| {
+            let solver = Counting(exact.as_ref(), Default::default());
+            let out =
+                moved_pole_descriptors(&surface, &solver, lm, &refs, searched, shared, &o, None);
+            (out.map(|v| v.len()), solver.1.into_inner())
+        };
+        // The own pair alone: 7 x 7 - 1 pole pairs, 6 moved fields per pole.
+        assert_eq!(run([false, true, false], false), ([0, 48, 0], 12));
+        // Every pair, each pole's first direction toward its pair's other pole: a corner's
+        // candidates differ between its two pairs, 36 fields.
+        assert_eq!(run([true; 3], false), ([48; 3], 36));
+        // Shared candidates: 6 moved fields per landmark, 18.
+        assert_eq!(run([true; 3], true), ([48; 3], 18));
+        // No search radius: nothing.
+        let off = DescribeOptions {
+            ref_search: None,
+            ..o.clone()
+        };
+        let none = moved_pole_descriptors(
+            &surface,
+            exact.as_ref(),
+            lm,
+            &refs,
+            [true; 3],
+            true,
+            &off,
+            None,
+        );
+        assert!(none.iter().all(Vec::is_empty));
+    }
+
     #[test]
     fn side_pairs_on_a_plane() {
         // A flat 100 x 60 mm sheet, 2 mm squares: geodesic distance = straight distance.
