@@ -105,9 +105,10 @@ pub struct Args {
     #[arg(long, default_value_t = SCAN_MAX_INCIDENCE_DEG)]
     pub max_incidence: f64,
     /// Reference-point search of the bipolar score (`--scans`; mm, 0: off): each probe is also
-    /// described from its two poles (the outer eye corners, or its side pair's corner and nose
-    /// tip) moved by this distance in 6 directions of their tangent planes (48 more
-    /// descriptors), and its score against a gallery face is the least distance over the 49.
+    /// described by each pole pair (the outer eye corners; each corner with the nose tip) from
+    /// its two poles moved by this distance in 6 directions of their tangent planes (48 more
+    /// descriptors per pair; only the probe's own pair with `--own-pair-search`), and its
+    /// distance by a pair is the least over the pair's 49 descriptors.
     #[arg(long, default_value_t = SCAN_REF_SEARCH_MM)]
     pub ref_search: f64,
     /// View matching of the bipolar score (`--scans`; degrees): when a probe's scanner
@@ -135,11 +136,12 @@ pub struct Args {
     /// (`--scans`).
     #[arg(long)]
     pub own_pair_only: bool,
-    /// The reference-point search (`--ref-search`) moves the poles of all three pairs, not
-    /// only those of the probe's own pair (`--scans`, with the least over the three pairs):
-    /// 18 moved fields and 144 more descriptors per probe instead of 12 and 48.
+    /// The reference-point search (`--ref-search`) moves only the poles of the probe's own
+    /// pair (`--scans`; the former default): 12 moved fields and 48 more descriptors per probe.
+    /// By default, with the least over the three pairs, it moves the poles of all three: 18
+    /// moved fields and 144 more descriptors.
     #[arg(long)]
-    pub search_all_pairs: bool,
+    pub own_pair_search: bool,
 }
 
 /// One sampled face.
@@ -344,7 +346,7 @@ struct DescribeOptions {
     /// its reference-point search); else the probe's own pair's (`Args::own_pair_only`).
     least_pair: bool,
     /// With `least_pair`, the reference-point search moves the poles of all three pairs, not
-    /// only the probe's own (`Args::search_all_pairs`).
+    /// only the probe's own (the default; `Args::own_pair_search` turns it off).
     search_all_pairs: bool,
 }
 
@@ -482,13 +484,33 @@ fn iso_levels_of(
         .context("iso-curvature levels of the reference face")
 }
 
+/// The vertices the bipolar descriptors of `surface` may use: those of `seen` (all without
+/// it) outside the band of `margin` along the boundary (`bipolar::boundary_band`). Built once
+/// per surface for all its descriptors, as `DescriptorOptions::boundary_margin` would build the
+/// band again for each (an exact solve from the boundary).
+fn kept_vertices(
+    surface: &Surface,
+    seen: Option<Vec<bool>>,
+    margin: Option<f64>,
+) -> Result<Option<Vec<bool>>, bipolar::BipolarError> {
+    let Some(m) = margin else {
+        return Ok(seen);
+    };
+    let band = bipolar::boundary_band(surface, m)?;
+    Ok(Some(match seen {
+        Some(s) => s.iter().zip(&band).map(|(s, b)| *s && !*b).collect(),
+        None => band.iter().map(|b| !*b).collect(),
+    }))
+}
+
 /// The benchmark's bipolar descriptor on `surface` from `refs`: static area, rule `All`, the
-/// options' levels and band, and the vertex mask `seen`.
+/// options' levels, on the vertices `kept` ([`kept_vertices`]: the scanner's incidence mask
+/// without the boundary band).
 fn static_bipolar(
     surface: &Surface,
     refs: &Refs,
     o: &DescribeOptions,
-    seen: Option<&[bool]>,
+    kept: Option<&[bool]>,
 ) -> Result<bipolar::Descriptor, bipolar::BipolarError> {
     bipolar(
         surface,
@@ -496,8 +518,8 @@ fn static_bipolar(
         o.levels,
         Region::Static,
         DescriptorRule::CrateAll,
-        o.boundary_margin,
-        seen,
+        None,
+        kept,
     )
 }
 
@@ -529,24 +551,31 @@ fn describe_face(
     let t_surface = Instant::now();
     let surface = Surface::new(mesh.clone());
     let t_surface = t_surface.elapsed().as_secs_f64();
+    let kept = kept_vertices(&surface, seen, o.boundary_margin)
+        .map_err(|e| format!("bipolar descriptor: {e}"));
     let refs = Pair::ALL.map(|p| pair_refs(mesh, &f, lm, p, frame));
     let bip = Pair::ALL.map(|p| {
         let refs = refs[p as usize].as_ref().map_err(Clone::clone)?;
-        static_bipolar(&surface, refs, o, seen.as_deref())
+        let kept = kept.as_ref().map_err(Clone::clone)?;
+        static_bipolar(&surface, refs, o, kept.as_deref())
             .map_err(|e| format!("bipolar descriptor: {e}"))
     });
     let all = o.least_pair && o.search_all_pairs;
     let searched = Pair::ALL.map(|p| p == pair || all);
-    let bip_alt = moved_pole_descriptors(
-        &surface,
-        solver,
-        lm,
-        &refs,
-        searched,
-        all,
-        o,
-        seen.as_deref(),
-    );
+    // Without the kept vertices every descriptor fails: no moved ones either.
+    let bip_alt = match &kept {
+        Ok(kept) => moved_pole_descriptors(
+            &surface,
+            solver,
+            lm,
+            &refs,
+            searched,
+            all,
+            o,
+            kept.as_deref(),
+        ),
+        Err(_) => Default::default(),
+    };
     let t_bip = t.elapsed().as_secs_f64();
     // The descriptions scaled by D need both corners.
     let scale = f.scale(lm);
@@ -782,9 +811,10 @@ impl ViewSource {
             Some(deg) => Some(crate::scans::seen_within(cut, Some(toward), deg).ok()?),
             None => None,
         };
+        let kept = kept_vertices(&surface, seen, self.opts.boundary_margin).ok()?;
         Some(Pair::ALL.map(|pair| {
             let refs = pair_refs(cut, &f, lm, pair, frame).ok()?;
-            static_bipolar(&surface, &refs, &self.opts, seen.as_deref()).ok()
+            static_bipolar(&surface, &refs, &self.opts, kept.as_deref()).ok()
         }))
     }
 }
