@@ -1577,6 +1577,32 @@ mod tests {
         assert!(pair_score([0.3, nan, 0.2], Pair::RightNose, false).is_nan());
     }
 
+    /// A flat sheet of `nx` x `ny` squares of 2 mm, its landmarks at the grid points `at` (r, q,
+    /// nose tip), its exact solver, their fields and frame.
+    fn plane_face(
+        nx: usize,
+        ny: usize,
+        at: [(u32, u32); 3],
+    ) -> (
+        TriMesh,
+        Lm,
+        Box<dyn geodesic::GeodesicSolver>,
+        Fields,
+        FaceFrame,
+    ) {
+        let m = meshcore::shapes::grid(nx, ny, meshcore::shapes::Diagonals::Alternating, |i, j| {
+            DVec3::new(2.0 * i as f64, 2.0 * j as f64, 0.0)
+        })
+        .unwrap();
+        let [r, q, nose] = at.map(|(i, j)| j * (nx as u32 + 1) + i);
+        let lm = Lm::new(r, q, nose);
+        let solver = geodesic::new_solver(&m, geodesic::Method::Exact).unwrap();
+        let f = fields(&m, solver.as_ref(), lm, true).unwrap();
+        let [r, q, nose] = lm.positions(&m);
+        let frame = face_frame(&m, r, q, nose);
+        (m, lm, solver, f, frame)
+    }
+
     /// A solver that counts the fields it solves.
     #[derive(Debug)]
     struct Counting<'a>(
@@ -1603,17 +1629,8 @@ mod tests {
 
     #[test]
     fn the_search_moves_the_pairs_asked_for_and_solves_each_moved_pole_once() {
-        // A flat 80 x 50 mm sheet, 2 mm squares; poles moved by 4 mm (distinct vertices).
-        let m = meshcore::shapes::grid(40, 25, meshcore::shapes::Diagonals::Alternating, |i, j| {
-            DVec3::new(2.0 * i as f64, 2.0 * j as f64, 0.0)
-        })
-        .unwrap();
-        let at = |i: u32, j: u32| j * 41 + i;
-        let lm = Lm::new(at(8, 16), at(32, 16), at(20, 6));
-        let exact = geodesic::new_solver(&m, geodesic::Method::Exact).unwrap();
-        let f = fields(&m, exact.as_ref(), lm, true).unwrap();
-        let [r, q, nose] = lm.positions(&m);
-        let frame = face_frame(&m, r, q, nose);
+        // An 80 x 50 mm sheet; poles moved by 4 mm (distinct vertices).
+        let (m, lm, exact, f, frame) = plane_face(40, 25, [(8, 16), (32, 16), (20, 6)]);
         let refs = Pair::ALL.map(|p| pair_refs(&m, &f, lm, p, frame));
         let o = DescribeOptions {
             levels: 8,
@@ -1661,17 +1678,9 @@ mod tests {
 
     #[test]
     fn side_pairs_on_a_plane() {
-        // A flat 100 x 60 mm sheet, 2 mm squares: geodesic distance = straight distance.
-        let m = meshcore::shapes::grid(50, 30, meshcore::shapes::Diagonals::Alternating, |i, j| {
-            DVec3::new(2.0 * i as f64, 2.0 * j as f64, 0.0)
-        })
-        .unwrap();
-        let at = |i: u32, j: u32| j * 51 + i;
-        let lm = Lm::new(at(5, 20), at(45, 20), at(25, 5));
-        let solver = geodesic::new_solver(&m, geodesic::Method::Exact).unwrap();
-        let f = fields(&m, solver.as_ref(), lm, true).unwrap();
+        // A 100 x 60 mm sheet: geodesic distance = straight distance.
+        let (m, lm, solver, f, frame) = plane_face(50, 30, [(5, 20), (45, 20), (25, 5)]);
         let [r, q, nose] = lm.positions(&m);
-        let frame = face_frame(&m, r, q, nose);
         let corners = pair_refs(&m, &f, lm, Pair::Corners, frame).unwrap();
         assert!((corners.d - 80.0).abs() < 1e-9, "{}", corners.d);
         for (pair, corner) in [(Pair::RightNose, r), (Pair::LeftNose, q)] {
