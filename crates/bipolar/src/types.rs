@@ -210,7 +210,9 @@ pub struct DescriptorOptions {
     /// boundary (holes, eye openings, a scan's border), as if it were a hole. Near a hole the
     /// fields bend around it and the level curves of two acquisitions of one surface cross in
     /// different places (docs/scans.md, "Yaw"). Holes whose boundary is shorter than twice the
-    /// margin get no band. `None` keeps everything.
+    /// margin get no band. `None` keeps everything. The band is built on every call (an exact
+    /// solve from the boundary); for many descriptors of one surface build it once with
+    /// [`crate::boundary_band`] and leave it out through `vertex_mask`, which is the same.
     #[serde(default)]
     pub boundary_margin: Option<f64>,
     /// Number of angle levels `K` (targets `alpha k / K`, `k = 0..=K`).

@@ -204,6 +204,26 @@ pub fn restrict(mask: Option<Vec<bool>>, seen: Option<&[bool]>) -> Option<Vec<bo
     }
 }
 
+/// The vertices the bipolar descriptors of `surface` may use: those of `seen` (all without
+/// it) outside the band of `margin` along the boundary (`bipolar::boundary_band`). For many
+/// descriptors of one surface, pass this as their vertex mask with no `boundary_margin`:
+/// `DescriptorOptions::boundary_margin` builds the band again (an exact solve from the
+/// boundary) on every call, and the two leave out the same vertices.
+pub fn kept_vertices(
+    surface: &bipolar::Surface,
+    seen: Option<Vec<bool>>,
+    margin: Option<f64>,
+) -> Result<Option<Vec<bool>>, bipolar::BipolarError> {
+    let Some(m) = margin else {
+        return Ok(seen);
+    };
+    let outside: Vec<bool> = bipolar::boundary_band(surface, m)?
+        .into_iter()
+        .map(|b| !b)
+        .collect();
+    Ok(restrict(Some(outside), seen.as_deref()))
+}
+
 /// A keyed point set as `shapedist::keyed_distance` takes it.
 pub trait Keyed {
     /// Packed keys and positions of the points that may be paired (ambiguous points left out).

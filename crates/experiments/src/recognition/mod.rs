@@ -19,7 +19,7 @@ use crate::curves::{
 };
 use crate::paths::{ModelArgs, ResolutionArgs};
 use crate::pipeline::{
-    bar, bipolar, dist, resolve_methods, single_thread, DescriptorRule, Refs, Region,
+    bar, bipolar, dist, kept_vertices, resolve_methods, single_thread, DescriptorRule, Refs, Region,
 };
 use crate::polar::{self, polar_descriptor, PolarOptions, Pole};
 use crate::report::{f4, line_plot, Report, Series};
@@ -484,25 +484,6 @@ fn iso_levels_of(
         .context("iso-curvature levels of the reference face")
 }
 
-/// The vertices the bipolar descriptors of `surface` may use: those of `seen` (all without
-/// it) outside the band of `margin` along the boundary (`bipolar::boundary_band`). Built once
-/// per surface for all its descriptors, as `DescriptorOptions::boundary_margin` would build the
-/// band again for each (an exact solve from the boundary).
-fn kept_vertices(
-    surface: &Surface,
-    seen: Option<Vec<bool>>,
-    margin: Option<f64>,
-) -> Result<Option<Vec<bool>>, bipolar::BipolarError> {
-    let Some(m) = margin else {
-        return Ok(seen);
-    };
-    let band = bipolar::boundary_band(surface, m)?;
-    Ok(Some(match seen {
-        Some(s) => s.iter().zip(&band).map(|(s, b)| *s && !*b).collect(),
-        None => band.iter().map(|b| !*b).collect(),
-    }))
-}
-
 /// The benchmark's bipolar descriptor on `surface` from `refs`: static area, rule `All`, the
 /// options' levels, on the vertices `kept` ([`kept_vertices`]: the scanner's incidence mask
 /// without the boundary band).
@@ -636,7 +617,7 @@ pub(super) const SEARCH_DIRECTIONS: usize = 6;
 /// each pair in `searched` (with reference fields `refs`; a pair whose `refs` failed is left
 /// empty) moved by the search radius `o.ref_search` (none without it) in [`SEARCH_DIRECTIONS`]
 /// directions of their tangent planes (`bipolar::reference_candidates`; each pole at its place
-/// or moved: 48 pairs), with the options of the face's own descriptors; pairs whose fields or
+/// or moved: 48 pairs), with the options and vertices `kept` of the face's own descriptors; pairs whose fields or
 /// descriptor fail are left out. The first direction of a pole points toward the pair's other
 /// pole, or, with `shared_candidates`, the same for every pair: an outer eye corner toward the
 /// other, the nose tip toward their midpoint, so that each landmark's moved fields are solved
@@ -651,7 +632,7 @@ fn moved_pole_descriptors(
     searched: [bool; 3],
     shared_candidates: bool,
     o: &DescribeOptions,
-    seen: Option<&[bool]>,
+    kept: Option<&[bool]>,
 ) -> [Vec<bipolar::Descriptor>; 3] {
     let mut out: [Vec<bipolar::Descriptor>; 3] = Default::default();
     let Some(rho) = o.ref_search else {
@@ -746,7 +727,7 @@ fn moved_pole_descriptors(
                         _ => refs.frame,
                     },
                 };
-                if let Ok(b) = static_bipolar(surface, &moved, o, seen) {
+                if let Ok(b) = static_bipolar(surface, &moved, o, kept) {
                     out[pair as usize].push(b);
                 }
             }

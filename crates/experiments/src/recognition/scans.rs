@@ -650,13 +650,13 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
             + &dopt
                 .side_pair_deg
                 .map(|a| format!("; side pairs: every face is also described by each outer eye corner with the nose tip (their lens above the nose tip's horizontal plane); a probe turned by more than {a} degrees (its eye line against its scanner), or with an outer eye corner off the scan, takes its nearer (or remaining) corner's side pair as its own pair, which the reference-point search moves; {}", if dopt.least_pair {
-                    if dopt.search_all_pairs && dopt.ref_search.is_some() {
-                    "its score is the least distance over the three pairs (outer eye corners, right corner and nose tip, left corner and nose tip), each view-matched, and the reference-point search moves the poles of all three pairs (a nose tip's first direction toward the corners' midpoint)"
+                    format!("its score is the least distance over the three pairs (outer eye corners, right corner and nose tip, left corner and nose tip), each view-matched{}", if dopt.search_all_pairs && dopt.ref_search.is_some() {
+                        ", and the reference-point search moves the poles of all three pairs (a nose tip's first direction toward the corners' midpoint)"
+                    } else {
+                        ""
+                    })
                 } else {
-                    "its score is the least distance over the three pairs (outer eye corners, right corner and nose tip, left corner and nose tip), each view-matched"
-                }
-                } else {
-                    "its score is its own pair's distance"
+                    "its score is its own pair's distance".to_string()
                 }))
                 .unwrap_or_default(),
         args.res.sectors,
