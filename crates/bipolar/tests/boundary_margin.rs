@@ -221,3 +221,25 @@ fn pinholes_shorter_than_twice_the_margin_get_no_band() {
     let small = boundary_band(&surface, 0.4 * p).unwrap();
     assert!(pinhole.iter().all(|&v| small[v as usize]));
 }
+
+#[test]
+fn the_band_left_out_through_the_vertex_mask_gives_the_same_descriptor() {
+    // What the experiments do to build the band once for many descriptors of one surface.
+    let (mesh, refs) = holed_plane();
+    let margin = 0.15;
+    let by_margin = describe_exact(&mesh, refs, &options(Some(margin))).unwrap();
+    let band = boundary_band(&Surface::new(mesh.clone()), margin).unwrap();
+    let by_mask = describe_exact(
+        &mesh,
+        refs,
+        &DescriptorOptions {
+            vertex_mask: Some(band.iter().map(|b| !b).collect()),
+            ..options(None)
+        },
+    )
+    .unwrap();
+    let all = describe_exact(&mesh, refs, &options(None)).unwrap();
+    // The band removes points (else the comparison below would say nothing).
+    assert!(by_margin.points.len() < all.points.len());
+    assert_eq!(by_mask.points, by_margin.points);
+}
