@@ -16,7 +16,7 @@
 //! input order).
 
 use crate::paths::FaceSetArgs;
-use crate::pipeline::{bar, dist, landmark_icp_rms, restrict};
+use crate::pipeline::{bar, dist, kept_vertices, landmark_icp_rms, restrict};
 use crate::polar::{polar_descriptor, PolarOptions, Pole};
 use crate::report::{joined, write_csv};
 use anyhow::{bail, Context, Result};
@@ -321,6 +321,9 @@ fn describe_mesh(
     let fields = [ur, uq];
     let mut bip = Vec::new();
     let mut sides = Vec::new();
+    // The band along the holes, built once per margin and left out through the vertex mask
+    // (`pipeline::kept_vertices`) rather than again by every descriptor.
+    let mut bands: Vec<(f64, Result<Vec<bool>, String>)> = Vec::new();
     for (k, v) in VARIANTS.iter().enumerate() {
         if view.is_some() && k != LEAST {
             bip.push(None);
@@ -338,6 +341,27 @@ fn describe_mesh(
                 continue;
             }
             seen => seen.and_then(Result::ok),
+        };
+        let band = v.margin_mm.map(|m| {
+            let i = bands.iter().position(|(b, _)| *b == m).unwrap_or_else(|| {
+                let kept = match kept_vertices(&surface, None, Some(m)) {
+                    Ok(Some(kept)) => Ok(kept),
+                    Ok(None) => Err("no band mask".to_string()),
+                    Err(e) => Err(e.to_string()),
+                };
+                bands.push((m, kept));
+                bands.len() - 1
+            });
+            bands[i].1.clone()
+        });
+        let seen = match band {
+            Some(Err(e)) => {
+                notes.push(format!("{}: {e}", v.name));
+                bip.push(None);
+                sides.push(None);
+                continue;
+            }
+            band => restrict(seen, band.and_then(Result::ok).as_deref()),
         };
         let describe = |pair: [&[f64]; 2], d: f64| {
             let mask = static_mask(&mesh, pair[0], pair[1], d, &frame, pos[2]);
@@ -477,7 +501,9 @@ struct Variant {
     name: &'static str,
     /// `None`: rule `All`; else the iso-angle rule with these crossings and repeats.
     isoangle: Option<(bipolar::IsoCrossings, bipolar::IsoRepeats)>,
-    /// Band along the scan's boundary left out (`DescriptorOptions::boundary_margin`, mm).
+    /// Band along the scan's boundary left out (mm; built once per scan by
+    /// `pipeline::kept_vertices` and left out through the vertex mask, which leaves out what
+    /// `DescriptorOptions::boundary_margin` would).
     margin_mm: Option<f64>,
     /// Vertices the scanner saw at a larger incidence left out (`scanprep::incidence_mask`,
     /// degrees; the scans and the face mesh look along +z).
@@ -503,8 +529,10 @@ impl Variant {
             && self.max_incidence_deg == other.max_incidence_deg
     }
 
+    /// The library's options of the variant's selection rule (its band and incidence limit go
+    /// through the vertex mask).
     fn options(&self) -> bipolar::DescriptorOptions {
-        let opts = match self.isoangle {
+        match self.isoangle {
             None => bipolar::DescriptorOptions {
                 rule: bipolar::SelectionRule::All,
                 ..Default::default()
@@ -518,10 +546,6 @@ impl Variant {
                 },
                 ..Default::default()
             },
-        };
-        bipolar::DescriptorOptions {
-            boundary_margin: self.margin_mm,
-            ..opts
         }
     }
 }
