@@ -817,6 +817,9 @@ struct Metrics {
     ms_per_description: f64,
     #[serde(skip)]
     roc: Vec<(f64, f64)>,
+    /// Per probe: identified at rank 1 ([`identified`]).
+    #[serde(skip)]
+    identified: Vec<bool>,
 }
 
 /// (rank-1 rate, EER, ROC points, mean genuine score, mean impostor score, failed pairs).
@@ -824,7 +827,10 @@ type Figures = (f64, f64, Vec<(f64, f64)>, f64, f64, usize);
 
 /// Rank-1 rate, EER and ROC from a probes x gallery score matrix (NaN = failure = worst).
 fn metrics(scores: &[Vec<f64>], probe_id: &[usize], gallery_id: &[usize]) -> Figures {
-    let mut correct = 0usize;
+    let correct = identified(scores, probe_id, gallery_id)
+        .into_iter()
+        .filter(|&i| i)
+        .count();
     let mut gen = Vec::new();
     let mut imp = Vec::new();
     let mut failures = 0;
@@ -834,10 +840,6 @@ fn metrics(scores: &[Vec<f64>], probe_id: &[usize], gallery_id: &[usize]) -> Fig
             .map(|v| if v.is_finite() { *v } else { f64::INFINITY })
             .collect();
         failures += row.iter().filter(|v| !v.is_finite()).count();
-        let best = (0..clean.len()).min_by(|&a, &b| clean[a].total_cmp(&clean[b]).then(a.cmp(&b)));
-        if best.is_some_and(|b| gallery_id[b] == probe_id[p] && clean[b].is_finite()) {
-            correct += 1;
-        }
         for (g, v) in clean.iter().enumerate() {
             if gallery_id[g] == probe_id[p] {
                 gen.push(*v);
@@ -853,6 +855,82 @@ fn metrics(scores: &[Vec<f64>], probe_id: &[usize], gallery_id: &[usize]) -> Fig
         f.iter().sum::<f64>() / f.len().max(1) as f64
     };
     (rank1, eer, roc, fmean(&gen), fmean(&imp), failures)
+}
+
+/// Per probe (row of `scores`, NaN = failure): its nearest gallery face (the lowest index on
+/// ties) is finite and of its own identity.
+fn identified(scores: &[Vec<f64>], probe_id: &[usize], gallery_id: &[usize]) -> Vec<bool> {
+    scores
+        .iter()
+        .zip(probe_id)
+        .map(|(row, &id)| {
+            let clean = |v: f64| if v.is_finite() { v } else { f64::INFINITY };
+            (0..row.len())
+                .min_by(|&a, &b| clean(row[a]).total_cmp(&clean(row[b])).then(a.cmp(&b)))
+                .is_some_and(|b| gallery_id[b] == id && row[b].is_finite())
+        })
+        .collect()
+}
+
+/// Exact two-sided McNemar test of two classifiers on the same probes, `b` of them identified
+/// by the first only and `c` by the second only: the probability, were both equally good
+/// (each discordant probe a fair coin), of a split at least as uneven,
+/// `min(1, 2 P(X <= min(b, c)))` with `X ~ Binomial(b + c, 1/2)`; 1 without discordant probes.
+fn mcnemar_exact(b: usize, c: usize) -> f64 {
+    let n = b + c;
+    let k = b.min(c);
+    // ln C(n, i) - n ln 2, summed term by term.
+    let mut ln_term = -(n as f64) * std::f64::consts::LN_2;
+    let mut tail = ln_term.exp();
+    for i in 1..=k {
+        ln_term += ((n - i + 1) as f64).ln() - (i as f64).ln();
+        tail += ln_term.exp();
+    }
+    (2.0 * tail).min(1.0)
+}
+
+/// Appends the paired comparison of bipolar with every other score on the same probes, per
+/// landmark set: the probes only one of the two identifies and the exact McNemar p-value
+/// ([`mcnemar_exact`]), so that a difference in rank-1 can be told from chance.
+fn paired_table(rep: &mut Report, all: &[Metrics]) {
+    let rows: Vec<Vec<String>> = all
+        .iter()
+        .filter(|b| b.descriptor == "bipolar")
+        .flat_map(|b| {
+            all.iter()
+                .filter(move |o| o.landmarks == b.landmarks && o.descriptor != "bipolar")
+                .map(move |o| {
+                    let only = |x: &Metrics, y: &Metrics| {
+                        x.identified
+                            .iter()
+                            .zip(&y.identified)
+                            .filter(|(a, b)| **a && !**b)
+                            .count()
+                    };
+                    let (nb, no) = (only(b, o), only(o, b));
+                    vec![
+                        b.landmarks.clone(),
+                        o.descriptor.clone(),
+                        format!("{:.3} / {:.3}", b.rank1, o.rank1),
+                        nb.to_string(),
+                        no.to_string(),
+                        format!("{:.3}", mcnemar_exact(nb, no)),
+                    ]
+                })
+        })
+        .collect();
+    rep.para("Paired comparison on the same probes: how many only bipolar identifies at rank 1, how many only the other score, and the exact two-sided McNemar p-value (the chance of a split at least as uneven were the two equally good; small values mean the difference in rank-1 is not luck of the probes).");
+    rep.table(
+        &[
+            "landmarks",
+            "against",
+            "rank-1 (bipolar / other)",
+            "only bipolar",
+            "only the other",
+            "McNemar p",
+        ],
+        &rows,
+    );
 }
 
 /// Equal error rate and ROC points (false accept rate, true accept rate) for distance scores:
@@ -1134,6 +1212,7 @@ fn summarize(
         .map(|(j, dname)| {
             let m: Vec<Vec<f64>> = rows.iter().map(|r| r[j].clone()).collect();
             let (rank1, eer, roc, gm, im, failures) = metrics(&m, probe_id, gallery_id);
+            let identified = identified(&m, probe_id, gallery_id);
             Metrics {
                 descriptor: dname.to_string(),
                 landmarks: landmarks.to_string(),
@@ -1145,6 +1224,7 @@ fn summarize(
                 ms_per_comparison: ms_comparison[j],
                 ms_per_description: DESCRIPTION_OF[j].map_or(f64::NAN, |k| ms_description[k]),
                 roc,
+                identified,
             }
         })
         .collect()
@@ -1448,6 +1528,7 @@ pub fn run(args: Args) -> Result<()> {
         |k: usize| det_err.iter().map(|e| e[k]).sum::<f64>() / det_err.len().max(1) as f64;
     rep.para(&format!("Landmark detection: {n_det} of {} faces detected; mean error right corner {:.3} cm, left corner {:.3} cm, nose tip {:.3} cm.", samples.len(), mean_err(0), mean_err(1), mean_err(2)));
     results_table(&mut rep, &all, "results.csv")?;
+    paired_table(&mut rep, &all);
     roc_figure(&mut rep, &all, "roc.svg", "ROC (verification)")?;
     rep.png_twins()?;
     let secs = t0.elapsed().as_secs_f64();
@@ -1494,6 +1575,29 @@ mod tests {
         // Perfect separation gives EER 0; NaN counts as a failure.
         let (r, e, ..) = metrics(&[vec![0.1, f64::NAN], vec![0.9, 0.2]], &[0, 1], &gid);
         assert_eq!((r, e), (1.0, 0.0));
+        assert_eq!(identified(&s, &pid, &gid), [true, true, true, false]);
+        // A probe whose every score failed is not identified, even of the first identity.
+        assert_eq!(
+            identified(&[vec![f64::NAN, f64::NAN]], &[0], &gid),
+            [false]
+        );
+    }
+
+    #[test]
+    fn the_mcnemar_p_value_is_the_two_sided_binomial_tail() {
+        // 10 discordant probes split 9 : 1: 2 (1 + 10) / 1024.
+        assert!((mcnemar_exact(9, 1) - 22.0 / 1024.0).abs() < 1e-15);
+        assert!((mcnemar_exact(1, 9) - 22.0 / 1024.0).abs() < 1e-15);
+        // 10 : 0: 2 / 1024; an even split and no discordant probe: 1.
+        assert!((mcnemar_exact(10, 0) - 2.0 / 1024.0).abs() < 1e-15);
+        assert_eq!(mcnemar_exact(5, 5), 1.0);
+        assert_eq!(mcnemar_exact(0, 0), 1.0);
+        // 6 : 2 (the figure of a 50-identity run): 2 (1 + 8 + 28) / 256.
+        assert!((mcnemar_exact(6, 2) - 74.0 / 256.0).abs() < 1e-14);
+        // Many probes, no underflow: 2 sum_{i <= 200} C(500, i) / 2^500 = 8.9401e-6 (exact
+        // integer sum).
+        let p = mcnemar_exact(300, 200);
+        assert!((p / 8.940066542253267e-6 - 1.0).abs() < 1e-9, "{p}");
     }
 
     #[test]

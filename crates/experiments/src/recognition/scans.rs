@@ -13,8 +13,8 @@
 //! the scan, a descriptor error) is listed with the face's name and counted, never replaced.
 
 use super::{
-    describe_face, elastic_options, icp_points, iso_levels_of, median, order_stat, results_table,
-    roc_figure, score_row, summarize, time_comparisons, time_descriptions, timed_pairs,
+    describe_face, elastic_options, icp_points, iso_levels_of, median, order_stat, paired_table,
+    results_table, roc_figure, score_row, summarize, time_comparisons, time_descriptions, timed_pairs,
     write_summary, Args, DescribeOptions, Described, Lm, Lost, Metrics, Row, ViewSource, SCORES,
     SEARCH_DIRECTIONS, TIMED_FACES,
 };
@@ -666,6 +666,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
     ));
     rep.heading(2, "Main run");
     results_table(&mut rep, &main, "results.csv")?;
+    paired_table(&mut rep, &main);
     rep.csv(
         "probes.csv",
         &[
