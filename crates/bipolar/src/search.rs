@@ -4,10 +4,101 @@
 //! error in a detected eye corner move the whole descriptor (on range scans, a corner 4 mm off
 //! tripled the distance to the same face). A search describes a face from several placements
 //! of each reference around the given one and keeps, per comparison, the least distance.
-//! [`reference_candidates`] gives those placements.
+//! [`reference_candidates`] gives those placements, [`SearchedPole`] them with their fields,
+//! and [`moved_pairs`] the pole pairs two searched poles make.
 
 use crate::BipolarError;
+use geodesic::{GeodesicSolver, SolveOptions, Source};
 use meshcore::{DVec3, TriMesh};
+
+/// A pole of a reference-point search: its candidate vertices ([`reference_candidates`], the
+/// given place first) and the geodesic distance field from each (`None` where its solve
+/// failed). The default has no candidate, so it makes no pair.
+#[derive(Debug, Clone, Default)]
+pub struct SearchedPole {
+    /// Candidate vertices, the given one first.
+    pub vertices: Vec<u32>,
+    /// The field from each candidate, in the same order.
+    pub fields: Vec<Option<Vec<f64>>>,
+}
+
+impl SearchedPole {
+    /// The candidates of the reference vertex `v` (as [`reference_candidates`] with `toward`,
+    /// `radius` and `directions`) with their fields: `given`, the field from `v`, is taken as
+    /// it is, each moved candidate's is solved by `solver` with `opts` (a cut-off keeps the
+    /// solves short). Errors are those of [`reference_candidates`]; a failed solve leaves that
+    /// candidate's field `None`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        mesh: &TriMesh,
+        solver: &dyn GeodesicSolver,
+        v: u32,
+        toward: DVec3,
+        given: &[f64],
+        radius: f64,
+        directions: usize,
+        opts: &SolveOptions,
+    ) -> Result<Self, BipolarError> {
+        let vertices = reference_candidates(mesh, v, toward, radius, directions)?;
+        let fields = vertices
+            .iter()
+            .map(|&w| {
+                if w == v {
+                    Some(given.to_vec())
+                } else {
+                    solver.distances(&[Source::Vertex(w)], opts).ok()
+                }
+            })
+            .collect();
+        Ok(Self { vertices, fields })
+    }
+}
+
+/// A pole pair of a reference-point search: its two vertices, their fields and their
+/// reference distance `d`.
+#[derive(Debug, Clone, Copy)]
+pub struct MovedPair<'a> {
+    /// The first pole's vertex.
+    pub r: u32,
+    /// The second pole's vertex.
+    pub q: u32,
+    /// The field from `r`.
+    pub ur: &'a [f64],
+    /// The field from `q`.
+    pub uq: &'a [f64],
+    /// The mean of each field at the other pole.
+    pub d: f64,
+}
+
+/// The pole pairs of two searched poles with at least one moved: every candidate of `a` with
+/// every candidate of `b` but the two given ones together, `a`'s candidates in the outer loop.
+/// Pairs with a failed field, or whose `d` is not positive and finite (the poles not connected
+/// within the fields' cut-off), are left out.
+pub fn moved_pairs<'a>(
+    a: &'a SearchedPole,
+    b: &'a SearchedPole,
+) -> impl Iterator<Item = MovedPair<'a>> + 'a {
+    let pairs = a
+        .vertices
+        .iter()
+        .zip(&a.fields)
+        .enumerate()
+        .flat_map(move |(i, (&r, ur))| {
+            b.vertices
+                .iter()
+                .zip(&b.fields)
+                .enumerate()
+                .map(move |(j, (&q, uq))| (i, j, r, ur, q, uq))
+        });
+    pairs.filter_map(|(i, j, r, ur, q, uq)| {
+        if i == 0 && j == 0 {
+            return None;
+        }
+        let (ur, uq) = (ur.as_deref()?, uq.as_deref()?);
+        let d = 0.5 * (ur.get(q as usize)? + uq.get(r as usize)?);
+        (d.is_finite() && d > 0.0).then_some(MovedPair { r, q, ur, uq, d })
+    })
+}
 
 /// Vertices around the reference vertex `v` for a reference-point search: `v` first, then,
 /// for each of `directions` directions evenly spread in `v`'s tangent plane (the first toward
@@ -129,6 +220,84 @@ mod tests {
         let moved = reference_candidates(&m.transformed(&t), v, t.transform_point3(toward), 1.5, 8)
             .unwrap();
         assert_eq!(base, moved);
+    }
+
+    #[test]
+    fn searched_poles_pair_every_placement_but_the_given_one() {
+        let (n, h) = (41, 0.25);
+        let m = grid(n, h);
+        let solver = geodesic::new_solver(&m, geodesic::Method::Exact).unwrap();
+        let opts = SolveOptions::default();
+        let (v, w) = ((20 * n + 12) as u32, (20 * n + 28) as u32);
+        let field = |x: u32| solver.distances(&[Source::Vertex(x)], &opts).unwrap();
+        // The given field is taken as it is (a marker value shows it is not solved again).
+        let mut given = field(v);
+        given[0] = 123.0;
+        let a = SearchedPole::new(&m, solver.as_ref(), v, m.position(w), &given, 1.0, 6, &opts)
+            .unwrap();
+        let b = SearchedPole::new(
+            &m,
+            solver.as_ref(),
+            w,
+            m.position(v),
+            &field(w),
+            1.0,
+            6,
+            &opts,
+        )
+        .unwrap();
+        assert_eq!(
+            a.vertices,
+            reference_candidates(&m, v, m.position(w), 1.0, 6).unwrap()
+        );
+        assert_eq!(a.fields[0].as_deref(), Some(given.as_slice()));
+        for (&x, u) in a.vertices.iter().zip(&a.fields).skip(1) {
+            assert_eq!(u.as_deref(), Some(field(x).as_slice()));
+        }
+        let pairs: Vec<MovedPair<'_>> = moved_pairs(&a, &b).collect();
+        assert_eq!(pairs.len(), a.vertices.len() * b.vertices.len() - 1);
+        assert_eq!((pairs[0].r, pairs[0].q), (a.vertices[0], b.vertices[1]));
+        for p in &pairs {
+            // On a plane the exact geodesic distance is the straight one.
+            let straight = (m.position(p.r) - m.position(p.q)).length();
+            assert!((p.d - straight).abs() < 1e-9, "{} {}", p.d, straight);
+            assert_eq!(p.ur[p.q as usize], field(p.r)[p.q as usize]);
+        }
+        // A failed candidate field leaves out its pairs; a pole without candidates makes none.
+        let mut broken = a.clone();
+        broken.fields[2] = None;
+        assert_eq!(
+            moved_pairs(&broken, &b).count(),
+            pairs.len() - b.vertices.len()
+        );
+        assert_eq!(moved_pairs(&SearchedPole::default(), &b).count(), 0);
+        // Poles not connected within the cut-off give no pair.
+        let short = SolveOptions {
+            max_distance: Some(1.5),
+        };
+        let c = SearchedPole::new(
+            &m,
+            solver.as_ref(),
+            v,
+            m.position(w),
+            &given,
+            1.0,
+            6,
+            &short,
+        )
+        .unwrap();
+        let far = SearchedPole::new(
+            &m,
+            solver.as_ref(),
+            w,
+            m.position(v),
+            &given,
+            1.0,
+            6,
+            &short,
+        )
+        .unwrap();
+        assert_eq!(moved_pairs(&c, &far).count(), 0);
     }
 
     #[test]

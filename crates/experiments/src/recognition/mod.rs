@@ -616,8 +616,8 @@ pub(super) const SEARCH_DIRECTIONS: usize = 6;
 /// Bipolar descriptors of a face, per [`Pair`] (indexed by its discriminant), from the poles of
 /// each pair in `searched` (with reference fields `refs`; a pair whose `refs` failed is left
 /// empty) moved by the search radius `o.ref_search` (none without it) in [`SEARCH_DIRECTIONS`]
-/// directions of their tangent planes (`bipolar::reference_candidates`; each pole at its place
-/// or moved: 48 pairs), with the options and vertices `kept` of the face's own descriptors; pairs whose fields or
+/// directions of their tangent planes (`bipolar::SearchedPole`, paired by
+/// `bipolar::moved_pairs`; each pole at its place or moved: 48 pairs), with the options and vertices `kept` of the face's own descriptors; pairs whose fields or
 /// descriptor fail are left out. The first direction of a pole points toward the pair's other
 /// pole, or, with `shared_candidates`, the same for every pair: an outer eye corner toward the
 /// other, the nose tip toward their midpoint, so that each landmark's moved fields are solved
@@ -656,29 +656,26 @@ fn moved_pole_descriptors(
     };
     let lm_vertex = [lm.r, lm.q, lm.nose];
     let [pr, pq, _] = lm.positions(mesh);
-    // A landmark's candidates and their fields, by (landmark, the point its first direction
-    // points toward); the given pole keeps its field, each moved one is solved.
-    type Moved = (Vec<u32>, Vec<Option<Vec<f64>>>);
-    let mut cache: Vec<((usize, [u64; 3]), Moved)> = Vec::new();
+    // A landmark's searched pole, by (landmark, the point its first direction points toward);
+    // the given pole keeps its field, each moved one is solved.
+    let mut cache: Vec<((usize, [u64; 3]), bipolar::SearchedPole)> = Vec::new();
     let mut moved = |k: usize, toward: DVec3, given: &[f64]| -> usize {
         let key = (k, toward.to_array().map(f64::to_bits));
         if let Some(i) = cache.iter().position(|(c, _)| *c == key) {
             return i;
         }
-        let v = lm_vertex[k];
-        let vs = bipolar::reference_candidates(mesh, v, toward, rho, SEARCH_DIRECTIONS)
-            .unwrap_or_default();
-        let fields = vs
-            .iter()
-            .map(|&w| {
-                if w == v {
-                    Some(given.to_vec())
-                } else {
-                    solver.distances(&[Source::Vertex(w)], &cut).ok()
-                }
-            })
-            .collect();
-        cache.push((key, (vs, fields)));
+        let pole = bipolar::SearchedPole::new(
+            mesh,
+            solver,
+            lm_vertex[k],
+            toward,
+            given,
+            rho,
+            SEARCH_DIRECTIONS,
+            &cut,
+        )
+        .unwrap_or_default();
+        cache.push((key, pole));
         cache.len() - 1
     };
     let toward = |k: usize, other: DVec3| match (shared_candidates, k) {
@@ -701,35 +698,22 @@ fn moved_pole_descriptors(
         })
         .collect();
     for (pair, refs, ia, ib) in jobs {
-        let ((rs, fr), (qs, fq)) = (&cache[ia].1, &cache[ib].1);
-        for (i, &r) in rs.iter().enumerate() {
-            for (j, &q) in qs.iter().enumerate() {
-                if i == 0 && j == 0 {
-                    continue;
-                }
-                let (Some(ur), Some(uq)) = (&fr[i], &fq[j]) else {
-                    continue;
-                };
-                let d = 0.5 * (ur[q as usize] + uq[r as usize]);
-                if !(d.is_finite() && d > 0.0) {
-                    continue;
-                }
-                let (pr, pq) = (mesh.position(r), mesh.position(q));
-                let moved = Refs {
-                    ur: ur.clone(),
-                    uq: uq.clone(),
-                    d,
-                    r: pr,
-                    q: pq,
-                    nose: refs.nose,
-                    frame: match pair {
-                        Pair::Corners => face_frame(mesh, pr, pq, refs.nose),
-                        _ => refs.frame,
-                    },
-                };
-                if let Ok(b) = static_bipolar(surface, &moved, o, kept) {
-                    out[pair as usize].push(b);
-                }
+        for m in bipolar::moved_pairs(&cache[ia].1, &cache[ib].1) {
+            let (pr, pq) = (mesh.position(m.r), mesh.position(m.q));
+            let moved = Refs {
+                ur: m.ur.to_vec(),
+                uq: m.uq.to_vec(),
+                d: m.d,
+                r: pr,
+                q: pq,
+                nose: refs.nose,
+                frame: match pair {
+                    Pair::Corners => face_frame(mesh, pr, pq, refs.nose),
+                    _ => refs.frame,
+                },
+            };
+            if let Ok(b) = static_bipolar(surface, &moved, o, kept) {
+                out[pair as usize].push(b);
             }
         }
     }
@@ -1577,10 +1561,7 @@ mod tests {
         assert_eq!((r, e), (1.0, 0.0));
         assert_eq!(identified(&s, &pid, &gid), [true, true, true, false]);
         // A probe whose every score failed is not identified, even of the first identity.
-        assert_eq!(
-            identified(&[vec![f64::NAN, f64::NAN]], &[0], &gid),
-            [false]
-        );
+        assert_eq!(identified(&[vec![f64::NAN, f64::NAN]], &[0], &gid), [false]);
     }
 
     #[test]

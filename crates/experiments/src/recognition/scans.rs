@@ -14,9 +14,9 @@
 
 use super::{
     describe_face, elastic_options, icp_points, iso_levels_of, median, order_stat, paired_table,
-    results_table, roc_figure, score_row, summarize, time_comparisons, time_descriptions, timed_pairs,
-    write_summary, Args, DescribeOptions, Described, Lm, Lost, Metrics, Row, ViewSource, SCORES,
-    SEARCH_DIRECTIONS, TIMED_FACES,
+    results_table, roc_figure, score_row, summarize, time_comparisons, time_descriptions,
+    timed_pairs, write_summary, Args, DescribeOptions, Described, Lm, Lost, Metrics, Row,
+    ViewSource, SCORES, SEARCH_DIRECTIONS, TIMED_FACES,
 };
 use crate::pipeline::{bar, resolve_methods};
 use crate::report::{line_plot, Report, Series};
