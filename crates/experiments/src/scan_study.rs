@@ -58,6 +58,12 @@ pub struct Args {
     /// Taubin smoothing iterations of the cleaned scans (`scanprep`; 0: none).
     #[arg(long, default_value_t = 0)]
     pub smooth: usize,
+    /// Radius (mm) of the reference-point search of the searched distance: each scan is also
+    /// described from the poles of its three pole pairs moved by this much in 6 directions
+    /// (`bipolar::SearchedPole`; 0, the default: no search and no searched distance). Measured
+    /// in docs/scans.md: it does not raise the separation ratios, at about 3 times the run time.
+    #[arg(long, default_value_t = 0.0)]
+    pub ref_search_mm: f64,
 }
 
 /// One way of acquiring a face.
@@ -145,6 +151,9 @@ struct Described {
     /// Per entry of [`VARIANTS`] with [`Variant::side_pairs`]: the descriptors of the right and
     /// of the left outer eye corner with the nose tip (`None` otherwise or refused).
     sides: Vec<Option<[bipolar::Descriptor; 2]>>,
+    /// The [`LEAST`] variant's descriptors from moved poles, per pole pair (corners, right
+    /// corner and nose tip, left corner and nose tip; empty without the search).
+    searched: [Vec<bipolar::Descriptor>; 3],
     polar: bipolar::PolarDescriptor,
     notes: Vec<String>,
     icp_probe: Vec<DVec3>,
@@ -253,6 +262,13 @@ fn field_at(mesh: &TriMesh, u: &[f64], sp: &SurfacePoint) -> f64 {
     crate::pipeline::field_at(mesh, u, sp)
 }
 
+/// The corner of `sp`'s face nearest to it (the first on ties).
+fn nearest_corner(mesh: &TriMesh, sp: &SurfacePoint) -> u32 {
+    let tri = mesh.triangles()[sp.face as usize];
+    let w = sp.bary.to_array();
+    tri[(0..3).fold(0, |b, i| if w[i] > w[b] { i } else { b })]
+}
+
 fn describe_scan(face: &Face, setting: &Setting, args: &Args) -> Result<Described> {
     let t0 = Instant::now();
     let (mesh, lms, hidden) = acquire(face, setting, args.smooth)?;
@@ -321,6 +337,7 @@ fn describe_mesh(
     let fields = [ur, uq];
     let mut bip = Vec::new();
     let mut sides = Vec::new();
+    let mut searched: [Vec<bipolar::Descriptor>; 3] = Default::default();
     // The band along the holes, built once per margin and left out through the vertex mask
     // (`pipeline::kept_vertices`) rather than again by every descriptor.
     let mut bands: Vec<(f64, Result<Vec<bool>, String>)> = Vec::new();
@@ -363,8 +380,8 @@ fn describe_mesh(
             }
             band => restrict(seen, band.and_then(Result::ok).as_deref()),
         };
-        let describe = |pair: [&[f64]; 2], d: f64| {
-            let mask = static_mask(&mesh, pair[0], pair[1], d, &frame, pos[2]);
+        let describe = |pair: [&[f64]; 2], d: f64, frame: &facemodel::FaceFrame| {
+            let mask = static_mask(&mesh, pair[0], pair[1], d, frame, pos[2]);
             let opts = bipolar::DescriptorOptions {
                 levels: bipolar::LevelSpec::Step(d / f64::from(args.set.res.levels)),
                 max_level: Some(args.set.res.levels),
@@ -392,7 +409,7 @@ fn describe_mesh(
         };
         match earlier(false) {
             Some(j) => bip.push(bip[j].clone()),
-            None => match describe([&fields[0], &fields[1]], d) {
+            None => match describe([&fields[0], &fields[1]], d, &frame) {
                 Ok(d) => bip.push(Some(d)),
                 Err(e) => {
                     notes.push(e);
@@ -411,7 +428,7 @@ fn describe_mesh(
                         v.name
                     ));
                 }
-                describe([&fields[k], &un], dk)
+                describe([&fields[k], &un], dk, &frame)
             };
             match (side(0), side(1)) {
                 (Ok(a), Ok(b)) => Some([a, b]),
@@ -423,6 +440,54 @@ fn describe_mesh(
         } else {
             None
         });
+        if k == LEAST && view.is_none() && args.ref_search_mm > 0.0 {
+            // The reference-point search (as the recognition benchmark's, over all three
+            // pairs): each landmark at its nearest vertex, with its candidates moved by the
+            // radius, the first direction of a corner toward the other corner and of the nose
+            // tip toward their midpoint, so each moved field is solved once for both its pairs.
+            let rho = args.ref_search_mm;
+            let moved_cut = SolveOptions {
+                max_distance: Some(cut + 4.0 * rho),
+            };
+            let toward = [pos[1], pos[0], 0.5 * (pos[0] + pos[1])];
+            let poles: Vec<bipolar::SearchedPole> = (0..3)
+                .map(|k| {
+                    let v = nearest_corner(&mesh, &sp[k]);
+                    solver
+                        .distances(&[Source::Vertex(v)], &moved_cut)
+                        .ok()
+                        .and_then(|given| {
+                            bipolar::SearchedPole::new(
+                                &mesh,
+                                solver.as_ref(),
+                                v,
+                                toward[k],
+                                &given,
+                                rho,
+                                SEARCH_DIRECTIONS,
+                                &moved_cut,
+                            )
+                            .ok()
+                        })
+                        .unwrap_or_default()
+                })
+                .collect();
+            for (p, (ka, kb)) in [(0, 1), (0, 2), (1, 2)].into_iter().enumerate() {
+                for m in bipolar::moved_pairs(&poles[ka], &poles[kb]) {
+                    if m.d + 2.0 * max_edge > cut + 4.0 * rho {
+                        continue;
+                    }
+                    let frame = if p == 0 {
+                        face_frame(&mesh, mesh.position(m.r), mesh.position(m.q), pos[2])
+                    } else {
+                        frame
+                    };
+                    if let Ok(b) = describe([m.ur, m.uq], m.d, &frame) {
+                        searched[p].push(b);
+                    }
+                }
+            }
+        }
     }
     let polar_opts = PolarOptions {
         step: d / f64::from(args.set.res.levels),
@@ -452,6 +517,7 @@ fn describe_mesh(
         landmark_offsets_mm: off,
         bip,
         sides,
+        searched,
         polar,
         notes,
         icp_probe,
@@ -639,13 +705,23 @@ const LEAST: usize = 8;
 const VIEW_MATCHED: &str =
     "bipolar All, band and incidence over 60 degrees left out, three pole pairs, least, view-matched";
 
-/// Names of the distances: the bipolar variants, the view-matched one, then the single pole
-/// and ICP.
-fn methods() -> Vec<&'static str> {
+/// Name of the distance of the [`LEAST`] variant with the reference-point search
+/// ([`searched_distance`]).
+const SEARCHED: &str =
+    "bipolar All, band and incidence over 60 degrees left out, three pole pairs, least, reference-point search";
+
+/// Directions of the reference-point search around each pole (as the recognition benchmark's).
+const SEARCH_DIRECTIONS: usize = 6;
+
+/// Names of the distances: the bipolar variants, the view-matched one, the searched one with
+/// `args.ref_search_mm` > 0, then the single pole and ICP.
+fn methods(args: &Args) -> Vec<&'static str> {
     VARIANTS
         .iter()
         .map(|v| v.name)
-        .chain([VIEW_MATCHED, "single pole", "ICP (mm)"])
+        .chain([VIEW_MATCHED])
+        .chain((args.ref_search_mm > 0.0).then_some(SEARCHED))
+        .chain(["single pole", "ICP (mm)"])
         .collect()
 }
 
@@ -690,6 +766,28 @@ fn view_matched_distance(a: &Described, b: &Described, args: &Args) -> f64 {
     };
     let (ca, cb) = (cut(a, b), cut(b, a));
     variant_distance(ca.as_ref().unwrap_or(a), cb.as_ref().unwrap_or(b), LEAST)
+}
+
+/// The [`LEAST`] distance with the reference-point search: per pole pair the least over the
+/// two scans' own descriptors and each scan's moved ones ([`Described::searched`]) against the
+/// other's own, then the least over the three pairs; NaN where either scan lacks its own
+/// descriptors of the three pairs.
+fn searched_distance(a: &Described, b: &Described) -> f64 {
+    fn own(x: &Described) -> Option<[&bipolar::Descriptor; 3]> {
+        let [r, l] = x.sides[LEAST].as_ref()?;
+        Some([x.bip[LEAST].as_ref()?, r, l])
+    }
+    let (Some(oa), Some(ob)) = (own(a), own(b)) else {
+        return f64::NAN;
+    };
+    let d = |x: &bipolar::Descriptor, y: &bipolar::Descriptor| dist(x, y).unwrap_or(f64::NAN);
+    (0..3)
+        .map(|p| {
+            let moved_a = a.searched[p].iter().map(|m| d(m, ob[p]));
+            let moved_b = b.searched[p].iter().map(|m| d(oa[p], m));
+            moved_a.chain(moved_b).fold(d(oa[p], ob[p]), f64::min)
+        })
+        .fold(f64::NAN, f64::min)
 }
 
 struct Pair {
@@ -793,6 +891,9 @@ pub fn run(args: Args) -> Result<()> {
                 .map(|k| variant_distance(da, db, k))
                 .collect();
             d.push(view_matched_distance(da, db, &args));
+            if args.ref_search_mm > 0.0 {
+                d.push(searched_distance(da, db));
+            }
             pb.inc(1);
             d.push(dist(&da.polar, &db.polar).unwrap_or(f64::NAN));
             d.push(icp);
@@ -886,7 +987,7 @@ fn write_outputs(
     let mut header: Vec<String> = ["face_a", "setting_a", "face_b", "setting_b", "relation"]
         .map(String::from)
         .to_vec();
-    header.extend(methods().into_iter().map(String::from));
+    header.extend(methods(args).into_iter().map(String::from));
     let rows: Vec<Vec<String>> = pairs
         .iter()
         .map(|p| {
@@ -1001,7 +1102,7 @@ fn write_outputs(
         }) && (p.rel != Relation::SameFace || faces[scans[p.a].face].expression == "neutral")
     };
     let mut ratios = Vec::new();
-    for (m, name) in methods().iter().enumerate() {
+    for (m, name) in methods(args).iter().enumerate() {
         let subset = |rel: Relation, keep: &dyn Fn(&Pair) -> bool| -> Vec<f64> {
             pairs
                 .iter()
@@ -1070,10 +1171,10 @@ fn write_outputs(
         md,
         "## Same face: each setting against the first, median over faces\n"
     );
-    let _ = writeln!(md, "| setting | {} |", methods().join(" | "));
-    let _ = writeln!(md, "|---|{}", "---|".repeat(methods().len()));
+    let _ = writeln!(md, "| setting | {} |", methods(args).join(" | "));
+    let _ = writeln!(md, "|---|{}", "---|".repeat(methods(args).len()));
     for (si, s) in sets.iter().enumerate().skip(1) {
-        let row: Vec<String> = (0..methods().len())
+        let row: Vec<String> = (0..methods(args).len())
             .map(|m| {
                 let v: Vec<f64> = pairs
                     .iter()
@@ -1195,8 +1296,72 @@ mod tests {
         assert!(matches!(v.side_pairs, Some(PairCombine::Least)));
         assert_eq!(v.max_incidence_deg, Some(60.0));
         assert!(VIEW_MATCHED.starts_with(v.name));
-        let m = methods();
+        assert!(SEARCHED.starts_with(v.name));
+        let mut args = study_args(0.0);
+        let m = methods(&args);
         assert_eq!(m.len(), VARIANTS.len() + 3);
         assert_eq!(m[VARIANTS.len()], VIEW_MATCHED);
+        args.ref_search_mm = 2.0;
+        let m = methods(&args);
+        assert_eq!(m.len(), VARIANTS.len() + 4);
+        assert_eq!(m[VARIANTS.len() + 1], SEARCHED);
+    }
+
+    fn study_args(ref_search_mm: f64) -> Args {
+        #[derive(clap::Parser)]
+        struct Cli {
+            #[command(flatten)]
+            args: Args,
+        }
+        let mut args = <Cli as clap::Parser>::parse_from(["scan-study"]).args;
+        args.ref_search_mm = ref_search_mm;
+        args
+    }
+
+    #[test]
+    fn the_search_finds_a_pole_moved_by_its_radius() {
+        // A curved, asymmetric height field in mm on a 1 mm grid (on a plane every placement
+        // gives the same scale-free descriptor); the right outer corner of `b` placed on the
+        // grid vertex 2 mm toward the left one and the left corner 2 mm toward the right one
+        // (so that every pair differs), where the search's first directions put candidates of
+        // `a`'s.
+        let z = |x: f64, y: f64| 0.006 * x * x + 0.002 * x * y + 0.004 * y * y + 5e-5 * x * x * x;
+        let mesh =
+            meshcore::shapes::grid(120, 100, meshcore::shapes::Diagonals::Uniform, |i, j| {
+                let (x, y) = (i as f64 - 60.0, j as f64 - 50.0);
+                DVec3::new(x, y, z(x, y))
+            })
+            .unwrap();
+        let at = |x: f64, y: f64| DVec3::new(x, y, z(x, y));
+        let lms = [at(-40.0, 10.0), at(40.0, 10.0), at(0.0, -25.0)];
+        let mut moved = lms;
+        moved[0] = at(-38.0, 10.0);
+        moved[1] = at(38.0, 10.0);
+        let args = study_args(2.0);
+        let a = describe_mesh(mesh.clone(), &lms, &[], &args, None).unwrap();
+        let b = describe_mesh(mesh, &moved, &[], &args, None).unwrap();
+        assert!(
+            a.searched.iter().all(|s| s.len() > 20),
+            "{:?}",
+            a.searched.each_ref().map(Vec::len)
+        );
+        let least = variant_distance(&a, &b, LEAST);
+        let searched = searched_distance(&a, &b);
+        assert!(least > 0.005, "{least}");
+        // The candidates land on the moved corners: the same descriptor, found exactly.
+        assert!(searched < 1e-6 * least, "{searched} against {least}");
+        assert_eq!(searched_distance(&a, &b), searched_distance(&b, &a));
+        // Without the search the scans have no moved descriptors and the two distances agree.
+        let args = study_args(0.0);
+        let mesh = a.mesh.clone();
+        let (a0, b0) = (
+            describe_mesh(mesh.clone(), &lms, &[], &args, None).unwrap(),
+            describe_mesh(mesh, &moved, &[], &args, None).unwrap(),
+        );
+        assert!(a0.searched.iter().all(Vec::is_empty));
+        assert_eq!(
+            searched_distance(&a0, &b0),
+            variant_distance(&a0, &b0, LEAST)
+        );
     }
 }
