@@ -104,7 +104,8 @@ pub struct Args {
     /// descriptor (`--scans`; 0 keeps everything).
     #[arg(long, default_value_t = SCAN_MAX_INCIDENCE_DEG)]
     pub max_incidence: f64,
-    /// Reference-point search of the bipolar score (`--scans`; mm, 0: off): each probe is also
+    /// Reference-point search of the bipolar score (mm, 0: off; on the clean meshes the outer
+    /// eye corners' pair alone, as their only pair): each probe is also
     /// described by each pole pair (the outer eye corners; each corner with the nose tip) from
     /// its two poles moved by this distance in 6 directions of their tangent planes (48 more
     /// descriptors per pair; only the probe's own pair with `--own-pair-search`), and its
@@ -898,7 +899,10 @@ fn paired_table(rep: &mut Report, all: &[Metrics]) {
                         format!("{:.3} / {:.3}", b.rank1, o.rank1),
                         nb.to_string(),
                         no.to_string(),
-                        format!("{:.3}", mcnemar_exact(nb, no)),
+                        match mcnemar_exact(nb, no) {
+                            p if p < 1e-3 => format!("{p:.1e}"),
+                            p => format!("{p:.3}"),
+                        },
                     ]
                 })
         })
@@ -1397,6 +1401,13 @@ pub fn run(args: Args) -> Result<()> {
         least_pair: false,
         search_all_pairs: false,
     };
+    // The reference-point search is the probes' (the gallery keeps its one description); its
+    // radius is given in mm, the model is in cm.
+    let probe_opts = DescribeOptions {
+        ref_search: (args.ref_search > 0.0)
+            .then(|| args.ref_search / meshcore::units::Units::Centimetre.mm_per_unit()),
+        ..desc_opts.clone()
+    };
     let elastic = elastic_options(args.curve_samples);
     // Landmark detection.
     let generic = landmarks::GenericModel::default_model()
@@ -1435,10 +1446,13 @@ pub fn run(args: Args) -> Result<()> {
         .map(|(s, det)| -> Result<_> {
             let solver = geodesic::new_solver(&s.mesh, method)?;
             let walker = Walker::new(&s.mesh);
+            let o = if s.index == 0 {
+                &desc_opts
+            } else {
+                &probe_opts
+            };
             let out = [Some(gt), *det].map(|lm| {
-                lm.and_then(|lm| {
-                    describe_face(&s.mesh, solver.as_ref(), &walker, lm, &desc_opts).ok()
-                })
+                lm.and_then(|lm| describe_face(&s.mesh, solver.as_ref(), &walker, lm, o).ok())
             });
             pb.inc(1);
             Ok(out)
@@ -1493,7 +1507,7 @@ pub fn run(args: Args) -> Result<()> {
         .take(TIMED_FACES)
         .map(|&g| (&samples[g].mesh, gt))
         .collect();
-    let ms_desc = time_descriptions(&first, method, &desc_opts)?;
+    let ms_desc = time_descriptions(&first, method, &probe_opts)?;
     for ((rows, ms_cmp), lname) in timed.iter().zip(["ground_truth", "detected"]) {
         all.extend(summarize(rows, ms_cmp, &ms_desc, &pid, &gid, lname));
     }
@@ -1501,10 +1515,12 @@ pub fn run(args: Args) -> Result<()> {
     // Output.
     let mut rep = Report::new(&out, "Recognition benchmark on sampled ICT faces")?;
     rep.para(&format!(
-        "{} identities x {} faces (seed {}): {} gallery faces (neutral), {} probes (random expressions: with probability 1/2 a recipe at strength 0.3-1, plus random blendshapes), every face under a random rigid motion. Geodesics: {}{}. Bipolar descriptor: static area, N = {} levels between the outer eye corners (grid reading, keyed distance); single pole: {} sectors x {} radius levels around the nose tip; ICP: {} probe vertices onto the gallery surface, started from the 3-landmark alignment, 10 % trimmed, score = RMS closest-point distance (cm); facial curves: N = {} level curves of the nose-tip field up to D, elastic distance ({} segments per curve, one start-point candidate, one rotation / reparametrisation alternation), root sum of squares; iso-curvature: {} levels per principal field (quantiles of the first gallery face) in the geodesic disc of radius D around the nose tip, ICP of the networks' points (thinned to at most {ISO_POINTS}, every k-th point) started from the 3-landmark alignment (10 iterations on a 500-point subsample, at most 10 on all points), score = normalised RMS closest-point distance. Times, single thread (a one-thread pool, after the parallel scoring; the machine is shared, so compare them as ratios): ms per comparison is the mean over {TIMED_PAIRS} probe x gallery pairs per landmark set; ms per description the median over the first {TIMED_FACES} gallery faces (ground-truth landmarks) of the fields a representation needs (both corners; the nose tip) plus its build.",
+        "{} identities x {} faces (seed {}): {} gallery faces (neutral), {} probes (random expressions: with probability 1/2 a recipe at strength 0.3-1, plus random blendshapes), every face under a random rigid motion. Geodesics: {}{}. Bipolar descriptor: static area, N = {} levels between the outer eye corners (grid reading, keyed distance){}; single pole: {} sectors x {} radius levels around the nose tip; ICP: {} probe vertices onto the gallery surface, started from the 3-landmark alignment, 10 % trimmed, score = RMS closest-point distance (cm); facial curves: N = {} level curves of the nose-tip field up to D, elastic distance ({} segments per curve, one start-point candidate, one rotation / reparametrisation alternation), root sum of squares; iso-curvature: {} levels per principal field (quantiles of the first gallery face) in the geodesic disc of radius D around the nose tip, ICP of the networks' points (thinned to at most {ISO_POINTS}, every k-th point) started from the 3-landmark alignment (10 iterations on a 500-point subsample, at most 10 on all points), score = normalised RMS closest-point distance. Times, single thread (a one-thread pool, after the parallel scoring; the machine is shared, so compare them as ratios): ms per comparison is the mean over {TIMED_PAIRS} probe x gallery pairs per landmark set; ms per description the median over the first {TIMED_FACES} gallery faces (ground-truth landmarks), described as probes, of the fields a representation needs (both corners; the nose tip; the search's moved corners) plus its build.",
         identities, expressions, args.seed, gallery.len(), probes.len(), method.name(),
         method_note.as_ref().map(|n| format!(" (exact requested: {n})")).unwrap_or_default(),
-        args.res.levels, args.res.sectors, args.res.levels, icp_points(&samples[0].mesh, args.icp_points).len(),
+        args.res.levels,
+        probe_opts.ref_search.map(|r| format!(", each probe also described from its outer eye corners moved by {r} cm in {SEARCH_DIRECTIONS} directions of their tangent planes (`bipolar::SearchedPole`), its score the least distance over these 49 descriptors")).unwrap_or_default(),
+        args.res.sectors, args.res.levels, icp_points(&samples[0].mesh, args.icp_points).len(),
         args.res.levels, args.curve_samples, args.iso_levels
     ));
     let n_det = detected.iter().filter(|d| d.is_some()).count();
