@@ -464,7 +464,7 @@ fn describe_mesh(
                                 toward[k],
                                 &given,
                                 rho,
-                                SEARCH_DIRECTIONS,
+                                crate::recognition::SEARCH_DIRECTIONS,
                                 &moved_cut,
                             )
                             .ok()
@@ -709,9 +709,6 @@ const VIEW_MATCHED: &str =
 /// ([`searched_distance`]).
 const SEARCHED: &str =
     "bipolar All, band and incidence over 60 degrees left out, three pole pairs, least, reference-point search";
-
-/// Directions of the reference-point search around each pole (as the recognition benchmark's).
-const SEARCH_DIRECTIONS: usize = 6;
 
 /// Names of the distances: the bipolar variants, the view-matched one, the searched one with
 /// `args.ref_search_mm` > 0, then the single pole and ICP.

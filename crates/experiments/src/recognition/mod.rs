@@ -611,8 +611,9 @@ fn describe_face(
     })
 }
 
-/// Directions of the reference-point search around each outer eye corner.
-pub(super) const SEARCH_DIRECTIONS: usize = 6;
+/// Directions of the reference-point search around each pole (the recognition benchmarks and
+/// scan-study).
+pub(crate) const SEARCH_DIRECTIONS: usize = 6;
 
 /// Bipolar descriptors of a face, per [`Pair`] (indexed by its discriminant), from the poles of
 /// each pair in `searched` (with reference fields `refs`; a pair whose `refs` failed is left
