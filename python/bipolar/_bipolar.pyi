@@ -1,7 +1,7 @@
 """Typed stubs of the extension module ``bipolar._bipolar`` (re-exported by ``bipolar``)."""
 
 import os
-from typing import Any, Dict, List, Literal, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, List, Literal, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -152,6 +152,7 @@ class Descriptor(_KeyedSurfacePoints):
     def save(self, path: PathLike) -> None: ...
     def to_json(self) -> str: ...
 
+@overload
 def describe(
     mesh: Union[Mesh, PathLike],
     ref_a: Reference,
@@ -171,7 +172,32 @@ def describe(
     solver: Optional[GeodesicSolver] = None,
     boundary_margin: Optional[float] = None,
     max_incidence: Optional[float] = None,
+    search_radius: None = None,
+    search_directions: int = 6,
 ) -> Descriptor: ...
+@overload
+def describe(
+    mesh: Union[Mesh, PathLike],
+    ref_a: Reference,
+    ref_b: Reference,
+    *,
+    refs: Optional[Sequence[Reference]] = None,
+    levels: Optional[int] = None,
+    step: Optional[float] = None,
+    max_level: Optional[int] = None,
+    angles: int = 8,
+    alpha: float = 0.95,
+    rule: Literal["isoangle", "iso-angle", "filter", "all"] = "isoangle",
+    tolerance: Optional[float] = None,
+    tangent: Literal["gradient", "strip", "spline"] = "gradient",
+    method: MethodName = "exact",
+    landmarks: Optional[Union[PathLike, Dict[str, ArrayLike]]] = None,
+    solver: Optional[GeodesicSolver] = None,
+    boundary_margin: Optional[float] = None,
+    max_incidence: Optional[float] = None,
+    search_radius: float,
+    search_directions: int = 6,
+) -> List[Descriptor]: ...
 def read_descriptor(path: PathLike) -> Descriptor: ...
 
 class PolarDescriptor(_KeyedSurfacePoints):

@@ -178,6 +178,30 @@ def test_describe_bad_input(bump_mesh):
         bipolar.describe(bump_mesh, 0, 1599, levels=12, max_level=5)
 
 
+def test_the_reference_point_search_gives_the_own_descriptor_then_the_moved_ones(bump_mesh):
+    a, b = 20 * 40 + 8, 20 * 40 + 32  # interior vertices of the bump's 40 x 40 grid
+    own = bipolar.describe(bump_mesh, a, b, levels=8)
+    found = bipolar.describe(bump_mesh, a, b, levels=8, search_radius=0.15)
+    assert isinstance(found, list) and 30 < len(found) <= 49
+    assert found[0] == own
+    # Each moved pair has its own references, and its descriptor is the one described from
+    # those two vertices with the same options.
+    assert len({d.references.tobytes() for d in found}) == len(found)
+    for d in (found[1], found[7], found[-1]):
+        va, vb = (int(np.argmin(np.linalg.norm(bump_mesh.vertices - r, axis=1))) for r in d.references)
+        direct = bipolar.describe(bump_mesh, va, vb, levels=8)
+        np.testing.assert_array_equal(direct.keys, d.keys)
+        np.testing.assert_allclose(direct.points, d.points, atol=1e-9)
+    # Fewer directions, fewer pairs; the results pickle (for dask) like any descriptor.
+    three = bipolar.describe(bump_mesh, a, b, levels=8, search_radius=0.15, search_directions=3)
+    assert 1 < len(three) <= 16
+    assert pickle.loads(pickle.dumps(three)) == three
+    with pytest.raises(errors.InputError, match="radius"):
+        bipolar.describe(bump_mesh, a, b, search_radius=0.0)
+    with pytest.raises(errors.InputError, match="reference points"):
+        bipolar.describe(bump_mesh, a, b, refs=[5], search_radius=0.15)
+
+
 def test_face_with_detected_landmarks(face_path, face):
     d = bipolar.describe(face, "outer-eye-right", "outer-eye-left", levels=30, max_level=30)
     assert len(d) > 500

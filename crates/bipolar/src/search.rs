@@ -5,11 +5,12 @@
 //! tripled the distance to the same face). A search describes a face from several placements
 //! of each reference around the given one and keeps, per comparison, the least distance.
 //! [`reference_candidates`] gives those placements, [`SearchedPole`] them with their fields,
-//! and [`moved_pairs`] the pole pairs two searched poles make.
+//! [`moved_pairs`] the pole pairs two searched poles make, and [`describe_searched`] the
+//! descriptors of them all for two reference points.
 
-use crate::BipolarError;
+use crate::{BipolarError, Descriptor, DescriptorOptions, Fields};
 use geodesic::{GeodesicSolver, SolveOptions, Source};
-use meshcore::{DVec3, TriMesh};
+use meshcore::{DVec3, Surface, TriMesh};
 
 /// A pole of a reference-point search: its candidate vertices ([`reference_candidates`], the
 /// given place first) and the geodesic distance field from each (`None` where its solve
@@ -98,6 +99,56 @@ pub fn moved_pairs<'a>(
         let d = 0.5 * (ur.get(q as usize)? + uq.get(r as usize)?);
         (d.is_finite() && d > 0.0).then_some(MovedPair { r, q, ur, uq, d })
     })
+}
+
+/// The descriptors of a reference-point search around two reference points: their own
+/// descriptor ([`crate::describe`] with `solver`) first, then one per moved pole pair
+/// ([`moved_pairs`] of the two references' [`SearchedPole`]s: each reference at its vertex, a
+/// surface point at the nearest corner of its face, with `directions` candidates at `radius`,
+/// the first toward the other reference), all with `opts`. A comparison's distance is then
+/// the least over them. Moved pairs whose descriptor fails (no points, ...) are left out. The
+/// fields of the moved poles are solved without a cut-off (two plus one per moved candidate).
+///
+/// Errors: not exactly two references; those of [`crate::describe`] for the own descriptor; a
+/// reference off the mesh; those of [`reference_candidates`] (radius, directions).
+pub fn describe_searched(
+    surface: &Surface,
+    solver: &dyn GeodesicSolver,
+    references: &[Source],
+    radius: f64,
+    directions: usize,
+    opts: &DescriptorOptions,
+) -> Result<Vec<Descriptor>, BipolarError> {
+    if references.len() != 2 {
+        return Err(BipolarError::ReferenceCount(references.len()));
+    }
+    let own = crate::describe(surface, Fields::Solve { solver, references }, opts)?;
+    let mesh = surface.mesh();
+    let vertex = |s: &Source| match s {
+        Source::Vertex(v) => mesh.try_position(*v).map(|_| *v),
+        Source::Point(p) => mesh.nearest_corner(p),
+    };
+    let (a, b) = (vertex(&references[0])?, vertex(&references[1])?);
+    let whole = SolveOptions::default();
+    let pole = |v: u32, toward: u32| -> Result<SearchedPole, BipolarError> {
+        let given = solver.distances(&[Source::Vertex(v)], &whole)?;
+        let toward = mesh.position(toward);
+        SearchedPole::new(mesh, solver, v, toward, &given, radius, directions, &whole)
+    };
+    let (pa, pb) = (pole(a, b)?, pole(b, a)?);
+    let mut out = vec![own];
+    for m in moved_pairs(&pa, &pb) {
+        let fields = [m.ur.to_vec(), m.uq.to_vec()];
+        let references = [Source::Vertex(m.r), Source::Vertex(m.q)];
+        let fields = Fields::Precomputed {
+            fields: &fields,
+            references: Some(&references),
+        };
+        if let Ok(d) = crate::describe(surface, fields, opts) {
+            out.push(d);
+        }
+    }
+    Ok(out)
 }
 
 /// Vertices around the reference vertex `v` for a reference-point search: `v` first, then,
@@ -298,6 +349,99 @@ mod tests {
         )
         .unwrap();
         assert_eq!(moved_pairs(&c, &far).count(), 0);
+    }
+
+    /// A curved, asymmetric height field on a 1-unit grid (on a plane every placement gives the
+    /// same scale-free descriptor).
+    fn bumpy(n: usize) -> TriMesh {
+        let h = 0.5 * (n - 1) as f64;
+        meshcore::shapes::grid(
+            n - 1,
+            n - 1,
+            meshcore::shapes::Diagonals::Uniform,
+            |i, j| {
+                let (x, y) = (i as f64 - h, j as f64 - h);
+                DVec3::new(
+                    x,
+                    y,
+                    0.02 * x * x + 0.01 * x * y + 0.03 * y * y + 2e-4 * x * x * x,
+                )
+            },
+        )
+        .unwrap()
+    }
+
+    #[test]
+    fn the_search_describes_the_references_then_each_moved_pair() {
+        let n = 41;
+        let m = bumpy(n);
+        let surface = Surface::new(m.clone());
+        let solver = geodesic::new_solver(&m, geodesic::Method::Exact).unwrap();
+        let (v, w) = ((20 * n + 10) as u32, (20 * n + 30) as u32);
+        let opts = DescriptorOptions {
+            max_level: Some(10),
+            ..DescriptorOptions::default()
+        };
+        let refs = [Source::Vertex(v), Source::Vertex(w)];
+        let all = describe_searched(&surface, solver.as_ref(), &refs, 2.0, 6, &opts).unwrap();
+        let own = crate::describe(
+            &surface,
+            Fields::Solve {
+                solver: solver.as_ref(),
+                references: &refs,
+            },
+            &opts,
+        )
+        .unwrap();
+        assert_eq!(all[0].points, own.points);
+        assert!(all.len() > 40 && all.len() <= 49, "{}", all.len());
+        // The first moved pair keeps `v` and moves `w` toward `v`; its descriptor is the one
+        // described from those two vertices directly (cut fields read the same values).
+        let cw = reference_candidates(&m, w, m.position(v), 2.0, 6).unwrap();
+        let moved = crate::describe(
+            &surface,
+            Fields::Solve {
+                solver: solver.as_ref(),
+                references: &[Source::Vertex(v), Source::Vertex(cw[1])],
+            },
+            &opts,
+        )
+        .unwrap();
+        assert_eq!(all[1].references, moved.references);
+        assert_eq!(all[1].points.len(), moved.points.len());
+        for (a, b) in all[1].points.iter().zip(&moved.points) {
+            assert_eq!(a.key, b.key);
+            assert!((a.position - b.position).length() < 1e-9);
+        }
+        // Every descriptor differs from the own one: each moved pair has other references.
+        assert!(all[1..].iter().all(|d| d.references != own.references));
+        // A surface point searches from the nearest corner of its face.
+        let face = (0..m.n_faces() as u32)
+            .find(|&f| m.triangles()[f as usize].contains(&v))
+            .unwrap();
+        let k = m.triangles()[face as usize]
+            .iter()
+            .position(|&c| c == v)
+            .unwrap();
+        let mut bary = [0.1; 3];
+        bary[k] = 0.8;
+        let point = Source::Point(meshcore::SurfacePoint::new(face, DVec3::from(bary)));
+        let from_point =
+            describe_searched(&surface, solver.as_ref(), &[point, refs[1]], 2.0, 6, &opts).unwrap();
+        assert_eq!(from_point.len(), all.len());
+        assert_eq!(from_point[1].references, all[1].references);
+        // Errors: not two references, a bad radius, a reference off the mesh.
+        let three = [refs[0], refs[1], Source::Vertex(0)];
+        assert!(matches!(
+            describe_searched(&surface, solver.as_ref(), &three, 2.0, 6, &opts),
+            Err(BipolarError::ReferenceCount(3))
+        ));
+        assert!(matches!(
+            describe_searched(&surface, solver.as_ref(), &refs, 0.0, 6, &opts),
+            Err(BipolarError::InvalidOption(_))
+        ));
+        let off = [refs[0], Source::Vertex(10_000)];
+        assert!(describe_searched(&surface, solver.as_ref(), &off, 2.0, 6, &opts).is_err());
     }
 
     #[test]

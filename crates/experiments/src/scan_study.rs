@@ -262,13 +262,6 @@ fn field_at(mesh: &TriMesh, u: &[f64], sp: &SurfacePoint) -> f64 {
     crate::pipeline::field_at(mesh, u, sp)
 }
 
-/// The corner of `sp`'s face nearest to it (the first on ties).
-fn nearest_corner(mesh: &TriMesh, sp: &SurfacePoint) -> u32 {
-    let tri = mesh.triangles()[sp.face as usize];
-    let w = sp.bary.to_array();
-    tri[(0..3).fold(0, |b, i| if w[i] > w[b] { i } else { b })]
-}
-
 fn describe_scan(face: &Face, setting: &Setting, args: &Args) -> Result<Described> {
     let t0 = Instant::now();
     let (mesh, lms, hidden) = acquire(face, setting, args.smooth)?;
@@ -452,25 +445,21 @@ fn describe_mesh(
             let toward = [pos[1], pos[0], 0.5 * (pos[0] + pos[1])];
             let poles: Vec<bipolar::SearchedPole> = (0..3)
                 .map(|k| {
-                    let v = nearest_corner(&mesh, &sp[k]);
-                    solver
-                        .distances(&[Source::Vertex(v)], &moved_cut)
-                        .ok()
-                        .and_then(|given| {
-                            bipolar::SearchedPole::new(
-                                &mesh,
-                                solver.as_ref(),
-                                v,
-                                toward[k],
-                                &given,
-                                rho,
-                                crate::recognition::SEARCH_DIRECTIONS,
-                                &moved_cut,
-                            )
-                            .ok()
-                        })
-                        .unwrap_or_default()
+                    let v = mesh.nearest_corner(&sp[k]).ok()?;
+                    let given = solver.distances(&[Source::Vertex(v)], &moved_cut).ok()?;
+                    bipolar::SearchedPole::new(
+                        &mesh,
+                        solver.as_ref(),
+                        v,
+                        toward[k],
+                        &given,
+                        rho,
+                        crate::recognition::SEARCH_DIRECTIONS,
+                        &moved_cut,
+                    )
+                    .ok()
                 })
+                .map(Option::unwrap_or_default)
                 .collect();
             for (p, (ka, kb)) in [(0, 1), (0, 2), (1, 2)].into_iter().enumerate() {
                 for m in bipolar::moved_pairs(&poles[ka], &poles[kb]) {

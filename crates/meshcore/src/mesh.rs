@@ -242,6 +242,16 @@ impl TriMesh {
         Ok(p.bary.x * a + p.bary.y * b + p.bary.z * c)
     }
 
+    /// The corner of a surface point's face with the largest barycentric weight (the first on
+    /// ties): the vertex nearest to it in the face's own coordinates. An error if the surface
+    /// point is invalid.
+    pub fn nearest_corner(&self, p: &SurfacePoint) -> Result<u32, MeshError> {
+        self.check_surface_point(p)?;
+        let w = p.bary.to_array();
+        let k = (1..3).fold(0, |b, i| if w[i] > w[b] { i } else { b });
+        Ok(self.triangles[p.face as usize][k])
+    }
+
     /// Validates a surface point: face in range, barycentrics finite, `>= -1e-9`, summing to 1 within 1e-9.
     pub fn check_surface_point(&self, p: &SurfacePoint) -> Result<(), MeshError> {
         if p.face as usize >= self.triangles.len() {
@@ -308,6 +318,22 @@ mod tests {
         assert!((m.ring_length(&[0, 2]) - 2.0 * 2f64.sqrt()).abs() < 1e-12);
         assert_eq!(m.ring_length(&[1]), 0.0);
         assert_eq!(m.ring_length(&[]), 0.0);
+    }
+
+    #[test]
+    fn the_nearest_corner_has_the_largest_weight() {
+        let m = quad();
+        let at = |face, w: [f64; 3]| m.nearest_corner(&SurfacePoint::new(face, DVec3::from(w)));
+        assert_eq!(at(0, [0.2, 0.5, 0.3]).unwrap(), 1);
+        assert_eq!(at(1, [0.1, 0.2, 0.7]).unwrap(), 3);
+        assert_eq!(at(1, [1.0, 0.0, 0.0]).unwrap(), 0);
+        // Ties go to the first corner.
+        assert_eq!(at(1, [0.2, 0.4, 0.4]).unwrap(), 2);
+        assert!(matches!(
+            at(2, [1.0, 0.0, 0.0]),
+            Err(MeshError::FaceOutOfRange { .. })
+        ));
+        assert!(at(0, [0.5, 0.5, 0.5]).is_err());
     }
 
     #[test]

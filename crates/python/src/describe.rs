@@ -147,15 +147,20 @@ pub(crate) fn references(
 /// within that geodesic distance (mesh units) of the mesh boundary: holes, eye openings, a
 /// scan's border. ``max_incidence`` (degrees) leaves out what a range scanner looking along -z
 /// saw at a larger incidence (a scan in its own frame, as ``read_bnt`` and ``scan`` give it).
-/// The GIL is released while it runs.
+/// ``search_radius`` (mesh units) turns on the reference-point search: the result is then a
+/// list, the references' own descriptor first, then one per pair of the two references moved
+/// by that distance in ``search_directions`` directions of their tangent planes (each
+/// reference at its vertex or the nearest corner of its face; the first direction toward the
+/// other reference; up to 48 more), all with the same options; compare a probe by the least
+/// distance over its list (``bipolar::describe_searched``). The GIL is released while it runs.
 #[pyfunction]
 #[pyo3(signature = (mesh, ref_a, ref_b, *, refs=None, levels=None, step=None, max_level=None,
                     angles=8, alpha=0.95, rule="isoangle", tolerance=None, tangent="gradient",
                     method="exact", landmarks=None, solver=None, boundary_margin=None,
-                    max_incidence=None))]
+                    max_incidence=None, search_radius=None, search_directions=6))]
 #[allow(clippy::too_many_arguments)]
-pub fn describe(
-    py: Python<'_>,
+pub fn describe<'py>(
+    py: Python<'py>,
     mesh: &Bound<'_, PyAny>,
     ref_a: &Bound<'_, PyAny>,
     ref_b: &Bound<'_, PyAny>,
@@ -173,7 +178,9 @@ pub fn describe(
     solver: Option<&Bound<'_, PyGeodesicSolver>>,
     boundary_margin: Option<f64>,
     max_incidence: Option<f64>,
-) -> PyResult<PyDescriptor> {
+    search_radius: Option<f64>,
+    search_directions: usize,
+) -> PyResult<Bound<'py, PyAny>> {
     // The options of `bipolar describe` (same defaults and rules).
     let levels = match (levels, step) {
         (Some(_), Some(_)) => return Err(errors::input("give levels or step, not both")),
@@ -232,19 +239,41 @@ pub fn describe(
     let (d, t) = py.detach(|| {
         let t = Instant::now();
         let d = choice.run(mesh, |solver| {
-            let fields = bipolar::Fields::Solve {
-                solver,
-                references: &sources,
-            };
-            bipolar::describe(&bipolar::Surface::new(mesh.clone()), fields, &opts)
+            let surface = bipolar::Surface::new(mesh.clone());
+            match search_radius {
+                Some(r) => bipolar::describe_searched(
+                    &surface,
+                    solver,
+                    &sources,
+                    r,
+                    search_directions,
+                    &opts,
+                ),
+                None => {
+                    let fields = bipolar::Fields::Solve {
+                        solver,
+                        references: &sources,
+                    };
+                    bipolar::describe(&surface, fields, &opts).map(|d| vec![d])
+                }
+            }
         });
         (d, t.elapsed())
     });
     in_library += t;
     LIBRARY_SECONDS.set(in_library.as_secs_f64());
-    Ok(PyDescriptor {
-        d: d.map_err(errors::descriptor)?,
-    })
+    let mut all = d
+        .map_err(errors::descriptor)?
+        .into_iter()
+        .map(|d| PyDescriptor { d });
+    match search_radius {
+        Some(_) => Ok(pyo3::types::PyList::new(py, all)?.into_any()),
+        None => {
+            let own = all.next();
+            let own = own.ok_or_else(|| errors::input("the descriptor could not be built"))?;
+            Ok(Bound::new(py, own)?.into_any())
+        }
+    }
 }
 
 thread_local! {
