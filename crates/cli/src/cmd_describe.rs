@@ -60,6 +60,20 @@ pub struct Args {
     /// depth noise runs along the surface (60 is the scan benchmark's choice).
     #[arg(long = "max-incidence", value_name = "DEG")]
     pub max_incidence: Option<f64>,
+    /// Reference-point search (mesh units): also describe the mesh from the two references
+    /// moved by this distance in --search-directions directions of their tangent planes (the
+    /// first toward the other reference; up to 48 more descriptors, `bipolar::describe_searched`),
+    /// written beside --out as `STEM.search-NN.EXT`. Compare a probe by the least distance over
+    /// its files (`bipolar matrix`).
+    #[arg(long = "search-radius")]
+    pub search_radius: Option<f64>,
+    /// Directions of the reference-point search around each reference.
+    #[arg(
+        long = "search-directions",
+        default_value_t = 6,
+        requires = "search_radius"
+    )]
+    pub search_directions: usize,
     /// Output file: .csv, .json or .ply.
     #[arg(long)]
     pub out: PathBuf,
@@ -91,6 +105,14 @@ pub fn options(args: &Args) -> anyhow::Result<DescriptorOptions> {
     })
 }
 
+/// Where the `k`-th descriptor of the reference-point search goes: `STEM.search-KK.EXT` beside
+/// `out`.
+fn search_path(out: &std::path::Path, k: usize) -> PathBuf {
+    let stem = out.file_stem().unwrap_or_default().to_string_lossy();
+    let ext = out.extension().unwrap_or_default().to_string_lossy();
+    out.with_file_name(format!("{stem}.search-{k:02}.{ext}"))
+}
+
 /// Runs the command.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let mut opts = options(&args)?;
@@ -115,16 +137,42 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let solver = geodesic::new_solver(&mesh, method)
         .with_context(|| format!("preparing the {} geodesic solver", method.name()))?;
     let surface = bipolar::Surface::new(mesh);
-    let d = bipolar::describe(
-        &surface,
-        bipolar::Fields::Solve {
-            solver: solver.as_ref(),
-            references: &refs,
-        },
-        &opts,
-    )?;
+    let all = match args.search_radius {
+        Some(r) => bipolar::describe_searched(
+            &surface,
+            solver.as_ref(),
+            &refs,
+            r,
+            args.search_directions,
+            &opts,
+        )
+        .context("--search-radius")?,
+        None => vec![bipolar::describe(
+            &surface,
+            bipolar::Fields::Solve {
+                solver: solver.as_ref(),
+                references: &refs,
+            },
+            &opts,
+        )?],
+    };
     let elapsed = t0.elapsed();
+    let mut all = all.into_iter();
+    let d = all
+        .next()
+        .context("the descriptor of the references was not built")?;
+    let moved: Vec<bipolar::Descriptor> = all.collect();
     bipolar::io::write_auto(&args.out, &d)?;
+    for (k, m) in moved.iter().enumerate() {
+        bipolar::io::write_auto(&search_path(&args.out, k + 1), m)?;
+    }
+    if !moved.is_empty() {
+        eprintln!(
+            "{} descriptors of the reference-point search: {} ...",
+            moved.len(),
+            search_path(&args.out, 1).display()
+        );
+    }
     let n_amb = d.points.iter().filter(|p| p.ambiguous).count();
     eprintln!(
         "{} points ({} ambiguous) from {} intersections; step {:.6}, levels 1..={}, d(a,b) = {:.6}; {} geodesics; {:.1} ms; wrote {}",

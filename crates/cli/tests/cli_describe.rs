@@ -231,3 +231,62 @@ fn max_incidence_leaves_out_what_the_scanner_saw_at_grazing_angles() {
     .failure();
     assert!(err.contains("max incidence 200"), "{err}");
 }
+
+#[test]
+fn describe_with_the_reference_point_search_writes_the_moved_descriptors_beside() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = sphere_obj(dir.path());
+    let plain = dir.path().join("plain.json");
+    let out = dir.path().join("d.json");
+    let ab = ["describe", arg(&obj), "--ref-a", "0", "--ref-b", "100"];
+    let opts = ["--levels", "6", "--method", "dijkstra"];
+    bipolar(&[&ab[..], &opts, &["--out", arg(&plain)]].concat()).success();
+    bipolar(
+        &[
+            &ab[..],
+            &opts,
+            &["--search-radius", "0.2", "--out", arg(&out)],
+        ]
+        .concat(),
+    )
+    .success();
+    // The references' own descriptor is the one written without the search.
+    assert_eq!(std::fs::read(&plain).unwrap(), std::fs::read(&out).unwrap());
+    let own = bipolar::io::read_json(&out).unwrap();
+    let moved: Vec<_> = (1..=48)
+        .map(|k| dir.path().join(format!("d.search-{k:02}.json")))
+        .take_while(|p| p.exists())
+        .map(|p| bipolar::io::read_json(&p).unwrap())
+        .collect();
+    assert!(moved.len() > 20, "{}", moved.len());
+    assert!(!dir
+        .path()
+        .join(format!("d.search-{:02}.json", moved.len() + 1))
+        .exists());
+    assert!(moved
+        .iter()
+        .all(|m| m.references != own.references && !m.is_empty()));
+    // A bad radius is an error naming the option; directions need a radius.
+    let err = bipolar(
+        &[
+            &ab[..],
+            &opts,
+            &["--search-radius", "0", "--out", arg(&out)],
+        ]
+        .concat(),
+    )
+    .failure();
+    assert!(
+        err.contains("--search-radius") && err.contains("radius"),
+        "{err}"
+    );
+    bipolar(
+        &[
+            &ab[..],
+            &opts,
+            &["--search-directions", "3", "--out", arg(&out)],
+        ]
+        .concat(),
+    )
+    .failure();
+}
