@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, List, Optional, Sequence, Tuple
+from typing import Any, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -160,7 +160,7 @@ class Identification:
 
 
 def identify(
-    probes: Sequence[_bipolar.Descriptor],
+    probes: Sequence[Union[_bipolar.Descriptor, Sequence[_bipolar.Descriptor]]],
     gallery: Sequence[_bipolar.Descriptor],
     options: Any = None,
     *,
@@ -173,10 +173,19 @@ def identify(
 ) -> Identification:
     """1:N identification: distances of every probe to every gallery descriptor, computed in
     blocks on the cluster (equal to ``bipolar.cross_distances(probes, gallery, options)``), and
-    the gallery ranked for each probe."""
+    the gallery ranked for each probe. A probe may also be a list of descriptors (what
+    ``bipolar.describe(..., search_radius=)`` returns): its distance to a gallery descriptor is
+    then the least over the list (NaN where every one failed, or for an empty list)."""
     c = _client(client)
     opts = _options(options, kwargs)
-    p_items, g_items = list(probes), list(gallery)
+    # Every probe's descriptors as rows, and the probe each row belongs to.
+    def listed(x: Any) -> list:
+        return list(x) if isinstance(x, (list, tuple)) else [x]
+
+    per_probe = [listed(x) for x in probes]
+    owner = np.array([i for i, x in enumerate(per_probe) for _ in x], dtype=np.int64)
+    p_items = [d for x in per_probe for d in x]
+    g_items = list(gallery)
     p, g = len(p_items), len(g_items)
     dist = np.zeros((p, g))
     if p and g:
@@ -191,7 +200,12 @@ def identify(
         ]
         for ((bi, bj), _), m in zip(tasks, c.gather([t for _, t in tasks])):
             dist[pr[bi][0] : pr[bi][1], gr[bj][0] : gr[bj][1]] = m
-    return rank(dist, probe_labels, gallery_labels)
+    n_probes = len(per_probe)
+    if len(owner) == n_probes and np.all(owner == np.arange(n_probes)):
+        return rank(dist, probe_labels, gallery_labels)
+    least = np.full((n_probes, g), np.nan)
+    np.fmin.at(least, owner, dist)
+    return rank(least, probe_labels, gallery_labels)
 
 
 def rank(

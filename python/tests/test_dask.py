@@ -93,6 +93,19 @@ def test_identify_ranks_the_gallery(client, descriptors):
     assert 0.0 <= res.rank1_rate <= 1.0
 
 
+def test_identify_takes_the_least_over_a_probes_list(client, descriptors):
+    # Probe 0 is a list of three descriptors, probe 1 a single one, probe 2 an empty list.
+    lists = [descriptors[0:3], descriptors[3], []]
+    gallery = descriptors[4:]
+    res = bdask.identify(lists, gallery, client=client, block_size=2)
+    whole = bipolar.cross_distances(descriptors[:4], gallery)
+    np.testing.assert_array_equal(res.distances[0], whole[0:3].min(axis=0))
+    np.testing.assert_array_equal(res.distances[1], whole[3])
+    assert np.all(np.isnan(res.distances[2]))
+    assert res.distances.shape == (3, len(gallery))
+    np.testing.assert_array_equal(res.best[:2], np.argmin(res.distances[:2], axis=1))
+
+
 def test_bad_block_size(client, descriptors):
     with pytest.raises(bipolar.InputError, match="block_size"):
         bdask.distance_matrix(descriptors, client=client, block_size=0)
