@@ -61,7 +61,8 @@ pub struct Args {
     /// Radius (mm) of the reference-point search of the searched distance: each scan is also
     /// described from the poles of its three pole pairs moved by this much in 6 directions
     /// (`bipolar::SearchedPole`; 0, the default: no search and no searched distance). Measured
-    /// in docs/scans.md: it does not raise the separation ratios, at about 3 times the run time.
+    /// in docs/scans.md: it does not raise the separation ratios, and it makes the run several
+    /// times longer.
     #[arg(long, default_value_t = 0.0)]
     pub ref_search_mm: f64,
 }
