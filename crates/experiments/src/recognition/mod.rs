@@ -143,6 +143,11 @@ pub struct Args {
     /// moved fields and 144 more descriptors.
     #[arg(long)]
     pub own_pair_search: bool,
+    /// Scan, clean and detect the landmarks of the gallery, probe and sweep scans, write
+    /// `detection.csv` (per scan: the detected landmarks' errors or why detection failed) and
+    /// stop, without describing or comparing (`--scans`).
+    #[arg(long)]
+    pub detect_only: bool,
 }
 
 /// One sampled face.
@@ -1552,6 +1557,56 @@ pub fn run(args: Args) -> Result<()> {
 mod tests {
     use super::*;
     use meshcore::DQuat;
+
+    #[test]
+    fn detect_only_writes_one_row_per_scan_and_stops() {
+        let model = testsupport::require_shared!(testsupport::MODEL);
+        let out = std::env::temp_dir().join(format!("bipolar-detect-only-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&out);
+        #[derive(clap::Parser)]
+        struct Cli {
+            #[command(flatten)]
+            args: Args,
+        }
+        let (model, dir) = (model.display().to_string(), out.display().to_string());
+        let args = <Cli as clap::Parser>::parse_from([
+            "recognition",
+            "--scans",
+            "--identities",
+            "2",
+            "--expressions",
+            "2",
+            "--no-sweeps",
+            "--detect-only",
+            "--model",
+            &model,
+            "--out",
+            &dir,
+        ])
+        .args;
+        run(args).unwrap();
+        let text = std::fs::read_to_string(out.join("detection.csv")).unwrap();
+        let rows: Vec<Vec<&str>> = text
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').collect())
+            .collect();
+        // Two gallery scans, then two probes, in order; nothing described or compared.
+        let names: Vec<&str> = rows.iter().map(|r| r[0]).collect();
+        assert_eq!(names[..2], ["id00-e0", "id01-e0"], "{text}");
+        assert_eq!(rows.len(), 4, "{text}");
+        assert!(names[2].starts_with("id00-e1-yaw") && names[3].starts_with("id01-e1-yaw"));
+        // The frontal gallery scans: found, every landmark within 5 mm of its ground truth.
+        for r in &rows[..2] {
+            assert_eq!(r[3], "found", "{text}");
+            for e in &r[4..7] {
+                let e: f64 = e.parse().unwrap();
+                assert!((0.0..5.0).contains(&e), "{text}");
+            }
+        }
+        assert!(!out.join("report.md").exists());
+        std::fs::remove_dir_all(&out).unwrap();
+    }
 
     #[test]
     fn eer_and_rank1_on_known_scores() {

@@ -426,6 +426,96 @@ fn failures(faces: &[Face], group: &str) -> Vec<[String; 4]> {
     out
 }
 
+/// `--detect-only`: scans, cleans and detects every face, writes `detection.csv` (per scan its
+/// yaw, noise, each detected landmark's distance from its ground truth or why it is unseen, and
+/// the detector's error when it found nothing) and prints the count and every failure.
+fn detect_only(
+    model: &FaceModel,
+    generic: &GenericModel,
+    specs: &[&FaceSpec],
+    scan_opts: &ScanSetOptions,
+    out: &std::path::Path,
+) -> Result<()> {
+    use landmarks::LandmarkName as L;
+    let pb = bar(specs.len(), "scan, clean, detect");
+    let rows: Vec<Vec<String>> = specs
+        .par_iter()
+        .map(|spec| {
+            let r = scan_face(model, generic, spec, scan_opts);
+            pb.inc(1);
+            let mut row = vec![
+                spec.name.clone(),
+                format!("{}", spec.settings.yaw_deg),
+                format!("{}", spec.settings.noise_mm),
+            ];
+            match r {
+                Err(e) => row.extend([
+                    "scan or cleaning failed".into(),
+                    String::new(),
+                    String::new(),
+                    String::new(),
+                    String::new(),
+                    format!("{e:#}"),
+                ]),
+                Ok(s) => match &s.detected {
+                    Err(e) => row.extend([
+                        "not found".into(),
+                        String::new(),
+                        String::new(),
+                        String::new(),
+                        String::new(),
+                        e.clone(),
+                    ]),
+                    Ok(d) => {
+                        let mut why = Vec::new();
+                        row.push("found".into());
+                        for n in [L::OuterEyeRight, L::OuterEyeLeft, L::NoseTip] {
+                            row.push(match d.get(n) {
+                                Ok(l) => format!(
+                                    "{:.2}",
+                                    (l.position - s.truth[n as usize].position).length()
+                                ),
+                                Err(u) => {
+                                    why.push(format!("{}: {u}", n.key()));
+                                    "unseen".into()
+                                }
+                            });
+                        }
+                        row.push(format!("{:.3}", d.confidence));
+                        row.push(why.join("; "));
+                    }
+                },
+            }
+            row
+        })
+        .collect();
+    pb.finish();
+    let path = out.join("detection.csv");
+    std::fs::create_dir_all(out)?;
+    crate::report::write_csv(
+        &path,
+        &[
+            "scan",
+            "yaw (degrees)",
+            "noise (mm)",
+            "detection",
+            "outer eye right (mm)",
+            "outer eye left (mm)",
+            "nose tip (mm)",
+            "confidence",
+            "why not found or unseen",
+        ],
+        &rows,
+    )?;
+    let found = rows.iter().filter(|r| r[3] == "found").count();
+    eprintln!("landmarks found on {found} of {} scans", rows.len());
+    for r in rows.iter().filter(|r| r[3] != "found" || !r[8].is_empty()) {
+        eprintln!("  {}: {}: {}", r[0], r[3], r[8]);
+    }
+    println!("{}", path.display());
+    Ok(())
+}
+
 /// 95th percentile (nearest rank) of the finite values.
 fn p95(v: Vec<f64>) -> f64 {
     order_stat(v, |n| ((n - 1) as f64 * 0.95).round() as usize)
@@ -519,6 +609,14 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
                 .collect()
         })
         .collect();
+    if args.detect_only {
+        let specs: Vec<&FaceSpec> = gallery_specs
+            .iter()
+            .chain(&probe_specs)
+            .chain(sweep_specs.iter().flatten().flatten())
+            .collect();
+        return detect_only(model, &generic, &specs, &scan_opts, &out);
+    }
     let methods = resolve_methods(&args.method, &meshcore::shapes::icosphere(1))?;
     let method = methods[0].used;
     // Iso-curvature levels: from the first gallery scan (ground-truth landmarks), scanned once
