@@ -42,7 +42,10 @@ pub use geodesic::Source;
 pub use key::Key;
 pub use meshcore::Surface;
 pub use polar::{describe_polar, PolarDescriptor, PolarKey, PolarOptions, PolarPoint};
-pub use search::{describe_searched, moved_pairs, reference_candidates, MovedPair, SearchedPole};
+pub use search::{
+    describe_searched, least_searched_distance, moved_pairs, reference_candidates, MovedPair,
+    SearchedPole,
+};
 pub use types::{
     Descriptor, DescriptorOptions, DescriptorPoint, DescriptorStats, IsoAngleOptions, IsoCrossings,
     IsoRepeats, LevelSpec, SelectionKind, SelectionRule, SplineOptions, StripOptions,

@@ -5,8 +5,9 @@
 //! tripled the distance to the same face). A search describes a face from several placements
 //! of each reference around the given one and keeps, per comparison, the least distance.
 //! [`reference_candidates`] gives those placements, [`SearchedPole`] them with their fields,
-//! [`moved_pairs`] the pole pairs two searched poles make, and [`describe_searched`] the
-//! descriptors of them all for two reference points.
+//! [`moved_pairs`] the pole pairs two searched poles make, [`describe_searched`] the
+//! descriptors of them all for two reference points, and [`least_searched_distance`] the
+//! distance of two faces so described.
 
 use crate::{BipolarError, Descriptor, DescriptorOptions, Fields};
 use geodesic::{GeodesicSolver, SolveOptions, Source};
@@ -99,6 +100,40 @@ pub fn moved_pairs<'a>(
         let d = 0.5 * (ur.get(q as usize)? + uq.get(r as usize)?);
         (d.is_finite() && d > 0.0).then_some(MovedPair { r, q, ur, uq, d })
     })
+}
+
+/// The distance of two faces described with a reference-point search: the least of the
+/// distance of their own descriptors (`a`, `b`) and of each side's moved descriptors
+/// (`a_moved`, `b_moved`: from [`describe_searched`], its first one left out) against the other
+/// side's own. Moved against moved is not compared: that would move the two sides' references
+/// at once and give both faces twice the freedom. Symmetric when `dist` is. Either list may
+/// be empty (a one-sided search: a probe searched against a gallery described once).
+///
+/// A distance that fails or is NaN is skipped; when every one does, the error (or NaN) of the
+/// own descriptors' distance is returned.
+pub fn least_searched_distance<T, E>(
+    a: &T,
+    a_moved: &[T],
+    b: &T,
+    b_moved: &[T],
+    mut dist: impl FnMut(&T, &T) -> Result<f64, E>,
+) -> Result<f64, E> {
+    let own = dist(a, b);
+    let moved = a_moved
+        .iter()
+        .map(|m| (m, b))
+        .chain(b_moved.iter().map(|m| (a, m)));
+    let mut least = f64::NAN;
+    for (x, y) in moved {
+        if let Ok(v) = dist(x, y) {
+            least = least.min(v);
+        }
+    }
+    match own {
+        Ok(v) => Ok(v.min(least)),
+        Err(_) if !least.is_nan() => Ok(least),
+        Err(e) => Err(e),
+    }
 }
 
 /// The descriptors of a reference-point search around two reference points: their own
@@ -442,6 +477,46 @@ mod tests {
         ));
         let off = [refs[0], Source::Vertex(10_000)];
         assert!(describe_searched(&surface, solver.as_ref(), &off, 2.0, 6, &opts).is_err());
+    }
+
+    #[test]
+    fn the_searched_distance_is_the_least_over_own_and_one_side_moved() {
+        // Descriptors stand in as numbers; the distance is their difference, and 100 + x fails.
+        let dist = |x: &f64, y: &f64| -> Result<f64, String> {
+            if *x >= 100.0 || *y >= 100.0 {
+                Err(format!("{x} or {y} failed"))
+            } else {
+                Ok((x - y).abs())
+            }
+        };
+        let least =
+            |a: f64, am: &[f64], b: f64, bm: &[f64]| least_searched_distance(&a, am, &b, bm, dist);
+        assert_eq!(least(0.0, &[], 5.0, &[]), Ok(5.0));
+        // Each side's moved ones against the other's own: 4 - 5 and 0 - 2.
+        assert_eq!(least(0.0, &[4.0, -3.0], 5.0, &[]), Ok(1.0));
+        assert_eq!(least(0.0, &[], 5.0, &[2.0, 9.0]), Ok(2.0));
+        // Symmetric; moved against moved (4 against 4.5: 0.5) is never compared.
+        assert_eq!(least(0.0, &[4.0], 5.0, &[4.5]), Ok(1.0));
+        assert_eq!(least(5.0, &[4.5], 0.0, &[4.0]), Ok(1.0));
+        assert_eq!(least(0.0, &[3.0], 9.0, &[3.5]), Ok(3.5));
+        // Failed distances are skipped; the own pair's error when every one fails.
+        assert_eq!(least(0.0, &[100.0, 4.0], 5.0, &[]), Ok(1.0));
+        assert_eq!(least(100.0, &[4.0], 5.0, &[]), Ok(1.0));
+        assert_eq!(
+            least(100.0, &[101.0], 5.0, &[]),
+            Err("100 or 5 failed".to_string())
+        );
+        // NaN distances are skipped too.
+        let nan = |x: &f64, y: &f64| -> Result<f64, ()> {
+            Ok(if *x < 0.0 { f64::NAN } else { (x - y).abs() })
+        };
+        assert_eq!(
+            least_searched_distance(&0.0, &[-1.0], &5.0, &[], nan),
+            Ok(5.0)
+        );
+        assert!(least_searched_distance(&-1.0, &[], &5.0, &[], nan)
+            .unwrap()
+            .is_nan());
     }
 
     #[test]

@@ -2,6 +2,7 @@
 
 use crate::choice::{choice, from_extension};
 use crate::refpoint::{RefArgs, Resolver};
+use crate::searchfiles::search_path;
 use anyhow::Context;
 use bipolar::{DescriptorOptions, LevelSpec, SelectionKind, TangentMethod};
 use geodesic::Method;
@@ -63,8 +64,9 @@ pub struct Args {
     /// Reference-point search (mesh units): also describe the mesh from the two references
     /// moved by this distance in --search-directions directions of their tangent planes (the
     /// first toward the other reference; up to 48 more descriptors, `bipolar::describe_searched`),
-    /// written beside --out as `STEM.search-NN.EXT`. Compare a probe by the least distance over
-    /// its files (`bipolar matrix`).
+    /// written beside --out as `STEM.search-NN.EXT` (earlier such files past the last one
+    /// written are removed). `bipolar distance --searched` and `bipolar matrix --searched`
+    /// compare faces by the least distance over them.
     #[arg(long = "search-radius")]
     pub search_radius: Option<f64>,
     /// Directions of the reference-point search around each reference.
@@ -103,14 +105,6 @@ pub fn options(args: &Args) -> anyhow::Result<DescriptorOptions> {
         boundary_margin: args.boundary_margin,
         ..DescriptorOptions::default()
     })
-}
-
-/// Where the `k`-th descriptor of the reference-point search goes: `STEM.search-KK.EXT` beside
-/// `out`.
-fn search_path(out: &std::path::Path, k: usize) -> PathBuf {
-    let stem = out.file_stem().unwrap_or_default().to_string_lossy();
-    let ext = out.extension().unwrap_or_default().to_string_lossy();
-    out.with_file_name(format!("{stem}.search-{k:02}.{ext}"))
 }
 
 /// Runs the command.
@@ -165,6 +159,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     bipolar::io::write_auto(&args.out, &d)?;
     for (k, m) in moved.iter().enumerate() {
         bipolar::io::write_auto(&search_path(&args.out, k + 1), m)?;
+    }
+    let stale = crate::searchfiles::remove_stale(&args.out, moved.len())?;
+    if stale > 0 {
+        eprintln!(
+            "removed {stale} search files of an earlier describe to {} (STEM.search-NN.EXT numbered past this one's {})",
+            args.out.display(),
+            moved.len()
+        );
     }
     if !moved.is_empty() {
         eprintln!(

@@ -54,6 +54,12 @@ pub struct Args {
     /// Print details as JSON (rotation, shared keys and shares, iterations, rmse).
     #[arg(long)]
     pub json: bool,
+    /// Reference-point search: also read the moved descriptors `STEM.search-NN.EXT` that
+    /// `bipolar describe --search-radius` wrote beside each file, and print the least of the two
+    /// files' distance and each side's moved descriptors against the other's own
+    /// (`bipolar::least_searched_distance`).
+    #[arg(long)]
+    pub searched: bool,
 }
 
 /// A descriptor file reduced to what the distances need.
@@ -123,10 +129,61 @@ pub fn compare(
     Ok((r, v))
 }
 
+/// The moved descriptors of a reference-point search beside `own` (`--searched`), loaded.
+pub fn load_moved(own: &Path, c: &CompareArgs, which: Which) -> anyhow::Result<Vec<Loaded>> {
+    crate::searchfiles::search_files(own)?
+        .iter()
+        .map(|p| load(p, c, which))
+        .collect()
+}
+
+/// The distance of `a` and `b` with their moved descriptors (`bipolar::least_searched_distance`)
+/// and the JSON details of the comparison that gave it.
+pub fn compare_searched(
+    (a, a_moved): (&Loaded, &[Loaded]),
+    (b, b_moved): (&Loaded, &[Loaded]),
+    c: &CompareArgs,
+) -> anyhow::Result<(f64, serde_json::Value)> {
+    let mut best: Option<(f64, serde_json::Value)> = None;
+    let d = bipolar::least_searched_distance(a, a_moved, b, b_moved, |x, y| {
+        let (r, v) = compare(x, y, c)?;
+        let d = r.distance();
+        if best.as_ref().is_none_or(|(b, _)| d < *b) {
+            best = Some((d, v));
+        }
+        Ok::<f64, anyhow::Error>(d)
+    })?;
+    let details = best.map(|(_, v)| v).unwrap_or_default();
+    Ok((d, details))
+}
+
 /// Runs the command.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let a = load(&args.a, &args.compare, Which::A)?;
     let b = load(&args.b, &args.compare, Which::B)?;
+    if args.searched {
+        let am = load_moved(&args.a, &args.compare, Which::A)?;
+        let bm = load_moved(&args.b, &args.compare, Which::B)?;
+        if am.is_empty() && bm.is_empty() {
+            anyhow::bail!(
+                "--searched: no moved descriptors beside {} or {} (STEM.search-NN.EXT, written by `bipolar describe --search-radius`)",
+                args.a.display(),
+                args.b.display()
+            );
+        }
+        let (d, mut details) = compare_searched((&a, &am), (&b, &bm), &args.compare)?;
+        if args.json {
+            details["searched"] = serde_json::json!({
+                "distance": d,
+                "a_moved": am.len(),
+                "b_moved": bm.len(),
+            });
+            println!("{}", serde_json::to_string_pretty(&details)?);
+        } else {
+            println!("{d}");
+        }
+        return Ok(());
+    }
     let (r, details) = compare(&a, &b, &args.compare)?;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&details)?);

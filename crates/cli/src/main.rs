@@ -16,6 +16,7 @@ mod cmd_render;
 mod cmd_scan;
 mod load;
 mod refpoint;
+mod searchfiles;
 
 /// Bipolar invariant representation of 3D surfaces: inspect meshes, compute geodesic fields and
 /// descriptors, compare faces.

@@ -266,6 +266,24 @@ fn describe_with_the_reference_point_search_writes_the_moved_descriptors_beside(
     assert!(moved
         .iter()
         .all(|m| m.references != own.references && !m.is_empty()));
+    // `distance --searched` of the own descriptor with itself is 0; of the plain one (no
+    // moved files beside it) with the searched one, too.
+    let r = bipolar(&["distance", arg(&plain), arg(&out), "--searched"]).success();
+    assert!(
+        r.stdout.trim().parse::<f64>().unwrap() < 1e-12,
+        "{}",
+        r.stdout
+    );
+    // Describing again without the search removes the moved files, which `--searched` would
+    // otherwise take for this descriptor's.
+    let err = bipolar(&[&ab[..], &opts, &["--out", arg(&out)]].concat())
+        .success()
+        .stderr;
+    assert!(
+        err.contains(&format!("removed {} search files", moved.len())),
+        "{err}"
+    );
+    assert!(!dir.path().join("d.search-01.json").exists());
     // A bad radius is an error naming the option; directions need a radius.
     let err = bipolar(
         &[

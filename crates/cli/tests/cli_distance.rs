@@ -175,3 +175,102 @@ fn bad_input_fails_with_a_clear_message() {
     assert!(!ok);
     assert!(err.contains("line 2"), "{err}");
 }
+
+/// The patch with its z stretched by `1 + s`, turned by `deg` about a fixed axis.
+fn stretched(s: f64, deg: f64) -> Vec<([f64; 3], [i64; 6])> {
+    patch()
+        .iter()
+        .map(|(q, k)| {
+            (
+                rot([0.3, 1.0, -0.2], deg, [q[0], q[1], q[2] * (1.0 + s)]),
+                *k,
+            )
+        })
+        .collect()
+}
+
+/// The number printed by a successful `bipolar distance`.
+fn distance(args: &[&str]) -> f64 {
+    let (ok, out, err) = bipolar(&[&["distance"][..], args].concat());
+    assert!(ok, "{err}");
+    out.trim().parse().unwrap()
+}
+
+#[test]
+fn searched_distances_take_the_least_over_each_sides_moved_descriptors() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // a and b differ; b's moved descriptors hold a turned copy of a, so the search finds it.
+    let fa = write(d, "a.csv", &stretched(0.0, 0.0), &[]);
+    let fb = write(d, "b.csv", &stretched(0.4, 10.0), &[]);
+    write(d, "b.search-01.csv", &stretched(0.3, 20.0), &[]);
+    write(d, "b.search-02.csv", &stretched(0.0, 30.0), &[]);
+    let plain = distance(&[p(&fa), p(&fb)]);
+    assert!(plain > 1e-3, "{plain}");
+    let searched = distance(&[p(&fa), p(&fb), "--searched"]);
+    assert!(searched < 1e-9, "{searched}");
+    assert!(distance(&[p(&fb), p(&fa), "--searched"]) < 1e-9);
+    let (ok, out, err) = bipolar(&["distance", p(&fa), p(&fb), "--searched", "--json"]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["searched"]["b_moved"], 2);
+    assert_eq!(v["searched"]["a_moved"], 0);
+    assert_eq!(v["b"], "b.search-02", "{out}");
+    // Moved against moved is not compared: c's moved copy equals b's first one, but the
+    // searched distance of b and c stays the least of own and one-sided moved distances.
+    let fc = write(d, "c.csv", &stretched(0.8, 0.0), &[]);
+    write(d, "c.search-01.csv", &stretched(0.3, 20.0), &[]);
+    let bc = distance(&[p(&fb), p(&fc), "--searched"]);
+    let one_sided = [
+        distance(&[p(&fb), p(&fc)]),
+        distance(&[p(&d.join("b.search-01.csv")), p(&fc)]),
+        distance(&[p(&d.join("b.search-02.csv")), p(&fc)]),
+        distance(&[p(&fb), p(&d.join("c.search-01.csv"))]),
+    ];
+    assert_eq!(bc, one_sided.into_iter().fold(f64::INFINITY, f64::min));
+    assert!(bc > 1e-3, "{bc}");
+
+    // The matrix: listed search files fold into their own file's row; entries as `distance`.
+    let out = d.join("m.csv");
+    let (ok, _, err) = bipolar(&[
+        "matrix",
+        p(&fa),
+        p(&fb),
+        p(&d.join("b.search-01.csv")),
+        p(&fc),
+        "--searched",
+        "--out",
+        p(&out),
+    ]);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("3 moved descriptors beside 2 of the 3 files"),
+        "{err}"
+    );
+    let text = std::fs::read_to_string(&out).unwrap();
+    let rows: Vec<Vec<&str>> = text.lines().map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows[0], ["label", "a", "b", "c"]);
+    let m = |i: usize, j: usize| -> f64 { rows[i + 1][j + 1].parse().unwrap() };
+    assert!(m(0, 1) < 1e-9 && m(1, 0) < 1e-9, "{text}");
+    assert!((m(1, 2) - bc).abs() <= 1e-12 * bc, "{text}");
+    assert_eq!(m(0, 2), distance(&[p(&fa), p(&fc), "--searched"]));
+    // Without --searched the listed search file is a row of its own.
+    let (ok, _, err) = bipolar(&[
+        "matrix",
+        p(&fa),
+        p(&fb),
+        p(&d.join("b.search-01.csv")),
+        "--out",
+        p(&out),
+    ]);
+    assert!(ok, "{err}");
+    assert!(std::fs::read_to_string(&out)
+        .unwrap()
+        .starts_with("label,a,b,b.search-01\n"));
+    // No search files anywhere: an error naming what is missing.
+    let fe = write(d, "e.csv", &stretched(0.1, 0.0), &[]);
+    let (ok, _, err) = bipolar(&["distance", p(&fa), p(&fe), "--searched"]);
+    assert!(!ok && err.contains("STEM.search-NN.EXT"), "{err}");
+    let (ok, _, err) = bipolar(&["matrix", p(&fa), p(&fe), "--searched", "--out", p(&out)]);
+    assert!(!ok && err.contains("no moved descriptors"), "{err}");
+}

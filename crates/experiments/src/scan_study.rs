@@ -755,9 +755,9 @@ fn view_matched_distance(a: &Described, b: &Described, args: &Args) -> f64 {
     variant_distance(ca.as_ref().unwrap_or(a), cb.as_ref().unwrap_or(b), LEAST)
 }
 
-/// The [`LEAST`] distance with the reference-point search: per pole pair the least over the
-/// two scans' own descriptors and each scan's moved ones ([`Described::searched`]) against the
-/// other's own, then the least over the three pairs; NaN where either scan lacks its own
+/// The [`LEAST`] distance with the reference-point search: per pole pair
+/// `bipolar::least_searched_distance` of the two scans' own and moved descriptors
+/// ([`Described::searched`]), then the least over the three pairs; NaN where either scan lacks its own
 /// descriptors of the three pairs.
 fn searched_distance(a: &Described, b: &Described) -> f64 {
     fn own(x: &Described) -> Option<[&bipolar::Descriptor; 3]> {
@@ -767,12 +767,10 @@ fn searched_distance(a: &Described, b: &Described) -> f64 {
     let (Some(oa), Some(ob)) = (own(a), own(b)) else {
         return f64::NAN;
     };
-    let d = |x: &bipolar::Descriptor, y: &bipolar::Descriptor| dist(x, y).unwrap_or(f64::NAN);
     (0..3)
         .map(|p| {
-            let moved_a = a.searched[p].iter().map(|m| d(m, ob[p]));
-            let moved_b = b.searched[p].iter().map(|m| d(oa[p], m));
-            moved_a.chain(moved_b).fold(d(oa[p], ob[p]), f64::min)
+            bipolar::least_searched_distance(oa[p], &a.searched[p], ob[p], &b.searched[p], dist)
+                .unwrap_or(f64::NAN)
         })
         .fold(f64::NAN, f64::min)
 }
