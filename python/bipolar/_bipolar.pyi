@@ -334,6 +334,12 @@ def distance_matrix(
     threads: Optional[int] = None,
     **kwargs: Any,
 ) -> F64: ...
+def searched_distance(
+    a: Union[Descriptor, Sequence[Descriptor]],
+    b: Union[Descriptor, Sequence[Descriptor]],
+    options: Optional[DistanceOptions] = None,
+    **kwargs: Any,
+) -> float: ...
 def cross_distances(
     rows: Sequence[Descriptor],
     cols: Sequence[Descriptor],

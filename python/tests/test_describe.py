@@ -202,6 +202,37 @@ def test_the_reference_point_search_gives_the_own_descriptor_then_the_moved_ones
         bipolar.describe(bump_mesh, a, b, refs=[5], search_radius=0.15)
 
 
+def test_searched_distance_is_the_least_over_own_and_each_sides_moved(bump_mesh):
+    a, b = 20 * 40 + 8, 20 * 40 + 32
+    found = bipolar.describe(bump_mesh, a, b, levels=8, search_radius=0.15)
+    own = found[0]
+    # A face described from one of the moved pairs: the search finds it exactly.
+    va, vb = (int(np.argmin(np.linalg.norm(bump_mesh.vertices - r, axis=1))) for r in found[5].references)
+    other = bipolar.describe(bump_mesh, va, vb, levels=8)
+    plain = bipolar.distance(own, other)
+    assert plain > 1e-4
+    assert bipolar.searched_distance(found, other) < 1e-12
+    assert bipolar.searched_distance(other, found) < 1e-12
+    # The rule: own against own and each side's moved against the other's own, never moved
+    # against moved.
+    other_found = bipolar.describe(bump_mesh, va, vb, levels=8, search_radius=0.15)
+    expected = min(
+        [bipolar.distance(own, other_found[0])]
+        + [bipolar.distance(m, other_found[0]) for m in found[1:]]
+        + [bipolar.distance(own, m) for m in other_found[1:]]
+    )
+    assert bipolar.searched_distance(found, other_found) == pytest.approx(expected, rel=1e-12, abs=1e-15)
+    # A Descriptor is a list of one; no search on either side is the plain distance.
+    assert bipolar.searched_distance(own, other) == bipolar.distance(own, other)
+    assert bipolar.searched_distance([own], [other], mode="icp") == pytest.approx(
+        bipolar.distance(own, other, mode="icp")
+    )
+    with pytest.raises(errors.InputError, match="empty list"):
+        bipolar.searched_distance([], other)
+    with pytest.raises(TypeError, match=r"b\[1\] is not a bipolar.Descriptor"):
+        bipolar.searched_distance(own, [other, 3])
+
+
 def test_face_with_detected_landmarks(face_path, face):
     d = bipolar.describe(face, "outer-eye-right", "outer-eye-left", levels=30, max_level=30)
     assert len(d) > 500

@@ -279,6 +279,55 @@ pub fn distance_details<'py>(
     py.import("json")?.call_method1("loads", (v.to_string(),))
 }
 
+/// A face described with a reference-point search: a list from ``describe(...,
+/// search_radius=)`` (the own descriptor first), or one Descriptor (a list of one).
+fn searched_list<'py>(
+    obj: &Bound<'py, PyAny>,
+    what: &str,
+) -> PyResult<Vec<Bound<'py, PyDescriptor>>> {
+    if let Ok(d) = obj.cast::<PyDescriptor>() {
+        return Ok(vec![d.clone()]);
+    }
+    let list = descriptor_list(obj, what)?;
+    if list.is_empty() {
+        return Err(errors::input(format!(
+            "{what} is an empty list: a searched face is its own descriptor followed by the moved ones"
+        )));
+    }
+    Ok(list)
+}
+
+/// The distance of two faces described with a reference-point search (``describe(...,
+/// search_radius=)`` lists, own descriptor first; a Descriptor counts as a list of one): the
+/// least of the own descriptors' distance and each side's moved descriptors against the other
+/// side's own (``bipolar::least_searched_distance``; moved against moved is not compared, so
+/// the two faces never both move). Symmetric. Failed distances are skipped; the own pair's
+/// error is raised when every one fails.
+#[pyfunction]
+#[pyo3(signature = (a, b, options=None, **kwargs))]
+pub fn searched_distance(
+    py: Python<'_>,
+    a: &Bound<'_, PyAny>,
+    b: &Bound<'_, PyAny>,
+    options: Option<&Bound<'_, PyDistanceOptions>>,
+    kwargs: Option<&Bound<'_, PyDict>>,
+) -> PyResult<f64> {
+    let o = options_arg(py, options, kwargs)?;
+    let (la, lb) = (searched_list(a, "a")?, searched_list(b, "b")?);
+    let da: Vec<&bipolar::Descriptor> = la.iter().map(|d| &d.get().d).collect();
+    let db: Vec<&bipolar::Descriptor> = lb.iter().map(|d| &d.get().d).collect();
+    py.detach(|| {
+        let sets = |l: &[&bipolar::Descriptor]| -> Vec<ComparedSet> {
+            l.iter().map(|d| load(d, o.keep_ambiguous)).collect()
+        };
+        let (sa, sb) = (sets(&da), sets(&db));
+        bipolar::least_searched_distance(&sa[0], &sa[1..], &sb[0], &sb[1..], |x, y| {
+            distance_of(x, y, &o)
+        })
+    })
+    .map_err(errors::shapedist)
+}
+
 /// The symmetric matrix of pairwise distances, zero diagonal, shape (n, n); pairs in parallel
 /// (``threads`` rayon threads, default one per core), each ICP set prepared once.
 #[pyfunction]

@@ -62,6 +62,7 @@ fn _bipolar(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(distance::distance_details, m)?)?;
     m.add_function(wrap_pyfunction!(distance::distance_matrix, m)?)?;
     m.add_function(wrap_pyfunction!(distance::cross_distances, m)?)?;
+    m.add_function(wrap_pyfunction!(distance::searched_distance, m)?)?;
     m.add_function(wrap_pyfunction!(distance::_distance_options_from_dict, m)?)?;
     m.add_function(wrap_pyfunction!(landmark::detect_landmarks, m)?)?;
     m.add_function(wrap_pyfunction!(scan::scan, m)?)?;
