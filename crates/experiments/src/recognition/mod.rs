@@ -145,7 +145,8 @@ pub struct Args {
     pub own_pair_search: bool,
     /// Scan, clean and detect the landmarks of the gallery, probe and sweep scans, write
     /// `detection.csv` (per scan: the detected landmarks' errors or why detection failed) and
-    /// stop, without describing or comparing (`--scans`).
+    /// a report of the errors and landmarks placed against the yaw, and stop, without
+    /// describing or comparing (`--scans`).
     #[arg(long)]
     pub detect_only: bool,
 }
@@ -1604,7 +1605,16 @@ mod tests {
                 assert!((0.0..5.0).contains(&e), "{text}");
             }
         }
-        assert!(!out.join("report.md").exists());
+        // The report: the yaw table and its two figures; nothing of a full run.
+        let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+        assert!(
+            md.contains("landmarks found on") && md.contains("| yaw bin"),
+            "{md}"
+        );
+        for f in ["detection-error-yaw.svg", "detection-placed-yaw.svg"] {
+            assert!(out.join(f).exists(), "{f}");
+        }
+        assert!(!out.join("probes.csv").exists() && !out.join("summary.json").exists());
         std::fs::remove_dir_all(&out).unwrap();
     }
 

@@ -428,7 +428,9 @@ fn failures(faces: &[Face], group: &str) -> Vec<[String; 4]> {
 
 /// `--detect-only`: scans, cleans and detects every face, writes `detection.csv` (per scan its
 /// yaw, noise, each detected landmark's distance from its ground truth or why it is unseen, and
-/// the detector's error when it found nothing) and prints the count and every failure.
+/// the detector's error when it found nothing) and a report with the errors and the share of
+/// landmarks placed against the yaw (table and figures), and prints the count and every
+/// failure.
 fn detect_only(
     model: &FaceModel,
     generic: &GenericModel,
@@ -437,63 +439,79 @@ fn detect_only(
     out: &std::path::Path,
 ) -> Result<()> {
     use landmarks::LandmarkName as L;
+    const NAMES: [L; 3] = [L::OuterEyeRight, L::OuterEyeLeft, L::NoseTip];
+    /// One scan: its outcome, each landmark's error (`None`: not placed) and the reasons.
+    struct Outcome {
+        status: &'static str,
+        err: [Option<f64>; 3],
+        confidence: Option<f64>,
+        why: String,
+    }
     let pb = bar(specs.len(), "scan, clean, detect");
-    let rows: Vec<Vec<String>> = specs
+    let outcomes: Vec<Outcome> = specs
         .par_iter()
         .map(|spec| {
             let r = scan_face(model, generic, spec, scan_opts);
             pb.inc(1);
+            let failed = |status, why| Outcome {
+                status,
+                err: [None; 3],
+                confidence: None,
+                why,
+            };
+            match r {
+                Err(e) => failed("scan or cleaning failed", format!("{e:#}")),
+                Ok(s) => match &s.detected {
+                    Err(e) => failed("not found", e.clone()),
+                    Ok(d) => {
+                        let mut why = Vec::new();
+                        let err = NAMES.map(|n| match d.get(n) {
+                            Ok(l) => Some((l.position - s.truth[n as usize].position).length()),
+                            Err(u) => {
+                                why.push(format!("{}: {u}", n.key()));
+                                None
+                            }
+                        });
+                        Outcome {
+                            status: "found",
+                            err,
+                            confidence: Some(d.confidence),
+                            why: why.join("; "),
+                        }
+                    }
+                },
+            }
+        })
+        .collect();
+    pb.finish();
+    let found = outcomes.iter().filter(|o| o.status == "found").count();
+    let rows: Vec<Vec<String>> = specs
+        .iter()
+        .zip(&outcomes)
+        .map(|(spec, o)| {
             let mut row = vec![
                 spec.name.clone(),
                 format!("{}", spec.settings.yaw_deg),
                 format!("{}", spec.settings.noise_mm),
+                o.status.to_string(),
             ];
-            match r {
-                Err(e) => row.extend([
-                    "scan or cleaning failed".into(),
-                    String::new(),
-                    String::new(),
-                    String::new(),
-                    String::new(),
-                    format!("{e:#}"),
-                ]),
-                Ok(s) => match &s.detected {
-                    Err(e) => row.extend([
-                        "not found".into(),
-                        String::new(),
-                        String::new(),
-                        String::new(),
-                        String::new(),
-                        e.clone(),
-                    ]),
-                    Ok(d) => {
-                        let mut why = Vec::new();
-                        row.push("found".into());
-                        for n in [L::OuterEyeRight, L::OuterEyeLeft, L::NoseTip] {
-                            row.push(match d.get(n) {
-                                Ok(l) => format!(
-                                    "{:.2}",
-                                    (l.position - s.truth[n as usize].position).length()
-                                ),
-                                Err(u) => {
-                                    why.push(format!("{}: {u}", n.key()));
-                                    "unseen".into()
-                                }
-                            });
-                        }
-                        row.push(format!("{:.3}", d.confidence));
-                        row.push(why.join("; "));
-                    }
-                },
-            }
+            row.extend(o.err.iter().map(|e| match (e, o.status) {
+                (Some(e), _) => format!("{e:.2}"),
+                (None, "found") => "unseen".into(),
+                (None, _) => String::new(),
+            }));
+            row.push(o.confidence.map_or(String::new(), |c| format!("{c:.3}")));
+            row.push(o.why.clone());
             row
         })
         .collect();
-    pb.finish();
-    let path = out.join("detection.csv");
-    std::fs::create_dir_all(out)?;
-    crate::report::write_csv(
-        &path,
+    let mut rep = Report::new(out, "Landmark detection on the recognition's scans")?;
+    rep.para(&format!(
+        "`--detect-only`: landmarks found on {found} of {} scans (gallery, probes and sweeps of the run; `landmarks::detect_visible`, seen from the scanner). Errors are distances from the ground truth carried through the scanner (mm); a landmark not placed (not found, or unseen) has none.",
+        outcomes.len()
+    ));
+    rep.csv(
+        "detection.csv",
         &[
             "scan",
             "yaw (degrees)",
@@ -507,10 +525,94 @@ fn detect_only(
         ],
         &rows,
     )?;
-    let found = rows.iter().filter(|r| r[3] == "found").count();
+    // Against the yaw, in 10-degree bins (centres -40 ... 40; 45 degrees counts as 40).
+    let bin = |yaw: f64| ((yaw / 10.0).round() as i64).clamp(-4, 4) * 10;
+    let bins: std::collections::BTreeMap<i64, Vec<&Outcome>> =
+        specs
+            .iter()
+            .zip(&outcomes)
+            .fold(Default::default(), |mut m, (spec, o)| {
+                m.entry(bin(spec.settings.yaw_deg)).or_default().push(o);
+                m
+            });
+    let mut table = Vec::new();
+    let mut med_series: Vec<Vec<(f64, f64)>> = vec![Vec::new(); 3];
+    let mut placed_series: Vec<Vec<(f64, f64)>> = vec![Vec::new(); 3];
+    for (&b, os) in &bins {
+        let mut row = vec![format!("{b}"), os.len().to_string()];
+        for k in 0..3 {
+            let errs: Vec<f64> = os.iter().filter_map(|o| o.err[k]).collect();
+            let placed = errs.len() as f64 / os.len() as f64;
+            let med = median(errs.clone());
+            row.push(format!("{:.0} %", 100.0 * placed));
+            row.push(if errs.is_empty() {
+                "-".into()
+            } else {
+                format!("{med:.2} / {:.2}", p95(errs.clone()))
+            });
+            placed_series[k].push((b as f64, 100.0 * placed));
+            if !errs.is_empty() {
+                med_series[k].push((b as f64, med));
+            }
+        }
+        table.push(row);
+    }
+    rep.table(
+        &[
+            "yaw bin (degrees)",
+            "scans",
+            "right outer corner placed",
+            "its error median / p95 (mm)",
+            "left outer corner placed",
+            "its error median / p95 (mm)",
+            "nose tip placed",
+            "its error median / p95 (mm)",
+        ],
+        &table,
+    );
+    let names = ["right outer corner", "left outer corner", "nose tip"];
+    let series = |v: Vec<Vec<(f64, f64)>>| -> Vec<Series> {
+        v.into_iter()
+            .zip(names)
+            .map(|(pts, n)| Series::new(n, pts))
+            .collect()
+    };
+    crate::report::line_plot(
+        &rep.path("detection-error-yaw.svg"),
+        "Detection error against yaw (median over the landmarks placed)",
+        "yaw (degrees, 10-degree bins)",
+        "median error (mm)",
+        &series(med_series),
+    )?;
+    rep.figure(
+        "detection-error-yaw.svg",
+        "Median detection error per yaw bin",
+    );
+    crate::report::line_plot(
+        &rep.path("detection-placed-yaw.svg"),
+        "Landmarks placed against yaw",
+        "yaw (degrees, 10-degree bins)",
+        "placed (% of the bin's scans)",
+        &series(placed_series),
+    )?;
+    rep.figure(
+        "detection-placed-yaw.svg",
+        "Share of scans on which each landmark was placed (not found or unseen: not placed)",
+    );
+    let failures: Vec<String> = rows
+        .iter()
+        .filter(|r| r[3] != "found" || !r[8].is_empty())
+        .map(|r| format!("{}: {}: {}", r[0], r[3], r[8]))
+        .collect();
+    if !failures.is_empty() {
+        rep.heading(2, "Not found or not placed");
+        rep.list(&failures);
+    }
+    rep.png_twins()?;
+    let path = rep.finish()?;
     eprintln!("landmarks found on {found} of {} scans", rows.len());
-    for r in rows.iter().filter(|r| r[3] != "found" || !r[8].is_empty()) {
-        eprintln!("  {}: {}: {}", r[0], r[3], r[8]);
+    for f in &failures {
+        eprintln!("  {f}");
     }
     println!("{}", path.display());
     Ok(())
