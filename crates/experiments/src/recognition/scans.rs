@@ -468,7 +468,14 @@ fn detect_only(
                         let err = NAMES.map(|n| match d.get(n) {
                             Ok(l) => Some((l.position - s.truth[n as usize].position).length()),
                             Err(u) => {
-                                why.push(format!("{}: {u}", n.key()));
+                                // Where the fitted face puts it: how far the pole would be
+                                // if it were used anyway.
+                                let k = n as usize;
+                                let off = (d.predicted[k] - s.truth[k].position).length();
+                                why.push(format!(
+                                    "{}: {u}; the fitted face predicts it {off:.2} mm from its ground truth",
+                                    n.key()
+                                ));
                                 None
                             }
                         });
