@@ -578,34 +578,32 @@ fn detect_only(
         &table,
     );
     let names = ["right outer corner", "left outer corner", "nose tip"];
-    let series = |v: Vec<Vec<(f64, f64)>>| -> Vec<Series> {
-        v.into_iter()
+    let figures = [
+        (
+            "detection-error-yaw.svg",
+            "Detection error against yaw (median over the landmarks placed)",
+            "median error (mm)",
+            med_series,
+            "Median detection error per yaw bin",
+        ),
+        (
+            "detection-placed-yaw.svg",
+            "Landmarks placed against yaw",
+            "placed (% of the bin's scans)",
+            placed_series,
+            "Share of scans on which each landmark was placed (not found or unseen: not placed)",
+        ),
+    ];
+    for (file, title, y_label, per_landmark, caption) in figures {
+        let series: Vec<Series> = per_landmark
+            .into_iter()
             .zip(names)
             .map(|(pts, n)| Series::new(n, pts))
-            .collect()
-    };
-    crate::report::line_plot(
-        &rep.path("detection-error-yaw.svg"),
-        "Detection error against yaw (median over the landmarks placed)",
-        "yaw (degrees, 10-degree bins)",
-        "median error (mm)",
-        &series(med_series),
-    )?;
-    rep.figure(
-        "detection-error-yaw.svg",
-        "Median detection error per yaw bin",
-    );
-    crate::report::line_plot(
-        &rep.path("detection-placed-yaw.svg"),
-        "Landmarks placed against yaw",
-        "yaw (degrees, 10-degree bins)",
-        "placed (% of the bin's scans)",
-        &series(placed_series),
-    )?;
-    rep.figure(
-        "detection-placed-yaw.svg",
-        "Share of scans on which each landmark was placed (not found or unseen: not placed)",
-    );
+            .collect();
+        let x_label = "yaw (degrees, 10-degree bins)";
+        crate::report::line_plot(&rep.path(file), title, x_label, y_label, &series)?;
+        rep.figure(file, caption);
+    }
     let failures: Vec<String> = rows
         .iter()
         .filter(|r| r[3] != "found" || !r[8].is_empty())
