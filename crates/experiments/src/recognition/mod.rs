@@ -143,6 +143,11 @@ pub struct Args {
     /// moved fields and 144 more descriptors.
     #[arg(long)]
     pub own_pair_search: bool,
+    /// Weight of the second least pair distance in the bipolar score with the least over the
+    /// three pairs (`--scans`; 0, the default: the least alone; 0.25 gives 0.75 x least + 0.25 x
+    /// second least, which asks two pairs to agree).
+    #[arg(long, default_value_t = 0.0)]
+    pub pair_second: f64,
     /// Scan, clean and detect the landmarks of the gallery, probe and sweep scans, write
     /// `detection.csv` (per scan: the detected landmarks' errors or why detection failed) and
     /// a report of the errors and landmarks placed against the yaw, and stop, without
@@ -312,6 +317,8 @@ struct Described {
     pair: Pair,
     /// Its score is the least distance over the three pairs ([`DescribeOptions::least_pair`]).
     least_pair: bool,
+    /// The weight of the second least pair distance ([`DescribeOptions::second_weight`]).
+    second_weight: f64,
     /// Bipolar descriptors from moved poles, per [`Pair`] (`DescribeOptions::ref_search`): of
     /// `pair`, or of all three with [`DescribeOptions::search_all_pairs`]; else empty.
     bip_alt: [Vec<bipolar::Descriptor>; 3],
@@ -355,6 +362,9 @@ struct DescribeOptions {
     /// With `least_pair`, the reference-point search moves the poles of all three pairs, not
     /// only the probe's own (the default; `Args::own_pair_search` turns it off).
     search_all_pairs: bool,
+    /// With `least_pair`, the weight of the second least pair distance in the score
+    /// (`Args::pair_second`; 0: the least alone).
+    second_weight: f64,
 }
 
 /// The fields of a face cut off at 1.4 |q - r| (corners r, q; nose tip, when asked for: else
@@ -602,6 +612,7 @@ fn describe_face(
         bip,
         pair,
         least_pair: o.least_pair,
+        second_weight: o.second_weight,
         bip_alt,
         pol,
         facial,
@@ -1005,19 +1016,26 @@ fn bipolar_pairs(x: &Described, y: &Described) -> [f64; 3] {
 }
 
 /// The bipolar score of a probe `x` from its distances by each pair `d` ([`bipolar_pairs`]):
-/// the least of them ([`Described::least_pair`]; `f64::min` skips a failed one), else its own
-/// pair's.
+/// the least of them ([`Described::least_pair`]; with [`Described::second_weight`] blended with
+/// the second least), else its own pair's.
 fn bipolar_score(x: &Described, d: [f64; 3]) -> f64 {
-    pair_score(d, x.pair, x.least_pair)
+    pair_score(d, x.pair, x.least_pair, x.second_weight)
 }
 
-/// The least of the distances by each pair `d` (`least`; NaN ones skipped, NaN when all are),
-/// else the one of the probe's pair `own`.
-fn pair_score(d: [f64; 3], own: Pair, least: bool) -> f64 {
-    if least {
-        d.into_iter().fold(f64::NAN, f64::min)
-    } else {
-        d[own as usize]
+/// With `least`: `(1 - second)` x the least of the distances by each pair `d` + `second` x the
+/// second least (NaN ones skipped; the least alone when only one is a number, or when
+/// `second` is 0; NaN when none is); else the one of the probe's pair `own`.
+fn pair_score(d: [f64; 3], own: Pair, least: bool, second: f64) -> f64 {
+    if !least {
+        return d[own as usize];
+    }
+    let mut f: Vec<f64> = d.into_iter().filter(|x| !x.is_nan()).collect();
+    f.sort_by(f64::total_cmp);
+    match f[..] {
+        [] => f64::NAN,
+        [a] => a,
+        [a, ..] if second == 0.0 => a,
+        [a, b, ..] => (1.0 - second) * a + second * b,
     }
 }
 
@@ -1407,6 +1425,7 @@ pub fn run(args: Args) -> Result<()> {
         side_pair_deg: None,
         least_pair: false,
         search_all_pairs: false,
+        second_weight: 0.0,
     };
     // The reference-point search is the probes' (the gallery keeps its one description); its
     // radius is given in mm, the model is in cm.
@@ -1716,13 +1735,23 @@ mod tests {
     #[test]
     fn the_score_is_the_least_pair_distance_or_the_probe_pair() {
         let nan = f64::NAN;
-        assert_eq!(pair_score([0.3, 0.1, 0.2], Pair::Corners, true), 0.1);
-        assert_eq!(pair_score([nan, 0.4, 0.2], Pair::RightNose, true), 0.2);
-        assert_eq!(pair_score([0.3, nan, nan], Pair::LeftNose, true), 0.3);
-        assert!(pair_score([nan; 3], Pair::Corners, true).is_nan());
-        assert_eq!(pair_score([0.3, 0.1, 0.2], Pair::Corners, false), 0.3);
-        assert_eq!(pair_score([0.3, 0.1, 0.2], Pair::LeftNose, false), 0.2);
-        assert!(pair_score([0.3, nan, 0.2], Pair::RightNose, false).is_nan());
+        assert_eq!(pair_score([0.3, 0.1, 0.2], Pair::Corners, true, 0.0), 0.1);
+        assert_eq!(pair_score([nan, 0.4, 0.2], Pair::RightNose, true, 0.0), 0.2);
+        assert_eq!(pair_score([0.3, nan, nan], Pair::LeftNose, true, 0.0), 0.3);
+        assert!(pair_score([nan; 3], Pair::Corners, true, 0.0).is_nan());
+        assert_eq!(pair_score([0.3, 0.1, 0.2], Pair::Corners, false, 0.0), 0.3);
+        assert_eq!(
+            pair_score([0.3, 0.1, 0.2], Pair::LeftNose, false, 0.25),
+            0.2
+        );
+        assert!(pair_score([0.3, nan, 0.2], Pair::RightNose, false, 0.0).is_nan());
+        // The blend: 0.75 x 0.1 + 0.25 x 0.2; NaN skipped; one number alone is the score.
+        let b = pair_score([0.3, 0.1, 0.2], Pair::Corners, true, 0.25);
+        assert!((b - 0.125).abs() < 1e-15, "{b}");
+        let b = pair_score([nan, 0.4, 0.2], Pair::Corners, true, 0.5);
+        assert!((b - 0.3).abs() < 1e-15, "{b}");
+        assert_eq!(pair_score([nan, 0.4, nan], Pair::Corners, true, 0.25), 0.4);
+        assert!(pair_score([nan; 3], Pair::Corners, true, 0.25).is_nan());
     }
 
     /// A flat sheet of `nx` x `ny` squares of 2 mm, its landmarks at the grid points `at` (r, q,
@@ -1791,6 +1820,7 @@ mod tests {
             side_pair_deg: None,
             least_pair: true,
             search_all_pairs: true,
+            second_weight: 0.0,
         };
         let surface = Surface::new(m.clone());
         let run = |searched: [bool; 3], shared: bool| {

@@ -639,6 +639,12 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
     let base = args.scan.settings();
     let generic =
         GenericModel::default_model().map_err(|e| anyhow::anyhow!("landmark model: {e}"))?;
+    if !(0.0..=1.0).contains(&args.pair_second) {
+        bail!(
+            "--pair-second {} (the weight of the second least pair distance must be in [0, 1])",
+            args.pair_second
+        );
+    }
     if !(args.scan_edge.is_finite() && args.scan_edge >= 0.0) {
         bail!(
             "--scan-edge {} mm (must be 0, for no decimation, or positive)",
@@ -668,6 +674,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         view_match: (!args.no_view_match).then_some(args.view_match),
         side_pair_deg: (!args.no_side_pair).then_some(args.side_pair),
         least_pair: !(args.no_side_pair || args.own_pair_only),
+        second_weight: args.pair_second,
         search_all_pairs: !args.own_pair_search,
     };
     let elastic = elastic_options(args.curve_samples);
@@ -855,7 +862,11 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
             + &dopt
                 .side_pair_deg
                 .map(|a| format!("; side pairs: every face is also described by each outer eye corner with the nose tip (their lens above the nose tip's horizontal plane); a probe turned by more than {a} degrees (its eye line against its scanner), or with an outer eye corner off the scan, takes its nearer (or remaining) corner's side pair as its own pair, which the reference-point search moves; {}", if dopt.least_pair {
-                    format!("its score is the least distance over the three pairs (outer eye corners, right corner and nose tip, left corner and nose tip), each view-matched{}", if dopt.search_all_pairs && dopt.ref_search.is_some() {
+                    format!("its score is the least distance over the three pairs (outer eye corners, right corner and nose tip, left corner and nose tip){}, each view-matched{}", if dopt.second_weight > 0.0 {
+                        format!(" blended with the second least ({} x least + {} x second least)", 1.0 - dopt.second_weight, dopt.second_weight)
+                    } else {
+                        String::new()
+                    }, if dopt.search_all_pairs && dopt.ref_search.is_some() {
                         ", and the reference-point search moves the poles of all three pairs (a nose tip's first direction toward the corners' midpoint)"
                     } else {
                         ""
