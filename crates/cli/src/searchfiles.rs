@@ -39,8 +39,8 @@ pub fn own_of(path: &Path) -> Option<PathBuf> {
     search_number(&own, name).map(|_| own)
 }
 
-/// The search files beside `own`, in the order of their numbers.
-pub fn search_files(own: &Path) -> anyhow::Result<Vec<PathBuf>> {
+/// The search files beside `own` with their numbers, in the order of their numbers.
+fn numbered(own: &Path) -> anyhow::Result<Vec<(usize, PathBuf)>> {
     let mut found: Vec<(usize, PathBuf)> = Vec::new();
     let dir = match own.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
@@ -55,7 +55,12 @@ pub fn search_files(own: &Path) -> anyhow::Result<Vec<PathBuf>> {
         }
     }
     found.sort();
-    Ok(found.into_iter().map(|(_, p)| p).collect())
+    Ok(found)
+}
+
+/// The search files beside `own`, in the order of their numbers.
+pub fn search_files(own: &Path) -> anyhow::Result<Vec<PathBuf>> {
+    Ok(numbered(own)?.into_iter().map(|(_, p)| p).collect())
 }
 
 /// Removes the search files beside `own` numbered above `keep` (left by an earlier `describe`
@@ -63,12 +68,9 @@ pub fn search_files(own: &Path) -> anyhow::Result<Vec<PathBuf>> {
 /// returns how many.
 pub fn remove_stale(own: &Path, keep: usize) -> anyhow::Result<usize> {
     let mut n = 0;
-    for p in search_files(own)? {
-        let name = p.file_name().and_then(|n| n.to_str()).unwrap_or_default();
-        if search_number(own, name).is_some_and(|k| k > keep) {
-            std::fs::remove_file(&p).with_context(|| format!("removing {}", p.display()))?;
-            n += 1;
-        }
+    for (_, p) in numbered(own)?.into_iter().filter(|(k, _)| *k > keep) {
+        std::fs::remove_file(&p).with_context(|| format!("removing {}", p.display()))?;
+        n += 1;
     }
     Ok(n)
 }

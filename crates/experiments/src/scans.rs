@@ -10,7 +10,7 @@
 use anyhow::Result;
 use facemodel::FaceModel;
 use indicatif::ProgressBar;
-use landmarks::{DetectOptions, GenericModel, LandmarkName, VisibleLandmarks};
+use landmarks::{DetectOptions, GenericModel, LandmarkName, Unseen, VisibleLandmarks};
 use meshcore::{DVec3, TriMesh};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -192,13 +192,31 @@ impl ScannedFace {
 
     /// Ground-truth vertices of the outer eye corners and the nose tip, or why one is missing.
     pub fn truth_vertices(&self) -> Result<[u32; 3], String> {
+        let [r, q, nose] = REFERENCE_LANDMARKS;
         Ok([
-            self.truth_vertex(LandmarkName::OuterEyeRight)?,
-            self.truth_vertex(LandmarkName::OuterEyeLeft)?,
-            self.truth_vertex(LandmarkName::NoseTip)?,
+            self.truth_vertex(r)?,
+            self.truth_vertex(q)?,
+            self.truth_vertex(nose)?,
         ])
     }
+
+    /// The distance (mm) of detected landmark `n` from its ground truth, or why the detector
+    /// left it unseen; `None` when detection failed.
+    pub fn detection_error(&self, n: LandmarkName) -> Option<Result<f64, Unseen>> {
+        let d = self.detected.as_ref().ok()?;
+        Some(
+            d.get(n)
+                .map(|l| (l.position - self.truth[n as usize].position).length()),
+        )
+    }
 }
+
+/// The landmarks the descriptors take their poles from: the outer eye corners and the nose tip.
+pub const REFERENCE_LANDMARKS: [LandmarkName; 3] = [
+    LandmarkName::OuterEyeRight,
+    LandmarkName::OuterEyeLeft,
+    LandmarkName::NoseTip,
+];
 
 /// The direction toward the scanner in the frame of every scan `rangescan` writes (it looks
 /// down the z axis).

@@ -997,8 +997,9 @@ fn icp_points(mesh: &TriMesh, n: usize) -> Vec<DVec3> {
 /// The bipolar distance of a probe `x` to a gallery face `y` by each [`Pair`] (indexed by its
 /// discriminant; NaN where a side has no descriptor or the distance fails). With view matching,
 /// against the gallery face as the probe's scanner would see it. With a reference-point search,
-/// a searched pair's distance is the least over its descriptors (`f64::min` skips a failed
-/// one).
+/// a searched pair's distance is `bipolar::least_searched_distance` of the probe's own and
+/// moved descriptors against the gallery's one (a failed one skipped; when the probe's own
+/// failed, the least over its moved ones).
 fn bipolar_pairs(x: &Described, y: &Described) -> [f64; 3] {
     let matched = y.view.as_ref().and_then(|v| v.describe_from(&x.lm_pos));
     Pair::ALL.map(|p| {
@@ -1007,11 +1008,12 @@ fn bipolar_pairs(x: &Described, y: &Described) -> [f64; 3] {
             return f64::NAN;
         };
         let yb = matched.as_ref().and_then(|m| m[i].as_ref()).unwrap_or(own);
-        let d = dist(&x.bip[i], yb).unwrap_or(f64::NAN);
-        x.bip_alt[i]
-            .iter()
-            .filter_map(|a| dist(a, yb).ok())
-            .fold(d, f64::min)
+        let (xa, moved) = match (&x.bip[i], x.bip_alt[i].split_first()) {
+            (Ok(xa), _) => (xa, &x.bip_alt[i][..]),
+            (Err(_), Some((first, rest))) => (first, rest),
+            (Err(_), None) => return f64::NAN,
+        };
+        bipolar::least_searched_distance(xa, moved, yb, &[], dist).unwrap_or(f64::NAN)
     })
 }
 

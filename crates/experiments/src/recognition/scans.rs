@@ -22,7 +22,7 @@ use crate::pipeline::{bar, resolve_methods};
 use crate::report::{line_plot, Report, Series};
 use crate::scans::{
     sample_weights, scan_face, scan_seed, FaceSpec, ScanSetOptions, ScanSettings, ScannedFace,
-    MAX_SNAP_MM, VIEW_MATCH_INCIDENCE_DEG,
+    MAX_SNAP_MM, REFERENCE_LANDMARKS, VIEW_MATCH_INCIDENCE_DEG,
 };
 use crate::walk::Walker;
 use anyhow::{bail, Context, Result};
@@ -228,15 +228,12 @@ fn describe_spec(
     face.secs[1] = s.times.clean.as_secs_f64();
     face.secs[2] = s.times.detect.as_secs_f64();
     face.pts = icp_points(&s.mesh, icp_n);
-    if let (Ok(d), Ok(t)) = (&s.detected, s.truth_vertices()) {
-        let _ = t;
-        use landmarks::LandmarkName as L;
-        let e = |n: L| {
-            d.get(n).map_or(f64::INFINITY, |l| {
-                (l.position - s.truth[n as usize].position).length()
-            })
-        };
-        face.det_err = Some([e(L::OuterEyeRight), e(L::OuterEyeLeft), e(L::NoseTip)]);
+    if s.detected.is_ok() && s.truth_vertices().is_ok() {
+        // An unseen landmark counts as infinitely far off.
+        face.det_err = Some(REFERENCE_LANDMARKS.map(|n| {
+            s.detection_error(n)
+                .map_or(f64::INFINITY, |e| e.unwrap_or(f64::INFINITY))
+        }));
     }
     let t = Instant::now();
     // The reference-point search is the probes' (the gallery keeps its one description).
@@ -438,8 +435,6 @@ fn detect_only(
     scan_opts: &ScanSetOptions,
     out: &std::path::Path,
 ) -> Result<()> {
-    use landmarks::LandmarkName as L;
-    const NAMES: [L; 3] = [L::OuterEyeRight, L::OuterEyeLeft, L::NoseTip];
     /// One scan: its outcome, each landmark's error (`None`: not placed) and the reasons.
     struct Outcome {
         status: &'static str,
@@ -465,9 +460,10 @@ fn detect_only(
                     Err(e) => failed("not found", e.clone()),
                     Ok(d) => {
                         let mut why = Vec::new();
-                        let err = NAMES.map(|n| match d.get(n) {
-                            Ok(l) => Some((l.position - s.truth[n as usize].position).length()),
-                            Err(u) => {
+                        let err = REFERENCE_LANDMARKS.map(|n| match s.detection_error(n) {
+                            Some(Ok(e)) => Some(e),
+                            None => None,
+                            Some(Err(u)) => {
                                 // Where the fitted face puts it: how far the pole would be
                                 // if it were used anyway.
                                 let k = n as usize;
