@@ -11,6 +11,7 @@
 //! probe x gallery pairs, and the ROC curve. Results: `report.md`, `summary.json`, `roc.svg` (and `roc.png`),
 //! CSV tables, in the output folder printed on the last line.
 
+mod pool;
 mod scans;
 
 use crate::curves::{
@@ -154,6 +155,21 @@ pub struct Args {
     /// describing or comparing (`--scans`).
     #[arg(long)]
     pub detect_only: bool,
+    /// Run the benchmark once per seed (comma-separated; `--seed` is then ignored), each into
+    /// `OUT/seed-S/`, and pool the runs probe by probe into `OUT/report.md` and `pooled.csv`:
+    /// rank-1 over all the seeds' probes with its 95 % interval, the mean EER, the paired
+    /// comparison with McNemar's test.
+    #[arg(long, value_delimiter = ',')]
+    pub seeds: Vec<u64>,
+    /// With `--seeds`: pool the runs already in `OUT/seed-S/` without running them.
+    #[arg(long, requires = "seeds")]
+    pub pool_only: bool,
+    /// Keep only these identities (comma-separated numbers, `--scans`): their gallery scans,
+    /// probes and sweep scans, with the scan seeds, yaws and noises of the whole run, so that a
+    /// run's misses can be rerun and looked at in a minute (ranks are then among these
+    /// identities only).
+    #[arg(long, value_delimiter = ',')]
+    pub only_identities: Vec<usize>,
 }
 
 /// One sampled face.
@@ -762,7 +778,8 @@ impl ViewSource {
     /// description fails (the caller then uses the face's own description).
     fn describe_from(&self, probe_lm: &[DVec3; 3]) -> Option<[Option<bipolar::Descriptor>; 3]> {
         let m = &self.mesh;
-        let own = [self.lm.r, self.lm.q, self.lm.nose].map(|v| m.position(v));
+        // A lost corner aligns by its place (true or predicted).
+        let own = self.lm.positions(m);
         let crate::scans::ViewCut {
             mesh: cut,
             map,
@@ -772,24 +789,28 @@ impl ViewSource {
         let cut = surface.mesh();
         // A landmark whose faces are all gone is placed as a probe's ground truth is: on the
         // nearest vertex left, within `MAX_SNAP_MM`.
-        let mut lm = [0u32; 3];
-        for (k, v) in [self.lm.r, self.lm.q, self.lm.nose].into_iter().enumerate() {
-            lm[k] = match map[v as usize] {
-                u32::MAX => match crate::scans::nearest_vertex(cut, m.position(v)) {
-                    Some((w, d)) if d <= crate::scans::MAX_SNAP_MM => w,
-                    _ => return None,
-                },
-                w => w,
-            };
-        }
-        let lm = Lm::new(lm[0], lm[1], lm[2]);
+        let place = |v: u32| match map[v as usize] {
+            u32::MAX => match crate::scans::nearest_vertex(cut, m.position(v)) {
+                Some((w, d)) if d <= crate::scans::MAX_SNAP_MM => Some(w),
+                _ => None,
+            },
+            w => Some(w),
+        };
+        let nose = place(self.lm.nose)?;
+        // A lost corner's vertex is the nose tip's, as in [`lm_from`].
+        let corner = |v: u32, right: bool| match self.lm.lost {
+            Some(l) if l.right == right => Some(nose),
+            _ => place(v),
+        };
+        let lm = Lm {
+            r: corner(self.lm.r, true)?,
+            q: corner(self.lm.q, false)?,
+            nose,
+            lost: self.lm.lost,
+        };
         let solver = geodesic::new_solver(cut, self.method).ok()?;
         let f = fields(cut, solver.as_ref(), lm, true).ok()?;
-        let (r, q, nose) = (
-            cut.position(lm.r),
-            cut.position(lm.q),
-            cut.position(lm.nose),
-        );
+        let [r, q, nose] = lm.positions(cut);
         let frame = face_frame(cut, r, q, nose);
         let seen = match self.opts.max_incidence_deg {
             Some(deg) => Some(crate::scans::seen_within(cut, Some(toward), deg).ok()?),
@@ -820,8 +841,8 @@ struct Metrics {
     ms_per_description: f64,
     #[serde(skip)]
     roc: Vec<(f64, f64)>,
-    /// Per probe: identified at rank 1 ([`identified`]).
-    #[serde(skip)]
+    /// Per probe, in the run's probe order: identified at rank 1 ([`identified`]); in
+    /// `summary.json`, so that runs of several seeds can be pooled probe by probe.
     identified: Vec<bool>,
 }
 
@@ -1356,6 +1377,9 @@ fn roc_figure(rep: &mut Report, all: &[Metrics], file: &str, title: &str) -> Res
 
 /// Runs the benchmark; prints the output folder on the last line.
 pub fn run(args: Args) -> Result<()> {
+    if !args.seeds.is_empty() {
+        return pool::run(args);
+    }
     let t0 = Instant::now();
     let model_dir = args.io.model_dir();
     let model = FaceModel::load(&model_dir)
@@ -1636,6 +1660,38 @@ mod tests {
             assert!(out.join(f).exists(), "{f}");
         }
         assert!(!out.join("probes.csv").exists() && !out.join("summary.json").exists());
+        // `--only-identities 1`: identity 1's scans alone, with the whole run's seeds, yaws and
+        // noises (the same rows byte for byte).
+        let only = <Cli as clap::Parser>::parse_from([
+            "recognition",
+            "--scans",
+            "--identities",
+            "2",
+            "--expressions",
+            "2",
+            "--no-sweeps",
+            "--detect-only",
+            "--only-identities",
+            "1",
+            "--model",
+            &model,
+            "--out",
+            &dir,
+        ])
+        .args;
+        run(only.clone()).unwrap();
+        let again = std::fs::read_to_string(out.join("detection.csv")).unwrap();
+        let id1: Vec<&str> = text.lines().filter(|l| l.starts_with("id01")).collect();
+        let got: Vec<&str> = again.lines().skip(1).collect();
+        assert_eq!(got, id1);
+        // An identity the run does not have is an error naming it.
+        let e = run(Args {
+            only_identities: vec![2],
+            ..only
+        })
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("--only-identities 2"), "{e}");
         std::fs::remove_dir_all(&out).unwrap();
     }
 
@@ -1886,6 +1942,54 @@ mod tests {
         assert!(pair_refs(&m, &f, lost, Pair::LeftNose, frame).is_err());
         let side = pair_refs(&m, &f, lost, Pair::RightNose, frame).unwrap();
         assert!((side.d - (r - nose).length()).abs() < 1e-9);
+    }
+
+    #[test]
+    fn view_matching_keeps_a_face_with_a_lost_corner() {
+        // A 100 x 60 mm sheet, seen by a probe turned 30 degrees about the vertical.
+        let (m, lm, _, _, _) = plane_face(50, 30, [(5, 20), (45, 20), (25, 5)]);
+        let o = DescribeOptions {
+            levels: 8,
+            sectors: 8,
+            iso_levels: None,
+            boundary_margin: None,
+            max_incidence_deg: None,
+            ref_search: None,
+            view_match: Some(10.0),
+            side_pair_deg: Some(30.0),
+            least_pair: true,
+            search_all_pairs: true,
+            second_weight: 0.0,
+        };
+        let source = |lm: Lm| ViewSource {
+            mesh: m.clone(),
+            lm,
+            method: geodesic::Method::Exact,
+            opts: o.clone(),
+            min_angle_deg: 10.0,
+        };
+        let [r, q, nose] = lm.positions(&m);
+        let turn = DQuat::from_rotation_y(30f64.to_radians());
+        let probe = [r, q, nose].map(|p| turn * p);
+        let whole = source(lm).describe_from(&probe).unwrap();
+        assert!(whole.iter().all(Option::is_some));
+        // The left corner lost at its true place: the cut is the same and the right side
+        // pair's descriptor too (its frame from the lost corner's place); no other pair.
+        let lost = Lm {
+            q: lm.nose,
+            lost: Some(Lost {
+                right: false,
+                position: q,
+            }),
+            ..lm
+        };
+        let cut = source(lost).describe_from(&probe).unwrap();
+        assert!(cut[Pair::Corners as usize].is_none() && cut[Pair::LeftNose as usize].is_none());
+        let right = Pair::RightNose as usize;
+        assert_eq!(cut[right], whole[right]);
+        assert!(!cut[right].as_ref().unwrap().points.is_empty());
+        // Below the angle, no cut.
+        assert!(source(lost).describe_from(&[r, q, nose]).is_none());
     }
 
     #[test]

@@ -265,7 +265,7 @@ fn describe_spec(
     face.secs[3] = t.elapsed().as_secs_f64();
     if let (true, Some(min_angle_deg)) = (keep_mesh, dopt.view_match) {
         for (d, lm) in face.desc.iter_mut().zip(lms) {
-            if let (Ok(d), Ok(lm @ Lm { lost: None, .. })) = (d, lm) {
+            if let (Ok(d), Ok(lm)) = (d, lm) {
                 d.view = Some(Box::new(ViewSource {
                     mesh: s.mesh.clone(),
                     lm,
@@ -719,6 +719,29 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
                 .collect()
         })
         .collect();
+    if let Some(&i) = args.only_identities.iter().find(|&&i| i >= identities) {
+        bail!(
+            "--only-identities {i}: the run has identities 0 to {}",
+            identities - 1
+        );
+    }
+    // The iso-curvature levels come from the whole run's first gallery scan.
+    let first_gallery = gallery_specs[0].clone();
+    let (gallery_specs, probe_specs, sweep_specs) = if args.only_identities.is_empty() {
+        (gallery_specs, probe_specs, sweep_specs)
+    } else {
+        let keep = |specs: Vec<FaceSpec>| -> Vec<FaceSpec> {
+            specs
+                .into_iter()
+                .filter(|s| args.only_identities.contains(&s.identity))
+                .collect()
+        };
+        let sweeps = sweep_specs
+            .into_iter()
+            .map(|groups| groups.into_iter().map(keep).collect())
+            .collect();
+        (keep(gallery_specs), keep(probe_specs), sweeps)
+    };
     if args.detect_only {
         let specs: Vec<&FaceSpec> = gallery_specs
             .iter()
@@ -735,7 +758,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         let first = scan_face(
             model,
             &generic,
-            &gallery_specs[0],
+            &first_gallery,
             &ScanSetOptions {
                 detect: None,
                 ..scan_opts.clone()
@@ -744,12 +767,12 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         .with_context(|| {
             format!(
                 "scanning {} for the iso-curvature levels",
-                gallery_specs[0].name
+                first_gallery.name
             )
         })?;
         let [r, q, nose] = first
             .truth_vertices()
-            .map_err(|e| anyhow::anyhow!("{}: {e}", gallery_specs[0].name))?;
+            .map_err(|e| anyhow::anyhow!("{}: {e}", first_gallery.name))?;
         let solver = geodesic::new_solver(&first.mesh, method)?;
         dopt.iso_levels = Some(iso_levels_of(
             &first.mesh,
@@ -876,6 +899,12 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         args.curve_samples,
         args.iso_levels,
     ));
+    if !args.only_identities.is_empty() {
+        rep.para(&format!(
+            "Only identities {:?} of the {identities} (`--only-identities`): their scans as in the whole run, ranks among them alone.",
+            args.only_identities
+        ));
+    }
     rep.heading(2, "Main run");
     results_table(&mut rep, &main, "results.csv")?;
     paired_table(&mut rep, &main);
