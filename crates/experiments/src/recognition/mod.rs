@@ -155,6 +155,17 @@ pub struct Args {
     /// describing or comparing (`--scans`).
     #[arg(long)]
     pub detect_only: bool,
+    /// An outer eye corner the detector reports unseen is placed at the vertex nearest where
+    /// the fitted face predicts it (within 3 mm of the cleaned scan) instead of being lost, so
+    /// that the corners' pair and its side pair still describe the face (`--scans`; the
+    /// landmark stays unseen in `detection.csv` and `landmarks.csv`).
+    #[arg(long)]
+    pub predicted_corners: bool,
+    /// Keep only the probes whose name starts with one of these (comma-separated, e.g.
+    /// `id01-e2,id27`; `--scans`), against the whole gallery: their ranks are those of the
+    /// whole run.
+    #[arg(long, value_delimiter = ',')]
+    pub only_probes: Vec<String>,
     /// Run the benchmark once per seed (comma-separated; `--seed` is then ignored), each into
     /// `OUT/seed-S/`, and pool the runs probe by probe into `OUT/report.md` and `pooled.csv`:
     /// rank-1 over all the seeds' probes with its 95 % interval, the mean EER, the paired
@@ -381,6 +392,10 @@ struct DescribeOptions {
     /// With `least_pair`, the weight of the second least pair distance in the score
     /// (`Args::pair_second`; 0: the least alone).
     second_weight: f64,
+    /// Scans: a detected outer eye corner reported unseen is placed at the vertex nearest the
+    /// fitted face's prediction (within `MAX_SNAP_MM`) instead of being lost
+    /// (`Args::predicted_corners`).
+    predicted_corners: bool,
 }
 
 /// The fields of a face cut off at 1.4 |q - r| (corners r, q; nose tip, when asked for: else
@@ -1452,6 +1467,7 @@ pub fn run(args: Args) -> Result<()> {
         least_pair: false,
         search_all_pairs: false,
         second_weight: 0.0,
+        predicted_corners: false,
     };
     // The reference-point search is the probes' (the gallery keeps its one description); its
     // radius is given in mm, the model is in cm.
@@ -1879,6 +1895,7 @@ mod tests {
             least_pair: true,
             search_all_pairs: true,
             second_weight: 0.0,
+            predicted_corners: false,
         };
         let surface = Surface::new(m.clone());
         let run = |searched: [bool; 3], shared: bool| {
@@ -1960,6 +1977,7 @@ mod tests {
             least_pair: true,
             search_all_pairs: true,
             second_weight: 0.0,
+            predicted_corners: false,
         };
         let source = |lm: Lm| ViewSource {
             mesh: m.clone(),

@@ -21,8 +21,8 @@ use super::{
 use crate::pipeline::{bar, resolve_methods};
 use crate::report::{line_plot, Report, Series};
 use crate::scans::{
-    sample_weights, scan_face, scan_seed, FaceSpec, ScanSetOptions, ScanSettings, ScannedFace,
-    MAX_SNAP_MM, REFERENCE_LANDMARKS, VIEW_MATCH_INCIDENCE_DEG,
+    nearest_vertex, sample_weights, scan_face, scan_seed, FaceSpec, ScanSetOptions, ScanSettings,
+    ScannedFace, MAX_SNAP_MM, REFERENCE_LANDMARKS, VIEW_MATCH_INCIDENCE_DEG,
 };
 use crate::walk::Walker;
 use anyhow::{bail, Context, Result};
@@ -172,14 +172,21 @@ fn truth_lm(s: &ScannedFace, allow_lost: bool) -> Result<Lm, String> {
 }
 
 /// The detected landmarks of a scan ([`lm_from`]; a corner the detector reported unseen may be
-/// lost, at the place the fitted face predicts).
-fn detected_lm(s: &ScannedFace, allow_lost: bool) -> Result<Lm, String> {
+/// lost, at the place the fitted face predicts, or with `predicted` placed at the vertex
+/// nearest that place when it is within [`MAX_SNAP_MM`] of the scan).
+fn detected_lm(s: &ScannedFace, allow_lost: bool, predicted: bool) -> Result<Lm, String> {
     use landmarks::LandmarkName as L;
     let d = s.detected.as_ref().map_err(|e| format!("detection: {e}"))?;
     let v = |n: L| {
-        d.get(n)
-            .map(|l| l.vertex)
-            .map_err(|u| format!("detection: {n} {u}"))
+        d.get(n).map(|l| l.vertex).or_else(|u| {
+            let placed = (predicted && n != L::NoseTip)
+                .then(|| nearest_vertex(&s.mesh, d.predicted[n as usize]))
+                .flatten();
+            match placed {
+                Some((w, dist)) if dist <= MAX_SNAP_MM => Ok(w),
+                _ => Err(format!("detection: {n} {u}")),
+            }
+        })
     };
     lm_from(
         [v(L::OuterEyeRight), v(L::OuterEyeLeft), v(L::NoseTip)],
@@ -248,7 +255,10 @@ fn describe_spec(
         dopt
     };
     let allow_lost = dopt.side_pair_deg.is_some();
-    let lms = [truth_lm(&s, allow_lost), detected_lm(&s, allow_lost)];
+    let lms = [
+        truth_lm(&s, allow_lost),
+        detected_lm(&s, allow_lost, dopt.predicted_corners),
+    ];
     face.gt_lm = lms[0].as_ref().ok().copied();
     face.desc = match geodesic::new_solver(&s.mesh, method) {
         Ok(solver) => {
@@ -671,6 +681,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         side_pair_deg: (!args.no_side_pair).then_some(args.side_pair),
         least_pair: !(args.no_side_pair || args.own_pair_only),
         second_weight: args.pair_second,
+        predicted_corners: args.predicted_corners,
         search_all_pairs: !args.own_pair_search,
     };
     let elastic = elastic_options(args.curve_samples);
@@ -741,6 +752,25 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
             .map(|groups| groups.into_iter().map(keep).collect())
             .collect();
         (keep(gallery_specs), keep(probe_specs), sweeps)
+    };
+    let probe_specs: Vec<FaceSpec> = if args.only_probes.is_empty() {
+        probe_specs
+    } else {
+        let kept: Vec<FaceSpec> = probe_specs
+            .into_iter()
+            .filter(|s| {
+                args.only_probes
+                    .iter()
+                    .any(|p| s.name.starts_with(p.as_str()))
+            })
+            .collect();
+        if kept.is_empty() {
+            bail!(
+                "--only-probes {:?}: no probe of the run is named so",
+                args.only_probes
+            );
+        }
+        kept
     };
     if args.detect_only {
         let specs: Vec<&FaceSpec> = gallery_specs
@@ -904,6 +934,15 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
             "Only identities {:?} of the {identities} (`--only-identities`): their scans as in the whole run, ranks among them alone.",
             args.only_identities
         ));
+    }
+    if !args.only_probes.is_empty() {
+        rep.para(&format!(
+            "Only the probes named {:?}... (`--only-probes`), scanned as in the whole run, against the whole gallery.",
+            args.only_probes
+        ));
+    }
+    if args.predicted_corners {
+        rep.para(&format!("Detected landmarks: an outer eye corner the detector reports unseen is placed at the vertex nearest where the fitted face predicts it, when that is within {MAX_SNAP_MM} mm of the cleaned scan (`--predicted-corners`)."));
     }
     rep.heading(2, "Main run");
     results_table(&mut rep, &main, "results.csv")?;
@@ -1105,4 +1144,74 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
     eprintln!("{} failures; {secs:.1} s wall", fails.len());
     println!("{}", out.display());
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scans::{StepTimes, Truth};
+    use landmarks::{Landmark, LandmarkName as L, Unseen, VisibleLandmarks};
+    use meshcore::DAffine3;
+
+    /// A 40 x 40 mm sheet (2 mm grid) with landmarks at grid vertices; the right outer corner
+    /// unseen, predicted at `predicted`.
+    fn sheet(predicted: DVec3) -> ScannedFace {
+        let mesh =
+            meshcore::shapes::grid(20, 20, meshcore::shapes::Diagonals::Alternating, |i, j| {
+                DVec3::new(2.0 * i as f64, 2.0 * j as f64, 0.0)
+            })
+            .unwrap();
+        let at = |i: u32, j: u32| j * 21 + i;
+        // In `LandmarkName::ALL` order: outer right, inner right, inner left, outer left, nose.
+        let vertices = [at(2, 15), at(6, 15), at(14, 15), at(18, 15), at(10, 5)];
+        let landmark = |v: u32| Landmark {
+            vertex: v,
+            position: mesh.position(v),
+            confidence: 1.0,
+        };
+        let mut landmarks = vertices.map(|v| Ok(landmark(v)));
+        landmarks[L::OuterEyeRight as usize] = Err(Unseen::Unobserved { agreement: 0.8 });
+        let mut at_pred = vertices.map(|v| mesh.position(v));
+        at_pred[L::OuterEyeRight as usize] = predicted;
+        let truth = vertices.map(|v| Truth {
+            position: mesh.position(v),
+            scanner: rangescan::Visibility::Visible,
+            vertex: Ok((v, 0.0)),
+        });
+        ScannedFace {
+            valid_samples: 0,
+            detected: Ok(VisibleLandmarks {
+                landmarks,
+                predicted: at_pred,
+                confidence: 1.0,
+                fit_rms: 0.0,
+                inlier_fraction: 1.0,
+                symmetry: 1.0,
+                model_to_mesh: DAffine3::IDENTITY,
+            }),
+            mesh,
+            truth,
+            times: StepTimes::default(),
+        }
+    }
+
+    #[test]
+    fn an_unseen_corner_is_lost_or_placed_at_its_prediction() {
+        // Predicted 1.1 mm above the sheet, nearest vertex (3, 15).
+        let s = sheet(DVec3::new(6.2, 30.0, 1.0));
+        let lost = detected_lm(&s, true, false).unwrap();
+        assert_eq!(lost.lost.map(|l| l.right), Some(true));
+        let placed = detected_lm(&s, true, true).unwrap();
+        assert_eq!(placed.lost, None);
+        assert_eq!(placed.r, 15 * 21 + 3);
+        assert_eq!(placed.q, 15 * 21 + 18);
+        // Without lost corners allowed, the unseen corner is an error unless placed.
+        assert!(detected_lm(&s, false, false)
+            .unwrap_err()
+            .contains("outer_eye_right"));
+        assert_eq!(detected_lm(&s, false, true).unwrap(), placed);
+        // A prediction farther than MAX_SNAP_MM from the scan stays lost.
+        let far = sheet(DVec3::new(6.0, 30.0, MAX_SNAP_MM + 0.5));
+        assert!(detected_lm(&far, true, true).unwrap().lost.is_some());
+    }
 }
