@@ -931,6 +931,18 @@ fn mcnemar_exact(b: usize, c: usize) -> f64 {
 /// Appends the paired comparison of bipolar with every other score on the same probes, per
 /// landmark set: the probes only one of the two identifies and the exact McNemar p-value
 /// ([`mcnemar_exact`]), so that a difference in rank-1 can be told from chance.
+/// Probes (by position) that only `a` identifies and that only `b` identifies.
+fn discordant(a: &Metrics, b: &Metrics) -> (usize, usize) {
+    let only = |x: &Metrics, y: &Metrics| {
+        x.identified
+            .iter()
+            .zip(&y.identified)
+            .filter(|(a, b)| **a && !**b)
+            .count()
+    };
+    (only(a, b), only(b, a))
+}
+
 fn paired_table(rep: &mut Report, all: &[Metrics]) {
     let rows: Vec<Vec<String>> = all
         .iter()
@@ -939,14 +951,7 @@ fn paired_table(rep: &mut Report, all: &[Metrics]) {
             all.iter()
                 .filter(move |o| o.landmarks == b.landmarks && o.descriptor != "bipolar")
                 .map(move |o| {
-                    let only = |x: &Metrics, y: &Metrics| {
-                        x.identified
-                            .iter()
-                            .zip(&y.identified)
-                            .filter(|(a, b)| **a && !**b)
-                            .count()
-                    };
-                    let (nb, no) = (only(b, o), only(o, b));
+                    let (nb, no) = discordant(b, o);
                     vec![
                         b.landmarks.clone(),
                         o.descriptor.clone(),
@@ -1631,22 +1636,24 @@ mod tests {
             args: Args,
         }
         let (model, dir) = (model.display().to_string(), out.display().to_string());
-        let args = <Cli as clap::Parser>::parse_from([
-            "recognition",
-            "--scans",
-            "--identities",
-            "2",
-            "--expressions",
-            "2",
-            "--no-sweeps",
-            "--detect-only",
-            "--model",
-            &model,
-            "--out",
-            &dir,
-        ])
-        .args;
-        run(args).unwrap();
+        let args = |extra: &[&str]| {
+            let base = [
+                "recognition",
+                "--scans",
+                "--identities",
+                "2",
+                "--expressions",
+                "2",
+                "--no-sweeps",
+                "--detect-only",
+                "--model",
+                &model,
+                "--out",
+                &dir,
+            ];
+            <Cli as clap::Parser>::parse_from(base.iter().chain(extra)).args
+        };
+        run(args(&[])).unwrap();
         let text = std::fs::read_to_string(out.join("detection.csv")).unwrap();
         let rows: Vec<Vec<&str>> = text
             .lines()
@@ -1678,23 +1685,7 @@ mod tests {
         assert!(!out.join("probes.csv").exists() && !out.join("summary.json").exists());
         // `--only-identities 1`: identity 1's scans alone, with the whole run's seeds, yaws and
         // noises (the same rows byte for byte).
-        let only = <Cli as clap::Parser>::parse_from([
-            "recognition",
-            "--scans",
-            "--identities",
-            "2",
-            "--expressions",
-            "2",
-            "--no-sweeps",
-            "--detect-only",
-            "--only-identities",
-            "1",
-            "--model",
-            &model,
-            "--out",
-            &dir,
-        ])
-        .args;
+        let only = args(&["--only-identities", "1"]);
         run(only.clone()).unwrap();
         let again = std::fs::read_to_string(out.join("detection.csv")).unwrap();
         let id1: Vec<&str> = text.lines().filter(|l| l.starts_with("id01")).collect();

@@ -7,7 +7,7 @@
 //! interval; the paired comparison adds up each seed's probes that only one of two scores
 //! identifies (the probes of one seed are the same for every score).
 
-use super::{mcnemar_exact, paired_table, Args, Metrics};
+use super::{discordant, mcnemar_exact, paired_table, Args, Metrics};
 use crate::report::{line_plot, Report, Series};
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
@@ -276,14 +276,7 @@ fn write_pooled(out: &Path, runs: &[(u64, Vec<RunRow>)]) -> Result<()> {
             .iter()
             .find(|o| o.descriptor == "icp_raw_mesh" && o.landmarks == b.landmarks)
         {
-            let only = |x: &Metrics, y: &Metrics| {
-                x.identified
-                    .iter()
-                    .zip(&y.identified)
-                    .filter(|(a, b)| **a && !**b)
-                    .count()
-            };
-            let (nb, no) = (only(b, o), only(o, b));
+            let (nb, no) = discordant(b, o);
             eprintln!(
                 "bipolar vs ICP ({}): only bipolar {nb}, only ICP {no}, McNemar p {:.4}",
                 b.landmarks,

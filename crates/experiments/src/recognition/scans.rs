@@ -815,7 +815,9 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         + probe_specs.len()
         + sweep_specs.iter().flatten().map(Vec::len).sum::<usize>();
     eprintln!(
-        "{n_faces} scans ({identities} identities x {expressions}, {} sweep scans); geodesics: {}",
+        "{n_faces} scans ({} gallery, {} probes, {} sweep scans); geodesics: {}",
+        gallery_specs.len(),
+        probe_specs.len(),
         n_faces - gallery_specs.len() - probe_specs.len(),
         method.name()
     );
