@@ -1845,6 +1845,18 @@ mod tests {
         (m, lm, solver, f, frame)
     }
 
+    /// `lm` with its left outer eye corner lost at `at` (its vertex the nose tip's).
+    fn left_lost(lm: Lm, at: DVec3) -> Lm {
+        Lm {
+            q: lm.nose,
+            lost: Some(Lost {
+                right: false,
+                position: at,
+            }),
+            ..lm
+        }
+    }
+
     /// A solver that counts the fields it solves.
     #[derive(Debug)]
     struct Counting<'a>(
@@ -1935,14 +1947,7 @@ mod tests {
             assert_eq!(side.frame, frame);
         }
         // The left corner lost: its true place still sets the frame; only the right pair.
-        let lost = Lm {
-            q: lm.nose,
-            lost: Some(Lost {
-                right: false,
-                position: q,
-            }),
-            ..lm
-        };
+        let lost = left_lost(lm, q);
         assert_eq!(lost.positions(&m), [r, q, nose]);
         let f = fields(&m, solver.as_ref(), lost, true).unwrap();
         assert!(f.uq.is_empty() && f.scale(lost).is_err());
@@ -1984,14 +1989,7 @@ mod tests {
         assert!(whole.iter().all(Option::is_some));
         // The left corner lost at its true place: the cut is the same and the right side
         // pair's descriptor too (its frame from the lost corner's place); no other pair.
-        let lost = Lm {
-            q: lm.nose,
-            lost: Some(Lost {
-                right: false,
-                position: q,
-            }),
-            ..lm
-        };
+        let lost = left_lost(lm, q);
         let cut = source(lost).describe_from(&probe).unwrap();
         assert!(cut[Pair::Corners as usize].is_none() && cut[Pair::LeftNose as usize].is_none());
         let right = Pair::RightNose as usize;
