@@ -1845,6 +1845,25 @@ mod tests {
         (m, lm, solver, f, frame)
     }
 
+    /// Options of the sheet tests: 8 levels and sectors, the least over the three pairs with
+    /// every pair searched, nothing else.
+    fn sheet_options() -> DescribeOptions {
+        DescribeOptions {
+            levels: 8,
+            sectors: 8,
+            iso_levels: None,
+            boundary_margin: None,
+            max_incidence_deg: None,
+            ref_search: None,
+            view_match: None,
+            side_pair_deg: None,
+            least_pair: true,
+            search_all_pairs: true,
+            second_weight: 0.0,
+            predicted_corners: false,
+        }
+    }
+
     /// `lm` with its left outer eye corner lost at `at` (its vertex the nose tip's).
     fn left_lost(lm: Lm, at: DVec3) -> Lm {
         Lm {
@@ -1887,18 +1906,8 @@ mod tests {
         let (m, lm, exact, f, frame) = plane_face(40, 25, [(8, 16), (32, 16), (20, 6)]);
         let refs = Pair::ALL.map(|p| pair_refs(&m, &f, lm, p, frame));
         let o = DescribeOptions {
-            levels: 8,
-            sectors: 8,
-            iso_levels: None,
-            boundary_margin: None,
-            max_incidence_deg: None,
             ref_search: Some(4.0),
-            view_match: None,
-            side_pair_deg: None,
-            least_pair: true,
-            search_all_pairs: true,
-            second_weight: 0.0,
-            predicted_corners: false,
+            ..sheet_options()
         };
         let surface = Surface::new(m.clone());
         let run = |searched: [bool; 3], shared: bool| {
@@ -1962,18 +1971,9 @@ mod tests {
         // A 100 x 60 mm sheet, seen by a probe turned 30 degrees about the vertical.
         let (m, lm, _, _, _) = plane_face(50, 30, [(5, 20), (45, 20), (25, 5)]);
         let o = DescribeOptions {
-            levels: 8,
-            sectors: 8,
-            iso_levels: None,
-            boundary_margin: None,
-            max_incidence_deg: None,
-            ref_search: None,
             view_match: Some(10.0),
             side_pair_deg: Some(30.0),
-            least_pair: true,
-            search_all_pairs: true,
-            second_weight: 0.0,
-            predicted_corners: false,
+            ..sheet_options()
         };
         let source = |lm: Lm| ViewSource {
             mesh: m.clone(),
