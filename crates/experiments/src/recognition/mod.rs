@@ -161,9 +161,9 @@ pub struct Args {
     /// landmark stays unseen in `detection.csv` and `landmarks.csv`).
     #[arg(long)]
     pub predicted_corners: bool,
-    /// Keep only the probes whose name starts with one of these (comma-separated, e.g.
-    /// `id01-e2,id27`; `--scans`), against the whole gallery: their ranks are those of the
-    /// whole run.
+    /// Keep only the probes (and sweep scans) whose name starts with one of these
+    /// (comma-separated, e.g. `id01-e2,id27`; `--scans`), against the whole gallery: their
+    /// ranks are those of the whole run.
     #[arg(long, value_delimiter = ',')]
     pub only_probes: Vec<String>,
     /// Run the benchmark once per seed (comma-separated; `--seed` is then ignored), each into
@@ -1699,6 +1699,11 @@ mod tests {
         .unwrap_err()
         .to_string();
         assert!(e.contains("--only-identities 2"), "{e}");
+        // So is a probe name the run does not have.
+        let e = run(args(&["--only-probes", "id05"]))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("no probe left") && e.contains("id05"), "{e}");
         std::fs::remove_dir_all(&out).unwrap();
     }
 

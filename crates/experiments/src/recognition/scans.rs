@@ -97,6 +97,11 @@ struct Face {
     secs: [f64; 4],
 }
 
+/// The specs `keep` accepts, in order.
+fn kept_specs(specs: Vec<FaceSpec>, keep: impl Fn(&FaceSpec) -> bool) -> Vec<FaceSpec> {
+    specs.into_iter().filter(|s| keep(s)).collect()
+}
+
 /// Scans, cleans, detects and describes every face (in parallel, in order).
 #[allow(clippy::too_many_arguments)]
 fn process(
@@ -738,40 +743,35 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
     }
     // The iso-curvature levels come from the whole run's first gallery scan.
     let first_gallery = gallery_specs[0].clone();
-    let (gallery_specs, probe_specs, sweep_specs) = if args.only_identities.is_empty() {
-        (gallery_specs, probe_specs, sweep_specs)
-    } else {
-        let keep = |specs: Vec<FaceSpec>| -> Vec<FaceSpec> {
-            specs
+    // `--only-identities` and `--only-probes`: the specs keep the whole run's seeds.
+    let named = |s: &FaceSpec| {
+        args.only_probes.is_empty()
+            || args
+                .only_probes
+                .iter()
+                .any(|p| s.name.starts_with(p.as_str()))
+    };
+    let of_identity = |s: &FaceSpec| {
+        args.only_identities.is_empty() || args.only_identities.contains(&s.identity)
+    };
+    let gallery_specs = kept_specs(gallery_specs, of_identity);
+    let probe_specs = kept_specs(probe_specs, |s| of_identity(s) && named(s));
+    let sweep_specs: Vec<Vec<Vec<FaceSpec>>> = sweep_specs
+        .into_iter()
+        .map(|groups| {
+            groups
                 .into_iter()
-                .filter(|s| args.only_identities.contains(&s.identity))
+                .map(|v| kept_specs(v, |s| of_identity(s) && named(s)))
                 .collect()
-        };
-        let sweeps = sweep_specs
-            .into_iter()
-            .map(|groups| groups.into_iter().map(keep).collect())
-            .collect();
-        (keep(gallery_specs), keep(probe_specs), sweeps)
-    };
-    let probe_specs: Vec<FaceSpec> = if args.only_probes.is_empty() {
-        probe_specs
-    } else {
-        let kept: Vec<FaceSpec> = probe_specs
-            .into_iter()
-            .filter(|s| {
-                args.only_probes
-                    .iter()
-                    .any(|p| s.name.starts_with(p.as_str()))
-            })
-            .collect();
-        if kept.is_empty() {
-            bail!(
-                "--only-probes {:?}: no probe of the run is named so",
-                args.only_probes
-            );
-        }
-        kept
-    };
+        })
+        .collect();
+    if probe_specs.is_empty() && sweep_specs.iter().flatten().all(Vec::is_empty) {
+        bail!(
+            "no probe left: --only-identities {:?}, --only-probes {:?}",
+            args.only_identities,
+            args.only_probes
+        );
+    }
     if args.detect_only {
         let specs: Vec<&FaceSpec> = gallery_specs
             .iter()
