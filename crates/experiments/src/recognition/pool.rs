@@ -98,6 +98,12 @@ pub(super) fn read_run(dir: &Path) -> Result<Vec<RunRow>> {
     Ok(s.results)
 }
 
+/// The row of one score and landmark set in a run.
+fn same_score<'a>(rows: &'a [RunRow], descriptor: &str, landmarks: &str) -> Option<&'a RunRow> {
+    rows.iter()
+        .find(|r| r.descriptor == descriptor && r.landmarks == landmarks)
+}
+
 /// Wilson score interval (95 %) of `k` successes in `n` trials.
 pub(super) fn wilson95(k: usize, n: usize) -> (f64, f64) {
     if n == 0 {
@@ -123,10 +129,7 @@ pub(super) fn pooled(runs: &[(u64, Vec<RunRow>)]) -> Result<Vec<Metrics>> {
             let mut identified = Vec::new();
             let mut eer = 0.0;
             for (seed, rows) in runs {
-                let Some(r) = rows
-                    .iter()
-                    .find(|r| r.descriptor == row.descriptor && r.landmarks == row.landmarks)
-                else {
+                let Some(r) = same_score(rows, &row.descriptor, &row.landmarks) else {
                     bail!(
                         "seed {seed} has no {} ({}) result to pool",
                         row.descriptor,
@@ -175,10 +178,7 @@ fn write_pooled(out: &Path, runs: &[(u64, Vec<RunRow>)]) -> Result<()> {
         let (lo, hi) = wilson95(hits, m.identified.len());
         let per_seed: Vec<&RunRow> = runs
             .iter()
-            .filter_map(|(_, rows)| {
-                rows.iter()
-                    .find(|r| r.descriptor == m.descriptor && r.landmarks == m.landmarks)
-            })
+            .filter_map(|(_, rows)| same_score(rows, &m.descriptor, &m.landmarks))
             .collect();
         let mut row = vec![m.descriptor.clone(), m.landmarks.clone()];
         row.extend(per_seed.iter().map(|r| {
@@ -235,8 +235,7 @@ fn write_pooled(out: &Path, runs: &[(u64, Vec<RunRow>)]) -> Result<()> {
                 let mut p: Vec<(f64, f64)> = runs
                     .iter()
                     .filter_map(|(seed, rows)| {
-                        rows.iter()
-                            .find(|r| r.descriptor == m.descriptor && r.landmarks == m.landmarks)
+                        same_score(rows, &m.descriptor, &m.landmarks)
                             .map(|r| (*seed as f64, r.rank1))
                     })
                     .collect();
