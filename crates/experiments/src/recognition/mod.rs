@@ -928,9 +928,6 @@ fn mcnemar_exact(b: usize, c: usize) -> f64 {
     (2.0 * tail).min(1.0)
 }
 
-/// Appends the paired comparison of bipolar with every other score on the same probes, per
-/// landmark set: the probes only one of the two identifies and the exact McNemar p-value
-/// ([`mcnemar_exact`]), so that a difference in rank-1 can be told from chance.
 /// Probes (by position) that only `a` identifies and that only `b` identifies.
 fn discordant(a: &Metrics, b: &Metrics) -> (usize, usize) {
     let only = |x: &Metrics, y: &Metrics| {
@@ -943,6 +940,9 @@ fn discordant(a: &Metrics, b: &Metrics) -> (usize, usize) {
     (only(a, b), only(b, a))
 }
 
+/// Appends the paired comparison of bipolar with every other score on the same probes, per
+/// landmark set: the probes only one of the two identifies and the exact McNemar p-value
+/// ([`mcnemar_exact`]), so that a difference in rank-1 can be told from chance.
 fn paired_table(rep: &mut Report, all: &[Metrics]) {
     let rows: Vec<Vec<String>> = all
         .iter()

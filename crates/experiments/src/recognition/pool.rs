@@ -35,7 +35,6 @@ pub(super) fn run(args: Args) -> Result<()> {
         for &seed in &seeds {
             let mut one = args.clone();
             one.seeds.clear();
-            one.pool_only = false;
             one.seed = seed;
             one.io.out.out = Some(seed_dir(&out, seed));
             eprintln!("== seed {seed}");

@@ -939,7 +939,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
     }
     if !args.only_probes.is_empty() {
         rep.para(&format!(
-            "Only the probes named {:?}... (`--only-probes`), scanned as in the whole run, against the whole gallery.",
+            "Only the probes and sweep scans whose names start with {:?} (`--only-probes`), scanned as in the whole run, against the whole gallery.",
             args.only_probes
         ));
     }
@@ -1199,7 +1199,7 @@ mod tests {
 
     #[test]
     fn an_unseen_corner_is_lost_or_placed_at_its_prediction() {
-        // Predicted 1.1 mm above the sheet, nearest vertex (3, 15).
+        // Predicted 1.02 mm from the sheet's vertex (3, 15), its nearest.
         let s = sheet(DVec3::new(6.2, 30.0, 1.0));
         let lost = detected_lm(&s, true, false).unwrap();
         assert_eq!(lost.lost.map(|l| l.right), Some(true));
