@@ -48,6 +48,13 @@ pub struct DetectOptions {
     /// scanner and are not affected. With a direction the learned regression also reads
     /// surface missing where the training faces had it as unobserved rather than as shape.
     pub toward_viewer: Option<DVec3>,
+    /// Fit confidence below which a detection's evidence is weak
+    /// ([`crate::Weakness::Fit`]); also the confidence below which a second round of
+    /// candidates runs.
+    pub strong_confidence: f64,
+    /// Mirror symmetry below which a detection's evidence is weak
+    /// ([`crate::Weakness::Asymmetric`]).
+    pub strong_symmetry: f64,
 }
 
 /// Least angle (degrees) between a rim vertex's normal and the direction toward the scanner
@@ -125,6 +132,8 @@ impl Default for DetectOptions {
             use_regressor: true,
             min_landmark_coverage: 0.5,
             toward_viewer: None,
+            strong_confidence: 0.85,
+            strong_symmetry: 0.75,
         }
     }
 }
@@ -584,7 +593,7 @@ fn detect_impl(
         }
         // The best-fitting pose decides; a second round only when it is weak or not symmetric.
         if let Some(f) = fits.first_mut() {
-            if f.conf >= 0.85 && f.sym >= options.min_symmetry {
+            if f.conf >= options.strong_confidence && f.sym >= options.min_symmetry {
                 let r = *f
                     .refined
                     .get_or_insert_with(|| refine_all(&idx, model, &f.h.t, f.conf, debug));

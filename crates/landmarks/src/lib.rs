@@ -265,6 +265,122 @@ impl VisibleLandmarks {
     }
 }
 
+/// Why the evidence behind a detection is weak ([`VisibleLandmarks::weak_evidence`]): the
+/// landmarks are returned, with this reason, instead of being refused. Values are printed
+/// unrounded.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Weakness {
+    /// The generic face fits the input less well than it fits typical faces: fit confidence
+    /// `confidence` below `strong` ([`DetectOptions::strong_confidence`]).
+    Fit {
+        /// The fit confidence.
+        confidence: f64,
+        /// The confidence of a convincing fit.
+        strong: f64,
+    },
+    /// The fitted face is less mirror-symmetric than faces usually are: `symmetry` below
+    /// `strong` ([`DetectOptions::strong_symmetry`]).
+    Asymmetric {
+        /// The symmetry of the fit.
+        symmetry: f64,
+        /// The symmetry of a convincing fit.
+        strong: f64,
+    },
+    /// The surface around a placed landmark matches its template weakly: local agreement
+    /// `agreement` below `strong` ([`DetectOptions::min_local_agreement`]).
+    Landmark {
+        /// The landmark.
+        name: LandmarkName,
+        /// Its local template agreement.
+        agreement: f64,
+        /// The agreement of a convincing landmark.
+        strong: f64,
+    },
+}
+
+impl std::fmt::Display for Weakness {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Weakness::Fit { confidence, strong } => write!(
+                f,
+                "the generic face fits weakly (fit confidence {confidence} < {strong})"
+            ),
+            Weakness::Asymmetric { symmetry, strong } => write!(
+                f,
+                "the fitted face is not very mirror-symmetric (symmetry {symmetry} < {strong})"
+            ),
+            Weakness::Landmark {
+                name,
+                agreement,
+                strong,
+            } => write!(
+                f,
+                "{name} matches its template weakly (agreement {agreement} < {strong})"
+            ),
+        }
+    }
+}
+
+/// The weaknesses of a detection with fit confidence `confidence`, symmetry `symmetry` and the
+/// placed landmarks `placed` (their confidences are the fit confidence times their local
+/// agreement).
+fn weaknesses<'a>(
+    confidence: f64,
+    symmetry: f64,
+    placed: impl Iterator<Item = (LandmarkName, &'a Landmark)>,
+    options: &DetectOptions,
+) -> Vec<Weakness> {
+    let mut out = Vec::new();
+    if confidence < options.strong_confidence {
+        out.push(Weakness::Fit {
+            confidence,
+            strong: options.strong_confidence,
+        });
+    }
+    if symmetry < options.strong_symmetry {
+        out.push(Weakness::Asymmetric {
+            symmetry,
+            strong: options.strong_symmetry,
+        });
+    }
+    for (name, l) in placed {
+        let agreement = if confidence > 0.0 {
+            l.confidence / confidence
+        } else {
+            0.0
+        };
+        if agreement < options.min_local_agreement {
+            out.push(Weakness::Landmark {
+                name,
+                agreement,
+                strong: options.min_local_agreement,
+            });
+        }
+    }
+    out
+}
+
+impl Landmarks {
+    /// Why the evidence behind these landmarks is weak under `options` (the options they were
+    /// detected with); empty when every check is convincing.
+    pub fn weak_evidence(&self, options: &DetectOptions) -> Vec<Weakness> {
+        let placed = LandmarkName::ALL.into_iter().map(|n| (n, self.get(n)));
+        weaknesses(self.confidence, self.symmetry, placed, options)
+    }
+}
+
+impl VisibleLandmarks {
+    /// Why the evidence behind the placed landmarks is weak under `options` (the options they
+    /// were detected with); empty when every check is convincing. Unseen landmarks carry their
+    /// own reason ([`Unseen`]).
+    pub fn weak_evidence(&self, options: &DetectOptions) -> Vec<Weakness> {
+        let placed = LandmarkName::ALL
+            .into_iter()
+            .filter_map(|n| self.get(n).ok().map(|l| (n, l)));
+        weaknesses(self.confidence, self.symmetry, placed, options)
+    }
+}
+
 /// Errors of the landmarks crate.
 #[derive(Debug, thiserror::Error)]
 pub enum LandmarkError {
