@@ -58,7 +58,7 @@ impl Kind {
 /// A generated test face, in mm.
 #[derive(Debug, Clone)]
 pub struct BeyondFace {
-    /// `KIND-NNN`.
+    /// The face's name, `KIND-NNN` (kind, then a three-digit number).
     pub name: String,
     /// The face (mm).
     pub mesh: TriMesh,
