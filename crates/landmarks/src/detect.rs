@@ -55,6 +55,17 @@ pub struct DetectOptions {
     /// Mirror symmetry below which a detection's evidence is weak
     /// ([`crate::Weakness::Asymmetric`]).
     pub strong_symmetry: f64,
+    /// Weakest local template agreement below which a fitted pose is refused. Between it and
+    /// [`DetectOptions::min_local_agreement`] the landmarks are returned graded: their
+    /// confidences are low and [`crate::VisibleLandmarks::weak_evidence`] names the landmark;
+    /// a fit whose every landmark agrees is always preferred. The default, equal to
+    /// `min_local_agreement` (0.85), grades nothing: a landmark beside a hole (no surface where
+    /// it is) agrees weakly too and would be returned on the hole's rim, so the gate stays
+    /// unless the caller lowers it.
+    pub refuse_local_agreement: f64,
+    /// Print the detector's trace (candidates, hypotheses, fits, per-landmark refinement, with
+    /// timings) to standard error.
+    pub trace: bool,
 }
 
 /// Least angle (degrees) between a rim vertex's normal and the direction toward the scanner
@@ -134,6 +145,8 @@ impl Default for DetectOptions {
             toward_viewer: None,
             strong_confidence: 0.85,
             strong_symmetry: 0.75,
+            refuse_local_agreement: 0.85,
+            trace: false,
         }
     }
 }
@@ -313,17 +326,26 @@ fn default_options(
 
 /// Mesh units per model unit for a face-sized `mesh`: the mesh's units recognised from its size
 /// ([`meshcore::units::detect_units`]), the model's from its `units` label (`mm`, `cm` or `m`).
-/// A model whose label names no unit (one trained by [`GenericModel::train`] without a label)
-/// is taken to be in the mesh's units (1). Errors when the mesh's size fits no unit.
+/// A model whose label names no unit (one trained by [`GenericModel::train`], labelled
+/// `unknown`) is refused ([`LandmarkError::InvalidModel`]): its units are never assumed; give
+/// [`DetectOptions::mesh_units_per_model_unit`] to [`detect_with`] instead. Errors too when the
+/// mesh's size fits no unit.
 pub fn mesh_units_per_model_unit(
     mesh: &TriMesh,
     model: &GenericModel,
 ) -> Result<f64, LandmarkError> {
+    let model_units = model
+        .units
+        .trim()
+        .parse::<meshcore::units::Units>()
+        .map_err(|e| {
+            LandmarkError::InvalidModel(format!(
+                "the generic model's units label {:?} names no unit ({e}); give the mesh units per model unit explicitly (DetectOptions::mesh_units_per_model_unit, CLI --scale)",
+                model.units
+            ))
+        })?;
     let mesh_units = meshcore::units::detect_units(mesh)?.units;
-    Ok(match model.units.trim().parse::<meshcore::units::Units>() {
-        Ok(model_units) => model_units.factor_to(mesh_units),
-        Err(_) => 1.0,
-    })
+    Ok(model_units.factor_to(mesh_units))
 }
 
 /// Detects the five landmarks.
@@ -393,7 +415,7 @@ fn detect_impl(
         &work
     };
     let p = &model.params;
-    let debug = std::env::var_os("LANDMARKS_DEBUG").is_some();
+    let debug = options.trace;
     let clock = std::time::Instant::now();
     let mut idx = surface_index(mesh_m);
     idx.unseen_rim = unseen_rims(mesh_m, &idx, options.toward_viewer, p.inlier_distance)?;
@@ -620,16 +642,22 @@ fn detect_impl(
     let mut rejected: Option<(String, f64)> = None;
     // A partial detection takes the first fit that places every landmark, as `detect_with`
     // does, and only when there is none the first that places enough of them.
-    let passes: &[bool] = if partial { &[false, true] } else { &[false] };
+    // Then, when no fit's landmarks all agree with their templates, the first whose weakest
+    // agreement is at least `refuse_local_agreement`, graded (low confidences, a reason).
+    let passes: &[(bool, bool)] = if partial {
+        &[(false, false), (true, false), (false, true), (true, true)]
+    } else {
+        &[(false, false), (false, true)]
+    };
     let n_fits = fits.len();
-    for (&allow_unseen, k) in passes
+    for (&(allow_unseen, graded), k) in passes
         .iter()
         .flat_map(|p| std::iter::repeat(p).zip(0..n_fits))
     {
         let f = &mut fits[k];
         let why = if f.conf < options.min_confidence {
             Some(format!(
-                "the best fit of the generic face covers {:.0} % of it (rms {:.3} model units; confidence {:.2} < {:.2})",
+                "the best fit of the generic face covers {} % of it (rms {} model units; confidence {} < {})",
                 100.0 * f.h.fit.inlier_fraction,
                 f.h.fit.rms,
                 f.conf,
@@ -637,7 +665,7 @@ fn detect_impl(
             ))
         } else if f.sym < options.min_symmetry {
             Some(format!(
-                "the best fit of the generic face is not mirror-symmetric (symmetry {:.2} < {:.2})",
+                "the best fit of the generic face is not mirror-symmetric (symmetry {} < {})",
                 f.sym, options.min_symmetry
             ))
         } else {
@@ -667,14 +695,20 @@ fn detect_impl(
             }
         }
         let local = weakest(&agreement, &unseen);
-        if local < options.min_local_agreement {
-            rejected.get_or_insert((
-                format!(
-                    "the surface around the landmarks predicted by the best fit does not match their templates (agreement {local:.2} < {:.2})",
-                    options.min_local_agreement
-                ),
-                f.conf * local,
-            ));
+        let need = if graded {
+            options.refuse_local_agreement
+        } else {
+            options.min_local_agreement
+        };
+        if local < need {
+            if graded || options.refuse_local_agreement >= options.min_local_agreement {
+                rejected.get_or_insert((
+                    format!(
+                        "the surface around the landmarks predicted by the best fit does not match their templates (agreement {local} < {need})"
+                    ),
+                    f.conf * local,
+                ));
+            }
             continue;
         }
         let best = f.h;
@@ -713,7 +747,7 @@ fn detect_impl(
         if let (false, Some((name, c))) = (allow_unseen, bare) {
             rejected.get_or_insert((
                 format!(
-                    "{name} is not on the surface: only {:.0} % of the surface expected around it was found (at least {:.0} % needed); it is occluded, in a hole or outside the scan",
+                    "{name} is not on the surface: only {} % of the surface expected around it was found (at least {} % needed); it is occluded, in a hole or outside the scan",
                     100.0 * c,
                     100.0 * options.min_landmark_coverage
                 ),
@@ -747,6 +781,7 @@ fn detect_impl(
                 ..out[k]
             }),
         });
+        let predicted = mirrored_predictions(model, &best.t, &out, &unseen, predicted);
         return Ok(VisibleLandmarks {
             landmarks,
             predicted: predicted.map(|p| p * s),
@@ -759,6 +794,44 @@ fn detect_impl(
     }
     let (reason, best_score) = rejected.unwrap_or_default();
     Err(LandmarkError::NotFound { reason, best_score })
+}
+
+/// The predictions of the unseen landmarks whose mirror partner (the other side's same
+/// corner) is placed: the partner mirrored across the fitted face's mid-sagittal plane (`x = 0`
+/// of the canonical frame), plus the generic face's own asymmetry (its mean landmark minus its
+/// mirrored partner's). A face's identity and expression move both corners of a pair alike, so
+/// the placed partner predicts an unseen corner better than the rigid generic face alone; the
+/// others keep `rigid`, the fitted face's prediction. Model units.
+fn mirrored_predictions(
+    model: &GenericModel,
+    t: &DAffine3,
+    placed: &[Landmark; 5],
+    unseen: &[Option<Unseen>; 5],
+    rigid: [DVec3; 5],
+) -> [DVec3; 5] {
+    use LandmarkName as L;
+    let partner = |n: L| match n {
+        L::OuterEyeRight => Some(L::OuterEyeLeft),
+        L::OuterEyeLeft => Some(L::OuterEyeRight),
+        L::InnerEyeRight => Some(L::InnerEyeLeft),
+        L::InnerEyeLeft => Some(L::InnerEyeRight),
+        L::NoseTip => None,
+    };
+    let inv = rigid_inverse(t);
+    let mirror = |v: DVec3| DVec3::new(-v.x, v.y, v.z);
+    let mut out = rigid;
+    for n in L::ALL {
+        let (k, Some(m)) = (n as usize, partner(n)) else {
+            continue;
+        };
+        if unseen[k].is_none() || unseen[m as usize].is_some() {
+            continue;
+        }
+        let c = mirror(inv.transform_point3(placed[m as usize].position));
+        let own = model.landmark(n) - mirror(model.landmark(m));
+        out[k] = t.transform_point3(c + own);
+    }
+    out
 }
 
 /// Local template refinement of the five landmarks predicted by the pose `t`: the landmarks

@@ -189,11 +189,11 @@ impl std::fmt::Display for Unseen {
         match self {
             Unseen::Unobserved { agreement } => write!(
                 f,
-                "beside surface the scanner did not see, and what it saw does not match the landmark's template (agreement {agreement:.2})"
+                "beside surface the scanner did not see, and what it saw does not match the landmark's template (agreement {agreement})"
             ),
             Unseen::Bare { coverage } => write!(
                 f,
-                "only {:.0} % of the surface expected around it was found (in a hole or outside the scan)",
+                "only {} % of the surface expected around it was found (in a hole or outside the scan)",
                 100.0 * coverage
             ),
         }
@@ -205,8 +205,11 @@ impl std::fmt::Display for Unseen {
 pub struct VisibleLandmarks {
     /// Per landmark in [`LandmarkName::ALL`] order: placed, or why not.
     pub landmarks: [Result<Landmark, Unseen>; 5],
-    /// Where the fitted generic face puts each landmark (input units), seen or not: not a point
-    /// of the input.
+    /// Where each landmark is predicted (input units), seen or not: not a point of the input.
+    /// A placed landmark's is where the fitted generic face puts it; an unseen one whose
+    /// mirror partner (the other side's same corner) is placed is predicted from the partner
+    /// mirrored across the fitted face's mid-sagittal plane, else where the fitted face puts
+    /// it.
     pub predicted: [DVec3; 5],
     /// Overall confidence in `[0, 1]` of the generic face fit.
     pub confidence: f64,
@@ -385,7 +388,7 @@ impl VisibleLandmarks {
 #[derive(Debug, thiserror::Error)]
 pub enum LandmarkError {
     /// No face-like configuration was found.
-    #[error("landmarks not found: {reason} (best candidate score {best_score:.3}, needs a face with outward normals in the model's units)")]
+    #[error("landmarks not found: {reason} (best candidate score {best_score}, needs a face with outward normals in the model's units)")]
     NotFound {
         /// What failed.
         reason: String,

@@ -110,7 +110,13 @@ fn small_evaluation_on_the_paper_set() {
     {
         let mesh = read_mesh(dir.join(format!("{name}.obj")));
         let t = motions()[k];
-        let lm = detect(&mesh.transformed(&t), &model).unwrap();
+        // The model trained without a units label: its units are given, never assumed.
+        let moved = mesh.transformed(&t);
+        match detect(&moved, &model) {
+            Err(LandmarkError::InvalidModel(m)) => assert!(m.contains("unknown"), "{m}"),
+            other => panic!("expected the unlabelled model's units refused, got {other:?}"),
+        }
+        let lm = detect_with(&moved, &model, &DetectOptions::default()).unwrap();
         for n in LandmarkName::ALL {
             let back = t.inverse().transform_point3(lm.get(n).position);
             errs.push((back - truth[*name][n as usize]).length());
@@ -253,6 +259,7 @@ fn each_verification_rejects_with_its_reason() {
         (
             DetectOptions {
                 min_local_agreement: 1.001,
+                refuse_local_agreement: 1.001,
                 ..defaults
             },
             "templates",
@@ -267,6 +274,41 @@ fn each_verification_rejects_with_its_reason() {
             other => panic!("expected NotFound ({word}), got {other:?}"),
         }
     }
+    // The message prints the values unrounded: never "0.85 < 0.85".
+    let strict = DetectOptions {
+        min_local_agreement: 0.999_999_9,
+        refuse_local_agreement: 0.999_999_9,
+        ..defaults
+    };
+    match detect_with(&mesh, &model, &strict) {
+        Err(LandmarkError::NotFound { reason, .. }) => {
+            assert!(reason.contains("< 0.9999999)"), "{reason}");
+            let value = reason.split("agreement ").nth(1).unwrap();
+            let value = value.split(' ').next().unwrap();
+            assert!(value.len() > 4, "rounded: {reason}");
+        }
+        other => panic!("expected NotFound, got {other:?}"),
+    }
+    // Local agreement below the strong level is graded, not gated: the same landmarks, with
+    // every one named as weak evidence.
+    let demanding = DetectOptions {
+        min_local_agreement: 1.001,
+        refuse_local_agreement: 0.0,
+        ..defaults
+    };
+    let graded = detect_with(&mesh, &model, &demanding).unwrap();
+    assert_eq!(graded.positions(), lm.positions());
+    let weak = graded.weak_evidence(&demanding);
+    assert_eq!(weak.len(), 5, "{weak:?}");
+    assert!(
+        weak.iter().all(|w| w.to_string().contains("< 1.001")),
+        "{weak:?}"
+    );
+    assert!(
+        lm.weak_evidence(&defaults).is_empty(),
+        "{:?}",
+        lm.weak_evidence(&defaults)
+    );
 }
 
 #[test]

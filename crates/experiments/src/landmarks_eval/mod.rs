@@ -44,7 +44,7 @@ pub struct Args {
     /// Evaluate this generic model file instead of training one.
     #[arg(long)]
     pub generic_model: Option<PathBuf>,
-    /// Evaluate only the test face of this index (debugging; set LANDMARKS_DEBUG=1 for a trace).
+    /// Evaluate only the test face of this index (debugging; with `--trace` for the detector's trace).
     #[arg(long)]
     pub only: Option<usize>,
     /// Evaluate on the training faces (`--train` of them, training seed stream) instead of the
@@ -94,6 +94,13 @@ pub struct Args {
     /// Scanner settings of `--scans`.
     #[command(flatten)]
     pub scan: ScanArgs,
+    /// Override `DetectOptions::refuse_local_agreement` (below `min_local_agreement`: weakly
+    /// agreeing landmarks are returned graded instead of refused).
+    #[arg(long)]
+    pub refuse_local_agreement: Option<f64>,
+    /// Print the detector's trace to standard error (`DetectOptions::trace`).
+    #[arg(long)]
+    pub trace: bool,
     /// Evaluate on faces outside the ICT model's span (expressions beyond full strength, smooth
     /// warps, other topologies, depth-camera scans) and on non-faces, made from the stream of
     /// `--seed`; writes into the `beyond` folder of the output folder.
@@ -285,6 +292,10 @@ pub fn run(args: Args) -> Result<()> {
         dopt.min_confidence = x;
     }
     dopt.use_regressor = !args.no_regressor;
+    dopt.trace = args.trace;
+    if let Some(x) = args.refuse_local_agreement {
+        dopt.refuse_local_agreement = x;
+    }
     if args.beyond {
         return beyond_eval::run_beyond(&args, &ict, &generic, &dopt, &out.join("beyond"));
     }
