@@ -11,6 +11,7 @@ mod cmd_distance;
 mod cmd_geodesic;
 mod cmd_info;
 mod cmd_landmarks;
+mod cmd_match;
 mod cmd_matrix;
 mod cmd_render;
 mod cmd_scan;
@@ -53,6 +54,12 @@ enum Command {
     Curves(cmd_curves::Args),
     /// Distance between two curve files (elastic for facial curves, ICP for iso-curvature).
     CurveDistance(cmd_curves::DistanceArgs),
+    /// Enrol scans into a gallery of face templates (one per scan; in parallel).
+    Enroll(cmd_match::EnrollArgs),
+    /// Rank a gallery's identities by their score against a probe scan or template.
+    Identify(cmd_match::IdentifyArgs),
+    /// Score two faces (scans or templates) and decide whether they are the same person.
+    Verify(cmd_match::VerifyArgs),
 }
 
 fn main() -> std::process::ExitCode {
@@ -70,6 +77,9 @@ fn main() -> std::process::ExitCode {
         Command::Clean(a) => cmd_clean::run(a),
         Command::Curves(a) => cmd_curves::run(a),
         Command::CurveDistance(a) => cmd_curves::run_distance(a),
+        Command::Enroll(a) => cmd_match::run_enroll(a),
+        Command::Identify(a) => cmd_match::run_identify(a),
+        Command::Verify(a) => cmd_match::run_verify(a),
     };
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

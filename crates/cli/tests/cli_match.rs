@@ -1,0 +1,108 @@
+//! `bipolar enroll`, `identify` and `verify` end to end on scans made by `bipolar scan`.
+
+mod common;
+
+use common::bipolar_cmd;
+
+#[test]
+fn enrol_identify_and_verify_scans_of_paper_faces() {
+    let Some(faces) = testsupport::paper_meshes(["id1_neutral.obj", "id2_neutral.obj"]) else {
+        return;
+    };
+    drop(faces);
+    let dir = tempfile::tempdir().unwrap();
+    let p = |n: &str| dir.path().join(n).to_str().unwrap().to_string();
+    let face = |n: &str| {
+        testsupport::paper_face(n)
+            .unwrap()
+            .to_str()
+            .unwrap()
+            .to_string()
+    };
+    // Two neutral gallery scans (one identity each), a probe of person 1 turned by 20 degrees.
+    for (src, out, yaw, seed) in [
+        ("id1_neutral.obj", "id1-e0.bnt", "0", "1"),
+        ("id2_neutral.obj", "id2-e0.bnt", "0", "2"),
+        ("id1_happiness.obj", "probe.bnt", "20", "3"),
+    ] {
+        bipolar_cmd(
+            "scan",
+            &[&face(src), "--out", &p(out), "--yaw", yaw, "--seed", seed],
+        )
+        .success();
+    }
+    let gallery = p("gallery");
+    let r = bipolar_cmd(
+        "enroll",
+        &[
+            &p("id1-e0.bnt"),
+            &p("id2-e0.bnt"),
+            "--out",
+            &gallery,
+            "--identity-from",
+            r"^(id\d+)-",
+        ],
+    )
+    .success();
+    assert!(r.stdout.contains("enrolled 2 of 2 scans"), "{}", r.stdout);
+    assert!(dir.path().join("gallery/id1-e0.bpt").is_file());
+    let r = bipolar_cmd(
+        "identify",
+        &[&p("probe.bnt"), "--gallery", &gallery, "--json"],
+    )
+    .success();
+    let j: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+    let ranking = j["ranking"].as_array().unwrap();
+    assert_eq!(ranking.len(), 2);
+    assert_eq!(ranking[0]["identity"], "id1", "{}", r.stdout);
+    assert_eq!(ranking[0]["template"], "id1-e0.bnt");
+    assert!(ranking[0]["score"].as_f64().unwrap() < ranking[1]["score"].as_f64().unwrap());
+    assert_eq!(
+        ranking[0]["comparison"]["view"]["kind"], "matched",
+        "{}",
+        r.stdout
+    );
+    // --top 1 and the text form.
+    let r = bipolar_cmd(
+        "identify",
+        &[&p("probe.bnt"), "--gallery", &gallery, "--top", "1"],
+    )
+    .success();
+    assert_eq!(r.stdout.lines().count(), 1, "{}", r.stdout);
+    assert!(r.stdout.contains("id1"));
+    // Verify: a scan against a template; the score on the first line.
+    let r = bipolar_cmd(
+        "verify",
+        &[&p("probe.bnt"), &p("gallery/id1-e0.bpt"), "--json"],
+    )
+    .success();
+    let j: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+    let s = j["score"].as_f64().unwrap();
+    assert_eq!(
+        j["same"].as_bool().unwrap(),
+        s <= j["threshold"].as_f64().unwrap()
+    );
+    let r = bipolar_cmd("verify", &[&p("probe.bnt"), &p("gallery/id1-e0.bpt")]).success();
+    let first: f64 = r.stdout.lines().next().unwrap().parse().unwrap();
+    assert!((first - s).abs() < 1e-6, "{first} vs {s}");
+    // Bad input: a gallery with no templates, a probe that is not a face.
+    std::fs::create_dir(dir.path().join("empty")).unwrap();
+    let e = bipolar_cmd("identify", &[&p("probe.bnt"), "--gallery", &p("empty")]).failure();
+    assert!(e.contains("no templates"), "{e}");
+}
+
+#[test]
+fn enrolling_a_non_face_says_no_face_was_found() {
+    let dir = tempfile::tempdir().unwrap();
+    let sphere = common::sphere_obj(dir.path());
+    let out = dir.path().join("g");
+    let e = bipolar_cmd(
+        "enroll",
+        &[sphere.to_str().unwrap(), "--out", out.to_str().unwrap()],
+    )
+    .failure();
+    assert!(
+        e.contains("not enrolled") && e.contains("sphere.obj"),
+        "{e}"
+    );
+}

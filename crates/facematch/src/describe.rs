@@ -1,0 +1,417 @@
+//! The bipolar descriptions of a face: the three pole pairs on the static area, without the
+//! boundary band and the grazing parts, and the reference-point search's moved descriptors.
+
+use crate::{KeyedSet, MatchOptions, Pair, Poles};
+use facemodel::{face_frame, static_mask, FaceFrame};
+use geodesic::{GeodesicSolver, SolveOptions, Source};
+use meshcore::{DVec3, Surface, TriMesh};
+
+/// The geodesic fields of a face's landmarks, cut off at `MatchOptions::field_cutoff` times the
+/// outer eye corners' distance. A lost corner has no field (an empty vector).
+#[derive(Debug, Clone)]
+pub struct FaceFields {
+    /// From the right outer eye corner.
+    pub ur: Vec<f64>,
+    /// From the left outer eye corner.
+    pub uq: Vec<f64>,
+    /// From the nose tip.
+    pub un: Vec<f64>,
+    /// D: the geodesic distance between the outer eye corners (mean of the two fields' values;
+    /// NaN with a lost corner).
+    pub d: f64,
+}
+
+impl FaceFields {
+    /// D, or why there is none (a lost corner; the corners not connected within the cut-off).
+    pub fn scale(&self, poles: Poles) -> Result<f64, String> {
+        if poles.lost.is_some() {
+            return Err("an outer eye corner is not on the surface".into());
+        }
+        let d = self.d;
+        if !d.is_finite() || d <= 0.0 {
+            return Err(format!(
+                "the geodesic distance between the outer eye corners is {d} (not reachable within 1.4 times their distance)"
+            ));
+        }
+        Ok(d)
+    }
+
+    /// The two fields of `pair`, in the places of r and q (empty for a lost corner).
+    fn of_pair(&self, pair: Pair) -> (&[f64], &[f64]) {
+        match pair {
+            Pair::Corners => (&self.ur, &self.uq),
+            Pair::RightNose => (&self.ur, &self.un),
+            Pair::LeftNose => (&self.uq, &self.un),
+        }
+    }
+}
+
+/// The fields of the landmarks `poles` on `mesh` by `solver` (of `mesh`), cut off at `cutoff`
+/// times the corners' straight distance.
+pub fn face_fields(
+    mesh: &TriMesh,
+    solver: &dyn GeodesicSolver,
+    poles: Poles,
+    cutoff: f64,
+) -> Result<FaceFields, String> {
+    if poles.lost.is_none() && poles.r == poles.q {
+        return Err(format!(
+            "the two outer eye corners are the same vertex {}",
+            poles.r
+        ));
+    }
+    let [pr, pq, _] = poles.positions(mesh);
+    let cut = SolveOptions {
+        max_distance: Some(cutoff * (pq - pr).length()),
+    };
+    let field = |v: u32, lost: bool| {
+        if lost {
+            return Ok(Vec::new());
+        }
+        solver
+            .distances(&[Source::Vertex(v)], &cut)
+            .map_err(|e| format!("geodesic field: {e}"))
+    };
+    let lost_right = poles.lost.map(|l| l.right);
+    let ur = field(poles.r, lost_right == Some(true))?;
+    let uq = field(poles.q, lost_right == Some(false))?;
+    let un = field(poles.nose, false)?;
+    let d = match poles.lost {
+        Some(_) => f64::NAN,
+        None => 0.5 * (ur[poles.q as usize] + uq[poles.r as usize]),
+    };
+    Ok(FaceFields { ur, uq, un, d })
+}
+
+/// The reference configuration of one pair: its two fields, D, the poles' places, the nose tip
+/// and the landmark frame (the static area's).
+#[derive(Debug, Clone)]
+struct PairRefs {
+    ua: Vec<f64>,
+    ub: Vec<f64>,
+    d: f64,
+    a: DVec3,
+    b: DVec3,
+    nose: DVec3,
+    frame: FaceFrame,
+}
+
+/// The reference fields of `pair`: the poles stand in r and q, D is their geodesic distance.
+/// The frame and the nose tip stay the landmarks' own for every pair, so the static area of a
+/// side pair is its lens above the nose tip's horizontal plane.
+fn pair_refs(
+    mesh: &TriMesh,
+    f: &FaceFields,
+    poles: Poles,
+    pair: Pair,
+    frame: FaceFrame,
+) -> Result<PairRefs, String> {
+    let (ua, ub) = f.of_pair(pair);
+    if ua.is_empty() || ub.is_empty() {
+        return Err(format!(
+            "{pair:?}: a pole has no geodesic field (an outer eye corner not on the surface)"
+        ));
+    }
+    let (a, b) = poles.pole_vertices(pair);
+    let d = match pair {
+        Pair::Corners => f.scale(poles)?,
+        _ => 0.5 * (ua[b as usize] + ub[a as usize]),
+    };
+    if !(d.is_finite() && d > 0.0) {
+        return Err(format!(
+            "{pair:?}: the geodesic distance between the poles is {d} (not reachable within the fields' cut-off)"
+        ));
+    }
+    let [_, _, nose] = poles.positions(mesh);
+    Ok(PairRefs {
+        ua: ua.to_vec(),
+        ub: ub.to_vec(),
+        d,
+        a: mesh.position(a),
+        b: mesh.position(b),
+        nose,
+        frame,
+    })
+}
+
+/// The bipolar descriptor of `refs` on `surface`: static area (within D of both poles, above
+/// the nose tip's horizontal plane), every intersection of the two level families at step
+/// D / N up to level N, on the vertices `kept`.
+fn static_descriptor(
+    surface: &Surface,
+    refs: &PairRefs,
+    levels: u32,
+    kept: Option<&[bool]>,
+) -> Result<bipolar::Descriptor, bipolar::BipolarError> {
+    let mesh = surface.mesh();
+    let mask = static_mask(mesh, &refs.ua, &refs.ub, refs.d, &refs.frame, refs.nose);
+    let mask = match kept {
+        Some(k) => mask.iter().zip(k).map(|(&a, &b)| a && b).collect(),
+        None => mask,
+    };
+    let opts = bipolar::DescriptorOptions {
+        levels: bipolar::LevelSpec::Step(refs.d / f64::from(levels)),
+        max_level: Some(levels),
+        vertex_mask: Some(mask),
+        rule: bipolar::SelectionRule::All,
+        ..Default::default()
+    };
+    bipolar::describe(
+        surface,
+        bipolar::Fields::Precomputed {
+            fields: &[refs.ua.clone(), refs.ub.clone()],
+            references: None,
+        },
+        &opts,
+    )
+}
+
+/// The vertices the descriptors of `surface` may use: those of `seen` (all without it) outside
+/// the band of `margin` along the boundary ([`bipolar::boundary_band`], built once for all the
+/// descriptors of a surface).
+fn kept_vertices(
+    surface: &Surface,
+    seen: Option<Vec<bool>>,
+    margin: Option<f64>,
+) -> Result<Option<Vec<bool>>, bipolar::BipolarError> {
+    let Some(m) = margin else {
+        return Ok(seen);
+    };
+    let band = bipolar::boundary_band(surface, m)?;
+    Ok(Some(match seen {
+        Some(s) => band.iter().zip(&s).map(|(&b, &s)| !b && s).collect(),
+        None => band.iter().map(|&b| !b).collect(),
+    }))
+}
+
+/// The bipolar descriptions of one face.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Description {
+    /// Per [`Pair`] (indexed by its discriminant): the descriptor's keyed points, or why it
+    /// could not be built.
+    pub sets: [Result<KeyedSet, String>; 3],
+    /// Per pair: the descriptors from the moved poles of the reference-point search (empty
+    /// without a search, or for a pair not searched).
+    pub moved: [Vec<KeyedSet>; 3],
+    /// Per pair: moved pole pairs whose fields or descriptor failed (left out, counted).
+    pub moved_failed: [usize; 3],
+    /// The pair this face is compared by as a probe ([`Pair::for_probe`]).
+    pub pair: Pair,
+    /// The landmarks' positions: right and left outer eye corners, nose tip (a lost corner at
+    /// its place).
+    pub landmarks: [DVec3; 3],
+    /// The lost outer corner, if any.
+    pub lost: Option<crate::Lost>,
+    /// The direction toward the scanner (the mesh's frame).
+    pub scanner: DVec3,
+}
+
+/// [`describe_with_fields`] after solving the fields ([`face_fields`]) with a new solver of
+/// `options.method`.
+pub fn describe(
+    mesh: &TriMesh,
+    poles: Poles,
+    scanner: DVec3,
+    options: &MatchOptions,
+    search: bool,
+) -> Result<Description, crate::MatchError> {
+    let solver = geodesic::new_solver(mesh, options.method)?;
+    let f = face_fields(mesh, solver.as_ref(), poles, options.field_cutoff)
+        .map_err(crate::MatchError::Describe)?;
+    let surface = Surface::new(mesh.clone());
+    describe_with_fields(
+        &surface,
+        solver.as_ref(),
+        &f,
+        poles,
+        scanner,
+        None,
+        options,
+        search,
+    )
+}
+
+/// The descriptions of a face on `surface` with its fields `f` (by `solver`, of the same mesh):
+/// each pair's static descriptor on the vertices seen within `options.max_incidence_deg` from
+/// `scanner` (and, when given, from `also_toward`: a view-matched cut) outside the boundary
+/// band, and with `search` the reference-point search's moved descriptors. A descriptor that
+/// cannot be built is kept as its error; the call fails only when the vertex mask does.
+#[allow(clippy::too_many_arguments)]
+pub fn describe_with_fields(
+    surface: &Surface,
+    solver: &dyn GeodesicSolver,
+    f: &FaceFields,
+    poles: Poles,
+    scanner: DVec3,
+    also_toward: Option<DVec3>,
+    options: &MatchOptions,
+    search: bool,
+) -> Result<Description, crate::MatchError> {
+    let mesh = surface.mesh();
+    let [r, q, nose] = poles.positions(mesh);
+    let frame = face_frame(mesh, r, q, nose);
+    let seen = match options.max_incidence_deg {
+        Some(deg) => Some(
+            crate::seen_within(mesh, scanner, also_toward, deg)
+                .map_err(|e| crate::MatchError::Describe(format!("incidence mask: {e}")))?,
+        ),
+        None => None,
+    };
+    let pair = Pair::for_probe(r, q, scanner, options.side_pair_deg, poles.lost);
+    let kept = kept_vertices(surface, seen, options.boundary_margin_mm)
+        .map_err(|e| crate::MatchError::Describe(format!("boundary band: {e}")))?;
+    let refs = Pair::ALL.map(|p| pair_refs(mesh, f, poles, p, frame));
+    let sets = Pair::ALL.map(|p| {
+        let refs = refs[p as usize].as_ref().map_err(Clone::clone)?;
+        static_descriptor(surface, refs, options.levels, kept.as_deref())
+            .map(|d| KeyedSet::of(&d))
+            .map_err(|e| format!("bipolar descriptor: {e}"))
+    });
+    let (moved, moved_failed) = match (search, &options.search) {
+        (true, Some(s)) => {
+            let all = options.least_pair && s.all_pairs;
+            let searched = Pair::ALL.map(|p| p == pair || all);
+            moved_descriptors(
+                surface,
+                solver,
+                poles,
+                &refs,
+                searched,
+                all,
+                s,
+                options,
+                kept.as_deref(),
+            )
+        }
+        _ => Default::default(),
+    };
+    Ok(Description {
+        sets,
+        moved,
+        moved_failed,
+        pair,
+        landmarks: [r, q, nose],
+        lost: poles.lost,
+        scanner,
+    })
+}
+
+/// A searched pole's identity: the landmark (0 r, 1 q, 2 nose tip) and the bits of the point
+/// its first direction points toward.
+type PoleKey = (usize, [u64; 3]);
+
+/// The moved descriptors per pair: the poles of each pair in `searched` (with reference fields
+/// `refs`; a pair whose `refs` failed is left empty) moved by the search radius in its
+/// directions of their tangent planes ([`bipolar::SearchedPole`], paired by
+/// [`bipolar::moved_pairs`]: each pole at its place or moved, 48 pairs with 6 directions).
+/// The first direction of a pole points toward the pair's other pole, or, with `shared`, the
+/// same for every pair: an outer eye corner toward the other, the nose tip toward their
+/// midpoint, so that each landmark's moved fields are solved once for all pairs. Moved corners
+/// get the frame of their new eye line; a side pair keeps the landmarks' frame. Also the count
+/// of moved pairs left out per pair (a failed candidate set, field or descriptor).
+#[allow(clippy::too_many_arguments)]
+fn moved_descriptors(
+    surface: &Surface,
+    solver: &dyn GeodesicSolver,
+    poles: Poles,
+    refs: &[Result<PairRefs, String>; 3],
+    searched: [bool; 3],
+    shared: bool,
+    s: &crate::SearchOptions,
+    o: &MatchOptions,
+    kept: Option<&[bool]>,
+) -> ([Vec<KeyedSet>; 3], [usize; 3]) {
+    let mut out: [Vec<KeyedSet>; 3] = Default::default();
+    let mut failed = [0usize; 3];
+    let mesh = surface.mesh();
+    let search: Vec<(Pair, &PairRefs)> = Pair::ALL
+        .into_iter()
+        .filter(|p| searched[*p as usize])
+        .filter_map(|p| refs[p as usize].as_ref().ok().map(|r| (p, r)))
+        .collect();
+    let Some(span) = search
+        .iter()
+        .map(|(_, r)| (r.b - r.a).length())
+        .reduce(f64::max)
+    else {
+        return (out, failed);
+    };
+    let rho = s.radius_mm;
+    let cut = SolveOptions {
+        max_distance: Some(o.field_cutoff * span + 4.0 * rho),
+    };
+    let lm_vertex = [poles.r, poles.q, poles.nose];
+    let [pr, pq, _] = poles.positions(mesh);
+    // A landmark's searched pole, by (landmark, the point its first direction points toward);
+    // the given pole keeps its field, each moved one is solved. `None`: no candidates.
+    let mut cache: Vec<(PoleKey, Option<bipolar::SearchedPole>)> = Vec::new();
+    let mut moved = |k: usize, toward: DVec3, given: &[f64]| -> usize {
+        let key = (k, toward.to_array().map(f64::to_bits));
+        if let Some(i) = cache.iter().position(|(c, _)| *c == key) {
+            return i;
+        }
+        let pole = bipolar::SearchedPole::new(
+            mesh,
+            solver,
+            lm_vertex[k],
+            toward,
+            given,
+            rho,
+            s.directions,
+            &cut,
+        )
+        .ok();
+        cache.push((key, pole));
+        cache.len() - 1
+    };
+    let toward = |k: usize, other: DVec3| match (shared, k) {
+        (false, _) => other,
+        (true, 0) => pq,
+        (true, 1) => pr,
+        (true, _) => 0.5 * (pr + pq),
+    };
+    let jobs: Vec<(Pair, &PairRefs, usize, usize)> = search
+        .into_iter()
+        .map(|(pair, refs)| {
+            let (ka, kb) = match pair {
+                Pair::Corners => (0, 1),
+                Pair::RightNose => (0, 2),
+                Pair::LeftNose => (1, 2),
+            };
+            let ia = moved(ka, toward(ka, refs.b), &refs.ua);
+            let ib = moved(kb, toward(kb, refs.a), &refs.ub);
+            (pair, refs, ia, ib)
+        })
+        .collect();
+    for (pair, refs, ia, ib) in jobs {
+        let (Some(a), Some(b)) = (&cache[ia].1, &cache[ib].1) else {
+            // No candidates: the pairs a full search would make are all missing.
+            failed[pair as usize] += (s.directions + 1) * (s.directions + 1) - 1;
+            continue;
+        };
+        // Every candidate of one pole with every one of the other but the given ones together.
+        let expected = a.vertices.len() * b.vertices.len() - 1;
+        let mut built = 0;
+        for m in bipolar::moved_pairs(a, b) {
+            let (pa, pb) = (mesh.position(m.r), mesh.position(m.q));
+            let moved = PairRefs {
+                ua: m.ur.to_vec(),
+                ub: m.uq.to_vec(),
+                d: m.d,
+                a: pa,
+                b: pb,
+                nose: refs.nose,
+                frame: match pair {
+                    Pair::Corners => face_frame(mesh, pa, pb, refs.nose),
+                    _ => refs.frame,
+                },
+            };
+            if let Ok(d) = static_descriptor(surface, &moved, o.levels, kept) {
+                out[pair as usize].push(KeyedSet::of(&d));
+                built += 1;
+            }
+        }
+        failed[pair as usize] += expected.saturating_sub(built);
+    }
+    (out, failed)
+}

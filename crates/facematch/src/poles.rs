@@ -1,0 +1,258 @@
+//! The reference landmarks of a face (outer eye corners, nose tip) and the three pole pairs.
+
+use landmarks::{LandmarkName, VisibleLandmarks};
+use meshcore::{DVec3, TriMesh};
+
+/// An outer eye corner that is not on the surface, and where it is (a ground truth, or where
+/// the detector's fitted face predicts it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Lost {
+    /// The right corner (r); else the left (q).
+    pub right: bool,
+    /// Where it is (mesh frame).
+    pub position: DVec3,
+}
+
+/// The three reference vertices of a face. With a [`Lost`] corner only the other corner's side
+/// pair describes the face; the lost corner's vertex field holds the nose tip's (never used as
+/// a pole: [`Poles::pole_vertices`] refuses it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Poles {
+    /// The right outer eye corner.
+    pub r: u32,
+    /// The left outer eye corner.
+    pub q: u32,
+    /// The nose tip.
+    pub nose: u32,
+    /// An outer eye corner that is not on the surface.
+    pub lost: Option<Lost>,
+}
+
+impl Poles {
+    /// The three landmarks without a lost corner.
+    pub fn new(r: u32, q: u32, nose: u32) -> Self {
+        Self {
+            r,
+            q,
+            nose,
+            lost: None,
+        }
+    }
+
+    /// From the vertices of the outer eye corners and the nose tip (or why each is missing) and
+    /// the corners' places `at` (true or predicted): all three, or, with `allow_lost`, one
+    /// corner missing (a [`Lost`] corner at its place). Otherwise the first missing one's
+    /// reason.
+    pub fn from_parts(
+        [r, q, nose]: [Result<u32, String>; 3],
+        at: [DVec3; 2],
+        allow_lost: bool,
+    ) -> Result<Self, String> {
+        let lost = |right: bool| {
+            Some(Lost {
+                right,
+                position: at[usize::from(!right)],
+            })
+        };
+        match (r, q, nose?) {
+            (Ok(r), Ok(q), nose) => Ok(Self::new(r, q, nose)),
+            (Err(_), Ok(q), nose) if allow_lost => Ok(Self {
+                r: nose,
+                q,
+                nose,
+                lost: lost(true),
+            }),
+            (Ok(r), Err(_), nose) if allow_lost => Ok(Self {
+                r,
+                q: nose,
+                nose,
+                lost: lost(false),
+            }),
+            (Err(e), _, _) | (_, Err(e), _) => Err(e),
+        }
+    }
+
+    /// From detected landmarks on `mesh` ([`Poles::from_parts`]): a corner the detector reported
+    /// unseen may be lost, at the place the fitted face predicts, or with `predicted` placed at
+    /// the vertex nearest that place when it is within `snap` of the mesh.
+    pub fn from_detected(
+        mesh: &TriMesh,
+        d: &VisibleLandmarks,
+        allow_lost: bool,
+        predicted: bool,
+        snap: f64,
+    ) -> Result<Self, String> {
+        use LandmarkName as L;
+        let v = |n: L| {
+            d.get(n).map(|l| l.vertex).or_else(|u| {
+                let placed = (predicted && n != L::NoseTip)
+                    .then(|| crate::nearest_vertex(mesh, d.predicted[n as usize]))
+                    .flatten();
+                match placed {
+                    Some((w, dist)) if dist <= snap => Ok(w),
+                    _ => Err(format!("detection: {n} {u}")),
+                }
+            })
+        };
+        Self::from_parts(
+            [v(L::OuterEyeRight), v(L::OuterEyeLeft), v(L::NoseTip)],
+            [
+                d.predicted[L::OuterEyeRight as usize],
+                d.predicted[L::OuterEyeLeft as usize],
+            ],
+            allow_lost,
+        )
+    }
+
+    /// Positions of r, q and the nose tip (for a lost corner, its [`Lost::position`]).
+    pub fn positions(self, mesh: &TriMesh) -> [DVec3; 3] {
+        let mut p = [self.r, self.q, self.nose].map(|v| mesh.position(v));
+        if let Some(l) = self.lost {
+            p[usize::from(!l.right)] = l.position;
+        }
+        p
+    }
+
+    /// The two pole vertices of `pair`, in the places of r and q.
+    pub fn pole_vertices(self, pair: Pair) -> (u32, u32) {
+        match pair {
+            Pair::Corners => (self.r, self.q),
+            Pair::RightNose => (self.r, self.nose),
+            Pair::LeftNose => (self.q, self.nose),
+        }
+    }
+
+    /// The same poles on a renumbered mesh (`map[old] = new`, `u32::MAX`: dropped), a dropped
+    /// landmark placed at the vertex of `to` nearest its old place within `snap`; `None` when
+    /// one cannot be placed. A lost corner stays lost.
+    pub fn carried(self, from: &TriMesh, to: &TriMesh, map: &[u32], snap: f64) -> Option<Self> {
+        let place = |v: u32| match map.get(v as usize).copied() {
+            Some(w) if w != u32::MAX => Some(w),
+            _ => match crate::nearest_vertex(to, from.position(v)) {
+                Some((w, d)) if d <= snap => Some(w),
+                _ => None,
+            },
+        };
+        let nose = place(self.nose)?;
+        let corner = |v: u32, right: bool| match self.lost {
+            Some(l) if l.right == right => Some(nose),
+            _ => place(v),
+        };
+        Some(Self {
+            r: corner(self.r, true)?,
+            q: corner(self.q, false)?,
+            nose,
+            lost: self.lost,
+        })
+    }
+}
+
+/// The two poles of a bipolar descriptor: the outer eye corners (the paper's), or one outer eye
+/// corner with the nose tip. The discriminant indexes per-pair arrays.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Pair {
+    /// The outer eye corners.
+    Corners = 0,
+    /// The right outer eye corner (r) and the nose tip.
+    RightNose = 1,
+    /// The left outer eye corner (q) and the nose tip.
+    LeftNose = 2,
+}
+
+impl Pair {
+    /// The three pairs, in index order.
+    pub const ALL: [Pair; 3] = [Pair::Corners, Pair::RightNose, Pair::LeftNose];
+
+    /// The pair's name in files and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Pair::Corners => "corners",
+            Pair::RightNose => "right-nose",
+            Pair::LeftNose => "left-nose",
+        }
+    }
+
+    /// The pair by its index.
+    pub fn from_index(i: usize) -> Option<Pair> {
+        Self::ALL.get(i).copied()
+    }
+
+    /// The pair a probe is compared by: the corners, or, when `limit_deg` is given and the face
+    /// is turned from its scanner (direction `scanner`) by more than it, the corner nearer the
+    /// scanner with the nose tip. The turn is estimated from the eye line alone,
+    /// `asin(|x . scanner|)` (x: the unit eye line r to q), so a pitch of the head barely
+    /// changes it. A face with a lost corner has only the other corner's pair.
+    pub fn for_probe(
+        r: DVec3,
+        q: DVec3,
+        scanner: DVec3,
+        limit_deg: Option<f64>,
+        lost: Option<Lost>,
+    ) -> Pair {
+        match lost {
+            Some(l) if l.right => return Pair::LeftNose,
+            Some(_) => return Pair::RightNose,
+            None => {}
+        }
+        let Some(limit) = limit_deg else {
+            return Pair::Corners;
+        };
+        let s = (q - r).normalize_or_zero().dot(scanner.normalize_or_zero());
+        match s.abs().clamp(0.0, 1.0).asin().to_degrees() {
+            t if t <= limit => Pair::Corners,
+            _ if s > 0.0 => Pair::LeftNose,
+            _ => Pair::RightNose,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_missing_corner_is_lost_only_when_allowed() {
+        let at = [DVec3::X, DVec3::Y];
+        let p = Poles::from_parts([Err("gone".into()), Ok(4), Ok(9)], at, true).unwrap();
+        assert_eq!(
+            p.lost.map(|l| (l.right, l.position)),
+            Some((true, DVec3::X))
+        );
+        assert_eq!(p.q, 4);
+        let e = Poles::from_parts([Err("gone".into()), Ok(4), Ok(9)], at, false).unwrap_err();
+        assert_eq!(e, "gone");
+        let e = Poles::from_parts([Ok(1), Ok(4), Err("no nose".into())], at, true).unwrap_err();
+        assert_eq!(e, "no nose");
+    }
+
+    #[test]
+    fn a_turned_face_takes_the_nearer_side_pair() {
+        let z = DVec3::Z;
+        let r = DVec3::new(-5.0, 0.0, 0.0);
+        let turn = |deg: f64| {
+            let a = deg.to_radians();
+            r + 10.0 * DVec3::new(a.cos(), 0.0, a.sin())
+        };
+        assert_eq!(
+            Pair::for_probe(r, turn(20.0), z, Some(30.0), None),
+            Pair::Corners
+        );
+        assert_eq!(
+            Pair::for_probe(r, turn(40.0), z, Some(30.0), None),
+            Pair::LeftNose
+        );
+        assert_eq!(
+            Pair::for_probe(r, turn(-40.0), z, Some(30.0), None),
+            Pair::RightNose
+        );
+        assert_eq!(Pair::for_probe(r, turn(40.0), z, None, None), Pair::Corners);
+        let lost = Some(Lost {
+            right: false,
+            position: DVec3::ZERO,
+        });
+        assert_eq!(
+            Pair::for_probe(r, turn(0.0), z, None, lost),
+            Pair::RightNose
+        );
+    }
+}

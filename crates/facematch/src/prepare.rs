@@ -1,0 +1,218 @@
+//! A scan prepared for matching: cleaned, cropped around the detected nose tip, its landmarks.
+
+use crate::{Description, MatchError, MatchOptions, Poles, PrepareOptions, GRID_SCANNER};
+use landmarks::{DetectOptions, GenericModel, LandmarkName, VisibleLandmarks};
+use mesh_io::BntGrid;
+use meshcore::units::Units;
+use meshcore::{DVec3, TriMesh};
+use scanprep::{CleanOptions, Crop, Input};
+use std::time::{Duration, Instant};
+
+/// What a face is prepared from.
+#[derive(Debug, Clone, Copy)]
+pub enum ScanInput<'a> {
+    /// A range grid (`.bnt`, mm): the scanner looks down its z axis ([`GRID_SCANNER`]).
+    Grid(&'a BntGrid),
+    /// A mesh in any units (`None`: recognised from the face's size) with the direction toward
+    /// its scanner where known (`None`: `+z` is taken, and the prepared scan says so).
+    Mesh {
+        /// The mesh.
+        mesh: &'a TriMesh,
+        /// Its units.
+        units: Option<Units>,
+        /// The direction toward its scanner.
+        scanner: Option<DVec3>,
+    },
+}
+
+/// Wall time of each step of [`prepare`].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct StepTimes {
+    /// The first cleaning (no crop).
+    pub clean: Duration,
+    /// Detection on it.
+    pub detect: Duration,
+    /// The cleaning with the crop around the detected nose tip.
+    pub crop_clean: Duration,
+    /// Detection on the cropped scan.
+    pub crop_detect: Duration,
+}
+
+/// A scan ready to be described: cleaned (mm), cropped around its detected nose tip, and the
+/// landmarks detected on the cropped scan.
+#[derive(Debug, Clone)]
+pub struct PreparedScan {
+    /// The cleaned, cropped scan (mm, the input's frame scaled).
+    pub mesh: TriMesh,
+    /// The direction toward the scanner (unit).
+    pub scanner: DVec3,
+    /// The units the input was read in.
+    pub units: Units,
+    /// The landmarks detected on `mesh` (those the scanner did not see reported unseen).
+    pub detected: VisibleLandmarks,
+    /// What was assumed or substituted (a default scanner direction, no crop possible, ...).
+    pub notes: Vec<String>,
+    /// Step times.
+    pub times: StepTimes,
+}
+
+/// [`prepare_with`] with the default generic landmark model.
+pub fn prepare(input: ScanInput<'_>, options: &MatchOptions) -> Result<PreparedScan, MatchError> {
+    let generic = GenericModel::default_model()
+        .map_err(|e| MatchError::Landmarks(format!("the generic model: {e}")))?;
+    prepare_with(input, &generic, options)
+}
+
+/// Prepares a scan: cleans it (`options.prepare.clean`, no crop), detects the landmarks seen
+/// from the scanner, cleans the input again with a crop of `options.prepare.crop_radius_mm`
+/// around the detected nose tip and detects again on the cropped scan. Errors: the cleaning's,
+/// and [`MatchError::NoFace`] with the detector's reason when no face is found.
+pub fn prepare_with(
+    input: ScanInput<'_>,
+    generic: &GenericModel,
+    options: &MatchOptions,
+) -> Result<PreparedScan, MatchError> {
+    options.validate()?;
+    let p = &options.prepare;
+    let mut notes = Vec::new();
+    let (scan_input, units, scanner) = match input {
+        ScanInput::Grid(g) => (Input::Grid(g), Some(Units::Millimetre), GRID_SCANNER),
+        ScanInput::Mesh {
+            mesh,
+            units,
+            scanner,
+        } => {
+            let s = match scanner.map(DVec3::normalize_or_zero) {
+                Some(s) if s.is_finite() && s != DVec3::ZERO => s,
+                Some(s) => {
+                    return Err(MatchError::InvalidOption(format!(
+                        "scanner direction {s:?} (a finite, non-zero vector)"
+                    )))
+                }
+                None => {
+                    notes.push(
+                        "no scanner direction given: +z taken (the direction toward the scanner decides what counts as seen)"
+                            .to_string(),
+                    );
+                    DVec3::Z
+                }
+            };
+            (Input::Mesh(mesh), units, s)
+        }
+    };
+    let clean_opts = CleanOptions {
+        units: units.or(p.clean.units),
+        crop: None,
+        ..p.clean.clone()
+    };
+    let t0 = Instant::now();
+    let first = scanprep::clean(scan_input, &clean_opts)?;
+    let used = first.report.units.used;
+    let t1 = Instant::now();
+    let found = detect(&first.mesh, generic, scanner, p)?;
+    let t2 = Instant::now();
+    let Some(radius_mm) = p.crop_radius_mm else {
+        return Ok(PreparedScan {
+            mesh: first.mesh,
+            scanner,
+            units: used,
+            detected: found,
+            notes,
+            times: StepTimes {
+                clean: t1 - t0,
+                detect: t2 - t1,
+                ..StepTimes::default()
+            },
+        });
+    };
+    // The crop's centre in the input's units and frame.
+    let nose_mm = first.mesh.position(
+        found
+            .get(LandmarkName::NoseTip)
+            .map_err(|u| MatchError::NoFace(format!("the nose tip is {u}")))?
+            .vertex,
+    );
+    let centre = nose_mm / used.mm_per_unit();
+    let cropped = scanprep::clean(
+        scan_input,
+        &CleanOptions {
+            units: Some(used),
+            crop: Some(Crop { centre, radius_mm }),
+            ..clean_opts
+        },
+    )?;
+    let t3 = Instant::now();
+    let detected = detect(&cropped.mesh, generic, scanner, p)?;
+    let t4 = Instant::now();
+    Ok(PreparedScan {
+        mesh: cropped.mesh,
+        scanner,
+        units: used,
+        detected,
+        notes,
+        times: StepTimes {
+            clean: t1 - t0,
+            detect: t2 - t1,
+            crop_clean: t3 - t2,
+            crop_detect: t4 - t3,
+        },
+    })
+}
+
+/// The landmarks seen from `scanner` on `mesh` (mm), detected on a smoothed copy when asked,
+/// placed at their vertices of `mesh`.
+fn detect(
+    mesh: &TriMesh,
+    generic: &GenericModel,
+    scanner: DVec3,
+    p: &PrepareOptions,
+) -> Result<VisibleLandmarks, MatchError> {
+    let smoothed = match p.detect_smoothing {
+        0 => None,
+        k => Some(scanprep::taubin_smooth(mesh, k)?),
+    };
+    let seen = smoothed.as_ref().unwrap_or(mesh);
+    let scale = landmarks::mesh_units_per_model_unit(seen, generic)
+        .map_err(|e| MatchError::NoFace(e.to_string()))?;
+    let mut found = landmarks::detect_visible(
+        seen,
+        generic,
+        &DetectOptions {
+            mesh_units_per_model_unit: scale,
+            toward_viewer: Some(scanner),
+            ..p.detect
+        },
+    )
+    .map_err(|e| MatchError::NoFace(e.to_string()))?;
+    for l in found.landmarks.iter_mut().flatten() {
+        l.position = mesh.position(l.vertex);
+    }
+    Ok(found)
+}
+
+impl PreparedScan {
+    /// The poles from the detected landmarks ([`Poles::from_detected`]: with side pairs on, an
+    /// unseen outer corner is lost; with `predicted_corners`, placed at its prediction when
+    /// within `snap_mm`).
+    pub fn poles(&self, options: &MatchOptions) -> Result<Poles, MatchError> {
+        Poles::from_detected(
+            &self.mesh,
+            &self.detected,
+            options.side_pair_deg.is_some(),
+            options.predicted_corners,
+            options.snap_mm,
+        )
+        .map_err(MatchError::Landmarks)
+    }
+
+    /// The scan's descriptions from its detected poles ([`crate::describe`]; with `search`, the
+    /// probe's reference-point search).
+    pub fn describe(
+        &self,
+        options: &MatchOptions,
+        search: bool,
+    ) -> Result<Description, MatchError> {
+        let poles = self.poles(options)?;
+        crate::describe(&self.mesh, poles, self.scanner, options, search)
+    }
+}
