@@ -3,7 +3,8 @@
 
 use clap::Parser;
 use experiments::{
-    landmarks_eval, recognition, robustness, scan_path, scan_study, section6, sphere_validate,
+    landmarks_eval, match_eval, recognition, robustness, scan_path, scan_study, section6,
+    sphere_validate,
 };
 
 /// Experiments and evaluations of the bipolar workspace.
@@ -18,6 +19,9 @@ enum Task {
     Recognition(recognition::Args),
     /// Landmark detection accuracy on sampled faces.
     LandmarksEval(landmarks_eval::Args),
+    /// Face matching through the public API (enrol, identify, verify) on virtual scans of the
+    /// benchmark's scanner and of another one, with the residual gate chosen on the first.
+    MatchEval(match_eval::Args),
     /// The descriptor's stability on range scans: rescans, expressions, other persons.
     ScanStudy(scan_study::Args),
     /// Wall time of each step of the path of one range scan (read, clean, detect, describe).
@@ -33,6 +37,7 @@ fn main() -> anyhow::Result<()> {
         Task::Robustness(args) => robustness::run(args),
         Task::Recognition(args) => recognition::run(args),
         Task::LandmarksEval(args) => landmarks_eval::run(args),
+        Task::MatchEval(args) => match_eval::run(args),
         Task::ScanStudy(args) => scan_study::run(args),
         Task::ScanPath(args) => scan_path::run(args),
         Task::Section6(args) => section6::run(args),

@@ -8,6 +8,7 @@
 //! face-set loading, the face frame and the static-area mask are in the `facemodel` crate.
 
 pub mod landmarks_eval;
+pub mod match_eval;
 pub mod recognition;
 pub mod robustness;
 pub mod scan_path;
