@@ -3,11 +3,13 @@
 Meshes (every format of the Rust mesh-io crate), geodesic distance fields (exact, fast
 marching, heat method, Dijkstra) from a solver prepared once per mesh, the bipolar descriptor
 with every option of ``bipolar describe``, normalised shape distances (keys, ICP, Hausdorff)
-and distance matrices, automatic face landmarks. numpy arrays in and out; the GIL is released
-while Rust computes.
+and distance matrices, automatic face landmarks, face matching (``enroll``, ``Template``,
+``Gallery.identify``, ``verify``: ``bipolar enroll / identify / verify``). numpy arrays in
+and out; the GIL is released while Rust computes.
 
 Sub-modules: ``bipolar.gdist`` (drop-in for tvb-gdist), ``bipolar.dask`` (describe many files,
-block distance matrices and 1:N identification on a dask.distributed cluster),
+block distance matrices and 1:N identification, of descriptors or of face templates, on a
+dask.distributed cluster),
 ``bipolar.errors`` (the exception hierarchy).
 
 Example::
@@ -28,10 +30,12 @@ from ._bipolar import (
     Descriptor,
     DistanceOptions,
     FacialCurves,
+    Gallery,
     GeodesicSolver,
     IsoCurvatureCurves,
     Mesh,
     PolarDescriptor,
+    Template,
     __version__,
     clean,
     cross_distances,
@@ -42,6 +46,7 @@ from ._bipolar import (
     distance_details,
     distance_matrix,
     elastic_distance,
+    enroll,
     facial_curves,
     facial_curves_distance,
     grid_plane,
@@ -62,6 +67,7 @@ from ._bipolar import (
     unpack_key,
     unpack_polar_key,
     uv_sphere,
+    verify,
     visible_faces,
     write_lm3,
     write_mesh,
@@ -77,6 +83,7 @@ from .errors import (
     InputTypeError,
     LandmarksNotFoundError,
     NoDescriptorPointsError,
+    TemplateSettingsError,
 )
 
 __all__ = [
@@ -88,6 +95,7 @@ __all__ = [
     "FacialCurves",
     "FileError",
     "FileFormatError",
+    "Gallery",
     "GeodesicSolver",
     "IndexOutOfRangeError",
     "InputError",
@@ -97,6 +105,8 @@ __all__ = [
     "Mesh",
     "NoDescriptorPointsError",
     "PolarDescriptor",
+    "Template",
+    "TemplateSettingsError",
     "__version__",
     "clean",
     "cross_distances",
@@ -107,6 +117,7 @@ __all__ = [
     "distance_details",
     "distance_matrix",
     "elastic_distance",
+    "enroll",
     "errors",
     "facial_curves",
     "facial_curves_distance",
@@ -129,6 +140,7 @@ __all__ = [
     "unpack_key",
     "unpack_polar_key",
     "uv_sphere",
+    "verify",
     "write_lm3",
     "write_mesh",
     "write_ply",

@@ -385,3 +385,89 @@ def clean(
     smooth: int = 0,
     target_edge: Optional[float] = None,
 ) -> Tuple[Mesh, Dict[str, Any]]: ...
+
+# Face matching (facematch): as `bipolar enroll`, `identify`, `verify`.
+
+Scan = Union[Mesh, PathLike]
+
+class Template:
+    """A face template (``.bpt``): identity, source, settings, the descriptors of the three pole
+    pairs and of the turned views; read back bit-identically."""
+
+    @staticmethod
+    def from_scan(
+        scan: Scan,
+        identity: Optional[str] = None,
+        *,
+        probe: bool = False,
+        source: Optional[str] = None,
+        scanner: Optional[ArrayLike] = None,
+        units: Optional[Literal["mm", "cm", "m"]] = None,
+    ) -> "Template": ...
+    @staticmethod
+    def from_bytes(data: bytes, name: str = "<bytes>") -> "Template": ...
+    @staticmethod
+    def read(path: PathLike) -> "Template": ...
+    def to_bytes(self) -> bytes: ...
+    def write(self, path: PathLike) -> None: ...
+    @property
+    def identity(self) -> str: ...
+    @property
+    def source(self) -> str: ...
+    @property
+    def settings(self) -> str: ...
+    @property
+    def notes(self) -> List[str]: ...
+    @property
+    def pair(self) -> Literal["corners", "right-nose", "left-nose"]: ...
+    @property
+    def searched(self) -> bool: ...
+    @property
+    def landmarks(self) -> F64: ...
+    @property
+    def view_yaws(self) -> List[float]: ...
+    def __eq__(self, other: object) -> bool: ...
+
+Probe = Union[Template, Mesh, PathLike]
+
+class Gallery:
+    """Templates to identify probes against (a folder of ``.bpt`` files or a ``.bpg`` file)."""
+
+    def __init__(self, templates: Sequence[Template]) -> None: ...
+    @staticmethod
+    def open(path: PathLike) -> "Gallery": ...
+    def write(self, path: PathLike) -> None: ...
+    def to_bytes(self) -> bytes: ...
+    @property
+    def templates(self) -> List[Template]: ...
+    @property
+    def identities(self) -> List[str]: ...
+    def identify(
+        self,
+        probe: Probe,
+        *,
+        top: Optional[int] = None,
+        gate: Optional[float] = None,
+        scanner: Optional[ArrayLike] = None,
+        units: Optional[Literal["mm", "cm", "m"]] = None,
+    ) -> List[Dict[str, Any]]: ...
+    def __len__(self) -> int: ...
+
+def enroll(
+    scans: Sequence[Scan],
+    identities: Optional[Sequence[str]] = None,
+    *,
+    identity_from: Optional[str] = None,
+    scanner: Optional[ArrayLike] = None,
+    units: Optional[Literal["mm", "cm", "m"]] = None,
+    skip_failed: bool = False,
+) -> Gallery: ...
+def verify(
+    a: Probe,
+    b: Probe,
+    *,
+    gate: Optional[float] = None,
+    scanner: Optional[ArrayLike] = None,
+    units: Optional[Literal["mm", "cm", "m"]] = None,
+) -> Dict[str, Any]: ...
+def _merge_rankings(shards: Sequence[Sequence[Dict[str, Any]]]) -> List[Dict[str, Any]]: ...

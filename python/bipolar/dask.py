@@ -7,9 +7,12 @@
   blocks are assembled on the client.
 * :func:`identify` ranks a gallery for each probe (1:N identification) from the P x G block
   matrix.
+* :func:`identify_templates` is face identification with templates (``bipolar.Gallery``):
+  the gallery cut into shards of templates, one task per probe and shard, the shards'
+  rankings merged on the client into ``Gallery.identify``'s ranking of the whole gallery.
 
 Results are identical to the single-process calls (``bipolar.describe``,
-``bipolar.distance_matrix``, ``bipolar.cross_distances``): each entry is computed by the same
+``bipolar.distance_matrix``, ``bipolar.cross_distances``, ``bipolar.Gallery.identify``): each entry is computed by the same
 deterministic library function on the same inputs, whatever the block size or the number of
 workers. Tasks use ``threads_per_task`` rayon threads (default 1: one task per worker thread
 keeps the cores busy without oversubscription).
@@ -28,7 +31,15 @@ import numpy as np
 
 from . import _bipolar
 
-__all__ = ["describe_files", "distance_matrix", "identify", "rank", "Identification", "blocks"]
+__all__ = [
+    "describe_files",
+    "distance_matrix",
+    "identify",
+    "identify_templates",
+    "rank",
+    "Identification",
+    "blocks",
+]
 
 
 def _client(client: Any) -> Any:
@@ -233,3 +244,64 @@ def rank(
         res.ranks = ranks
         res.rank1_rate = float(np.mean(ranks[known] == 1)) if known.any() else float("nan")
     return res
+
+
+def _probe_template(scan: Any, kwargs: dict) -> _bipolar.Template:
+    return _bipolar.Template.from_scan(scan, "probe", probe=True, **kwargs)
+
+
+def _identify_shard(
+    probe: Any, shard: _bipolar.Gallery, gate: Optional[float]
+) -> List[dict]:
+    return shard.identify(probe, gate=gate)
+
+
+def identify_templates(
+    probes: Sequence[Any],
+    gallery: Any,
+    *,
+    client: Any = None,
+    shard_size: Optional[int] = None,
+    top: Optional[int] = None,
+    gate: Optional[float] = None,
+    scanner: Any = None,
+    units: Optional[str] = None,
+) -> List[List[dict]]:
+    """Face identification of each probe against a gallery of templates on the cluster: for
+    every probe the ranking ``gallery.identify(probe, top=top, gate=gate)`` gives in one
+    process (the same dicts, in the same order).
+
+    ``gallery``: a ``bipolar.Gallery``, a list of ``bipolar.Template`` or a gallery path
+    (opened on the client). It is cut into shards of ``shard_size`` templates (default: about
+    two shards per worker thread), each scattered to the workers once; a task ranks one shard for one
+    probe (``Gallery.identify``), and the client merges the shards' rankings, taking per
+    identity its first best score as ``Gallery.identify`` does. ``probes``: ``Template`` objects
+    (used as is) or scans (``Mesh`` objects or paths the workers can read), made into probe
+    templates on the workers (``Template.from_scan(scan, "probe", probe=True, scanner=,
+    units=)``), one task each. Returns one ranking (a list of dicts) per probe, in order."""
+    c = _client(client)
+    if isinstance(gallery, _bipolar.Gallery):
+        g = gallery
+    elif isinstance(gallery, (list, tuple)):
+        g = _bipolar.Gallery(list(gallery))
+    else:
+        g = _bipolar.Gallery.open(gallery)
+    templates = g.templates
+    if shard_size is None:
+        shard_size = _default_block(len(templates), c) * 2
+    shards = [
+        c.scatter(_bipolar.Gallery(templates[s:e]), hash=False)
+        for s, e in blocks(len(templates), shard_size)
+    ]
+    kwargs = {"scanner": scanner, "units": units}
+    out = []
+    for p in probes:
+        probe = p if isinstance(p, _bipolar.Template) else c.submit(
+            _probe_template, p, kwargs, pure=False
+        )
+        out.append([c.submit(_identify_shard, probe, s, gate, pure=False) for s in shards])
+    rankings = []
+    for futures in out:
+        merged = _bipolar._merge_rankings(c.gather(futures))
+        rankings.append(merged if top is None else merged[:top])
+    return rankings

@@ -18,6 +18,7 @@ __all__ = [
     "FileError",
     "LandmarksNotFoundError",
     "ComputationError",
+    "TemplateSettingsError",
 ]
 
 
@@ -55,3 +56,8 @@ class LandmarksNotFoundError(BipolarError):
 
 class ComputationError(BipolarError, RuntimeError):
     """A numerical step failed (e.g. a sparse factorisation of a degenerate mesh)."""
+
+
+class TemplateSettingsError(InputError):
+    """A face template made with other settings than the ones it is compared with (the message
+    gives both)."""

@@ -27,6 +27,8 @@ pub enum Kind {
     NotFound,
     /// `ComputationError` (a `RuntimeError`).
     Computation,
+    /// `TemplateSettingsError` (a `ValueError`): a template made with other settings.
+    Settings,
 }
 
 impl Kind {
@@ -40,6 +42,7 @@ impl Kind {
             Kind::File => "FileError",
             Kind::NotFound => "LandmarksNotFoundError",
             Kind::Computation => "ComputationError",
+            Kind::Settings => "TemplateSettingsError",
         }
     }
 }
@@ -216,6 +219,22 @@ pub fn facecurves(e: facecurves::FaceCurvesError) -> PyErr {
         E::File { .. } => Kind::Format,
         E::NoCurves(_) | E::NoSharedCurves { .. } => Kind::NoPoints,
         _ => Kind::Input,
+    };
+    err(kind, chain(&e))
+}
+
+/// The Python exception (of `bipolar.errors`) for a `facematch::MatchError`.
+pub fn matching(e: facematch::MatchError) -> PyErr {
+    use facematch::MatchError as E;
+    let kind = match &e {
+        E::Clean(_) => Kind::Input,
+        E::NoFace(_) | E::Landmarks(_) => Kind::NotFound,
+        E::Geodesic(g) => geodesic_kind(g),
+        E::Describe(_) => Kind::NoPoints,
+        E::InvalidOption(_) | E::EmptyGallery(_) => Kind::Input,
+        E::Template { .. } => Kind::Format,
+        E::Settings { .. } => Kind::Settings,
+        E::Io { .. } => Kind::File,
     };
     err(kind, chain(&e))
 }

@@ -19,6 +19,7 @@ mod distance;
 mod errors;
 mod geodesic;
 mod landmark;
+mod matching;
 mod mesh;
 mod polar;
 mod scan;
@@ -73,5 +74,6 @@ fn _bipolar(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(curves::facial_curves_distance, m)?)?;
     m.add_function(wrap_pyfunction!(curves::iso_curvature_distance, m)?)?;
     m.add_function(wrap_pyfunction!(curves::elastic_distance, m)?)?;
+    matching::register(m)?;
     Ok(())
 }
