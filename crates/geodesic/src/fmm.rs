@@ -697,6 +697,128 @@ impl Field for FastMarching {
     }
 }
 
+/// Diagnostic of the curved-front rule on a mesh of the unit sphere, for the `fmm_trace`
+/// example; not part of the API. From the source vertex `src`: the carried front curvature
+/// against the sphere's `cot(g)` by geodesic distance `g`, the vertices where it is worst at
+/// `g` in [2, 2.4), then the walk back from `start` (default: the vertex of largest error)
+/// through the best candidate update of each step, with the candidates.
+#[doc(hidden)]
+pub fn trace_curved_front(
+    mesh: &TriMesh,
+    src: u32,
+    start: Option<u32>,
+) -> Result<String, GeodesicError> {
+    use std::fmt::Write;
+    let fm = FastMarching::with_update(mesh, FmmUpdate::CurvedFront)?;
+    let (d, kap) = fm.march(&[Source::Vertex(src)], f64::INFINITY)?;
+    let mut report = String::new();
+    macro_rules! say {
+        ($($t:tt)*) => {
+            let _ = writeln!(report, $($t)*);
+        };
+    }
+    let ps = mesh.position(src).normalize();
+    let g: Vec<f64> = mesh
+        .positions()
+        .iter()
+        .map(|v| v.normalize().dot(ps).clamp(-1.0, 1.0).acos())
+        .collect();
+    // Front curvature against the sphere's cot(g), by distance.
+    for k in 0..16 {
+        let (lo, hi) = (k as f64 * 0.2, (k + 1) as f64 * 0.2);
+        let sel: Vec<usize> = (0..d.len()).filter(|&i| g[i] >= lo && g[i] < hi).collect();
+        if sel.is_empty() {
+            continue;
+        }
+        let mean_k = sel.iter().map(|&i| kap[i]).sum::<f64>() / sel.len() as f64;
+        let mean_c = sel.iter().map(|&i| 1.0 / g[i].tan()).sum::<f64>() / sel.len() as f64;
+        let mean_e = sel.iter().map(|&i| d[i] - g[i]).sum::<f64>() / sel.len() as f64;
+        let max_e = sel.iter().map(|&i| (d[i] - g[i]).abs()).fold(0.0, f64::max);
+        say!(
+            "g in [{lo:.1}, {hi:.1}): kappa {mean_k:+.3} sphere {mean_c:+.3} mean err {mean_e:+.2e} max |err| {max_e:.2e}"
+        );
+    }
+    // Where the carried curvature is worst at moderate distance.
+    let mut sel: Vec<usize> = (0..d.len())
+        .filter(|&i| g[i] >= 2.0 && g[i] < 2.4)
+        .collect();
+    sel.sort_by(|&i, &j| {
+        (kap[j] - 1.0 / g[j].tan())
+            .abs()
+            .total_cmp(&(kap[i] - 1.0 / g[i].tan()).abs())
+    });
+    for &i in sel.iter().take(12) {
+        let q = mesh.position(i as u32).normalize();
+        say!(
+            "  kappa off at v{i}: lat {:+.1} lon {:+.1} g {:.3} kappa {:+.3} sphere {:+.3}",
+            q.z.asin().to_degrees(),
+            q.y.atan2(q.x).to_degrees(),
+            g[i],
+            kap[i],
+            1.0 / g[i].tan()
+        );
+    }
+    let mut v = start.unwrap_or_else(|| {
+        (0..d.len())
+            .max_by(|&i, &j| (d[i] - g[i]).abs().total_cmp(&(d[j] - g[j]).abs()))
+            .unwrap() as u32
+    });
+    for _ in 0..60 {
+        let q = mesh.position(v).normalize();
+        say!(
+            "v{v}: lat {:+.1} lon {:+.1} T {:.4} err {:+.2e} kappa {:+.3e} (sphere {:+.3e})",
+            q.z.asin().to_degrees(),
+            q.y.atan2(q.x).to_degrees(),
+            d[v as usize],
+            d[v as usize] - g[v as usize],
+            kap[v as usize],
+            1.0 / g[v as usize].tan(),
+        );
+        if v == src {
+            break;
+        }
+        // All candidates of v from vertices accepted before it.
+        let mut cands = Vec::new();
+        for (ti, t) in fm.tris.iter().enumerate() {
+            let _ = ti;
+            let owner = fm.deps
+                [fm.dep_offsets[t.a as usize] as usize..fm.dep_offsets[t.a as usize + 1] as usize]
+                .iter()
+                .any(|&(c, i)| c == v && i as usize == ti);
+            if !owner {
+                continue;
+            }
+            let (a, b) = (t.a as usize, t.b as usize);
+            if !(d[a] < d[v as usize] && d[b] < d[v as usize]) {
+                continue;
+            }
+            let kg = t.kg;
+            let (tc, kc) = update_curved(t, d[a], d[b], kap[a], kap[b], kg);
+            let edge = edge_curved(t, d[a], d[b], kap[a], kap[b], kg).0;
+            let (tx, kx) = update_curved(t, g[a], g[b], 1.0 / g[a].tan(), 1.0 / g[b].tan(), kg);
+            if cands.is_empty() {
+                say!("    [exact inputs for the first triangle: T {tx:.5} (g {:.5}) kappa {kx:+.3e}]", g[v as usize]);
+            }
+            cands.push((tc, kc, a, b, tc == edge, t.la, t.lb));
+        }
+        cands.sort_by(|x, y| x.0.total_cmp(&y.0));
+        for c in cands.iter().take(3) {
+            say!(
+                "    cand T {:.4} kappa {:+.3e} from a v{} (err {:+.2e}) b v{} (err {:+.2e}) edge {} la {:.4} lb {:.4}",
+                c.0, c.1, c.2, d[c.2] - g[c.2], c.3, d[c.3] - g[c.3], c.4, c.5, c.6
+            );
+        }
+        let Some(best) = cands.first() else { break };
+        // Follow the corner with the larger error magnitude.
+        v = if (d[best.2] - g[best.2]).abs() >= (d[best.3] - g[best.3]).abs() {
+            best.2 as u32
+        } else {
+            best.3 as u32
+        };
+    }
+    Ok(report)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -786,145 +908,5 @@ mod tests {
         let q = DVec2::new(2.0, 0.0);
         let w = unfold_point(p, q, 2f64.sqrt(), 2f64.sqrt(), DVec2::new(1.0, 1.0)).unwrap();
         assert!((w - DVec2::new(1.0, -1.0)).length() < 1e-14);
-    }
-    /// Diagnostic (not a check): walks back from the worst vertex of the curved-front solution
-    /// on the peers' UV sphere from the equator and prints every step.
-    #[test]
-    #[ignore = "diagnostic: needs /tmp/peers-geo/meshes/uv10k.obj; prints, asserts nothing"]
-    fn trace_uv10k_equator() {
-        let path = std::env::var("FMM_TRACE_MESH")
-            .unwrap_or_else(|_| "/tmp/peers-geo/meshes/uv10k.obj".to_string());
-        let Ok(text) = std::fs::read_to_string(&path) else {
-            println!("skipping: no {path}");
-            return;
-        };
-        let (mut p, mut f) = (Vec::new(), Vec::new());
-        for line in text.lines() {
-            let w: Vec<&str> = line.split_whitespace().collect();
-            match w.first() {
-                Some(&"v") => p.push(DVec3::new(
-                    w[1].parse().unwrap(),
-                    w[2].parse().unwrap(),
-                    w[3].parse().unwrap(),
-                )),
-                Some(&"f") => {
-                    let c: Vec<u32> = w[1..]
-                        .iter()
-                        .map(|s| s.split('/').next().unwrap().parse::<u32>().unwrap() - 1)
-                        .collect();
-                    f.push([c[0], c[1], c[2]]);
-                }
-                _ => {}
-            }
-        }
-        let mesh = TriMesh::new(p, f).unwrap();
-        let src: u32 = std::env::var("FMM_TRACE_SRC")
-            .ok()
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(4901);
-        let fm = FastMarching::with_update(&mesh, FmmUpdate::CurvedFront).unwrap();
-        let (d, kap) = fm.march(&[Source::Vertex(src)], f64::INFINITY).unwrap();
-        let ps = mesh.position(src).normalize();
-        let g: Vec<f64> = mesh
-            .positions()
-            .iter()
-            .map(|v| v.normalize().dot(ps).clamp(-1.0, 1.0).acos())
-            .collect();
-        // Front curvature against the sphere's cot(g), by distance.
-        for k in 0..16 {
-            let (lo, hi) = (k as f64 * 0.2, (k + 1) as f64 * 0.2);
-            let sel: Vec<usize> = (0..d.len()).filter(|&i| g[i] >= lo && g[i] < hi).collect();
-            if sel.is_empty() {
-                continue;
-            }
-            let mean_k = sel.iter().map(|&i| kap[i]).sum::<f64>() / sel.len() as f64;
-            let mean_c = sel.iter().map(|&i| 1.0 / g[i].tan()).sum::<f64>() / sel.len() as f64;
-            let mean_e = sel.iter().map(|&i| d[i] - g[i]).sum::<f64>() / sel.len() as f64;
-            let max_e = sel.iter().map(|&i| (d[i] - g[i]).abs()).fold(0.0, f64::max);
-            println!(
-                "g in [{lo:.1}, {hi:.1}): kappa {mean_k:+.3} sphere {mean_c:+.3} mean err {mean_e:+.2e} max |err| {max_e:.2e}"
-            );
-        }
-        // Where the carried curvature is worst at moderate distance.
-        let mut sel: Vec<usize> = (0..d.len())
-            .filter(|&i| g[i] >= 2.0 && g[i] < 2.4)
-            .collect();
-        sel.sort_by(|&i, &j| {
-            (kap[j] - 1.0 / g[j].tan())
-                .abs()
-                .total_cmp(&(kap[i] - 1.0 / g[i].tan()).abs())
-        });
-        for &i in sel.iter().take(12) {
-            let q = mesh.position(i as u32).normalize();
-            println!(
-                "  kappa off at v{i}: lat {:+.1} lon {:+.1} g {:.3} kappa {:+.3} sphere {:+.3}",
-                q.z.asin().to_degrees(),
-                q.y.atan2(q.x).to_degrees(),
-                g[i],
-                kap[i],
-                1.0 / g[i].tan()
-            );
-        }
-        let mut v = std::env::var("FMM_TRACE_V")
-            .ok()
-            .and_then(|s| s.parse().ok())
-            .unwrap_or_else(|| {
-                (0..d.len())
-                    .max_by(|&i, &j| (d[i] - g[i]).abs().total_cmp(&(d[j] - g[j]).abs()))
-                    .unwrap() as u32
-            });
-        for _ in 0..60 {
-            let q = mesh.position(v).normalize();
-            println!(
-                "v{v}: lat {:+.1} lon {:+.1} T {:.4} err {:+.2e} kappa {:+.3e} (sphere {:+.3e})",
-                q.z.asin().to_degrees(),
-                q.y.atan2(q.x).to_degrees(),
-                d[v as usize],
-                d[v as usize] - g[v as usize],
-                kap[v as usize],
-                1.0 / g[v as usize].tan(),
-            );
-            if v == src {
-                break;
-            }
-            // All candidates of v from vertices accepted before it.
-            let mut cands = Vec::new();
-            for (ti, t) in fm.tris.iter().enumerate() {
-                let _ = ti;
-                let owner = fm.deps[fm.dep_offsets[t.a as usize] as usize
-                    ..fm.dep_offsets[t.a as usize + 1] as usize]
-                    .iter()
-                    .any(|&(c, i)| c == v && i as usize == ti);
-                if !owner {
-                    continue;
-                }
-                let (a, b) = (t.a as usize, t.b as usize);
-                if !(d[a] < d[v as usize] && d[b] < d[v as usize]) {
-                    continue;
-                }
-                let kg = t.kg;
-                let (tc, kc) = update_curved(t, d[a], d[b], kap[a], kap[b], kg);
-                let edge = edge_curved(t, d[a], d[b], kap[a], kap[b], kg).0;
-                let (tx, kx) = update_curved(t, g[a], g[b], 1.0 / g[a].tan(), 1.0 / g[b].tan(), kg);
-                if cands.is_empty() {
-                    println!("    [exact inputs for the first triangle: T {tx:.5} (g {:.5}) kappa {kx:+.3e}]", g[v as usize]);
-                }
-                cands.push((tc, kc, a, b, tc == edge, t.la, t.lb));
-            }
-            cands.sort_by(|x, y| x.0.total_cmp(&y.0));
-            for c in cands.iter().take(3) {
-                println!(
-                    "    cand T {:.4} kappa {:+.3e} from a v{} (err {:+.2e}) b v{} (err {:+.2e}) edge {} la {:.4} lb {:.4}",
-                    c.0, c.1, c.2, d[c.2] - g[c.2], c.3, d[c.3] - g[c.3], c.4, c.5, c.6
-                );
-            }
-            let Some(best) = cands.first() else { break };
-            // Follow the corner with the larger error magnitude.
-            v = if (d[best.2] - g[best.2]).abs() >= (d[best.3] - g[best.3]).abs() {
-                best.2 as u32
-            } else {
-                best.3 as u32
-            };
-        }
     }
 }

@@ -29,6 +29,8 @@ pub mod straightest;
 pub use dijkstra::Dijkstra;
 pub use error::GeodesicError;
 pub use exact::{ExactGeodesic, ExactMeshReport};
+#[doc(hidden)]
+pub use fmm::trace_curved_front;
 pub use fmm::{FastMarching, FmmUpdate};
 pub use heat::HeatMethod;
 pub use meshcore::{SurfacePoint, TriMesh};

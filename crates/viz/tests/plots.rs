@@ -284,31 +284,3 @@ fn histogram_svg_png_and_errors() {
     let svg = histogram_svg("t", "x", &[("c".into(), vec![2.0, 2.0, f64::NAN])], 5).unwrap();
     assert_well_formed(&svg);
 }
-
-#[test]
-#[ignore = "writes plots to /tmp for manual inspection"]
-fn write_sample_plots() {
-    line_plot("/tmp/viz-line.png", &spec().with_log_y(true)).unwrap();
-    let mut m = matrix(6);
-    m[1][2] = f64::NAN;
-    heatmap(
-        "/tmp/viz-heat.png",
-        "Distances",
-        &labels(6),
-        &m,
-        "shape distance",
-    )
-    .unwrap();
-    let a: Vec<f64> = (0..200).map(|i| ((i * 37) % 101) as f64 / 10.0).collect();
-    let b: Vec<f64> = (0..100)
-        .map(|i| 3.0 + ((i * 13) % 29) as f64 / 10.0)
-        .collect();
-    histogram(
-        "/tmp/viz-hist.png",
-        "Errors",
-        "angle error (deg)",
-        &[("first".into(), a), ("second".into(), b)],
-        20,
-    )
-    .unwrap();
-}

@@ -230,38 +230,6 @@ fn non_finite_overlays_are_skipped_and_views_parse() {
 }
 
 #[test]
-#[ignore = "writes pictures to /tmp for manual inspection"]
-fn write_sample_pictures() {
-    let mesh = sphere(1.0, 32, 64);
-    let field: Vec<f64> = mesh.positions().iter().map(|p| p.x + p.y).collect();
-    let mut scene = Scene::new(&mesh).with_field(&field);
-    for z in [-0.6, 0.0, 0.6] {
-        let r = (1.0f64 - z * z).sqrt();
-        scene.polylines.push(Polyline {
-            points: (0..64)
-                .map(|k| {
-                    let a = TAU * k as f64 / 64.0;
-                    DVec3::new(r * a.cos(), z, r * a.sin())
-                })
-                .collect(),
-            closed: true,
-            color: [220, 30, 30],
-            width: 2.0,
-        });
-    }
-    scene.points.push(Marker {
-        position: DVec3::new(0.0, 0.0, 1.0),
-        color: [30, 30, 220],
-        radius: 5.0,
-    });
-    let view = View::new(DVec3::new(-0.3, -0.4, -1.0), DVec3::Y);
-    render_to_file("/tmp/viz-sphere.png", &scene, &view, 400, 300).unwrap();
-    render_to_file("/tmp/viz-sphere.svg", &scene, &view, 400, 300).unwrap();
-    let svg = std::fs::read_to_string("/tmp/viz-sphere.svg").unwrap();
-    std::fs::write("/tmp/viz-sphere-svg.png", viz::svg_to_png(&svg).unwrap()).unwrap();
-}
-
-#[test]
 fn picture_format_names_round_trip() {
     testsupport::check_choice_error::<viz::Format>("jpg", |e| {
         matches!(e, viz::VizError::UnknownChoice(_))

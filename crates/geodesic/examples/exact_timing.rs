@@ -1,8 +1,8 @@
 //! Timing of the exact solver on the timed cases (paper-set face id1_neutral from vertex
-//! 1507, uncut and cut at 11.8 cm; icospheres 5 and 6 from vertex 0), run by hand in release:
+//! 1507, uncut and cut at 11.8 cm; icospheres 5 and 6 from vertex 0):
 //!
 //! ```text
-//! cargo test --release -p geodesic --test exact_timing -- --ignored --nocapture
+//! cargo run --release -p geodesic --example exact_timing
 //! ```
 //!
 //! `EXACT_TIMING_REPEAT` (default 7) sets the repetitions (the median is printed);
@@ -46,14 +46,12 @@ fn time_case(name: &str, m: &TriMesh, src: u32, cut: Option<f64>, repeat: usize)
     }
 }
 
-#[test]
-#[ignore = "timing; run by hand in release (see the file header)"]
-fn exact_timing() {
+fn main() {
     let repeat: usize = std::env::var("EXACT_TIMING_REPEAT")
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(7);
-    // Without the shared data, paper_face prints why the face is skipped.
+    // Without the shared data, paper_face says why the face cases are left out.
     if let Some(face) = testsupport::paper_face("id1_neutral.obj") {
         let m = testsupport::read_mesh(face);
         time_case("face1507", &m, 1507, None, repeat);

@@ -1,28 +1,28 @@
-//! Comparison with an exact peer (tvb-gdist / pygeodesic output), run by hand in release:
+//! Comparison of the exact solver with an exact peer (tvb-gdist / pygeodesic output):
 //!
 //! ```text
 //! EXACT_PEER_MESH=mesh.obj EXACT_PEER_REF=dist.txt EXACT_PEER_SOURCE=0 \
-//!     cargo test --release -p geodesic --test exact_peer -- --ignored --nocapture
+//!     cargo run --release -p geodesic --example exact_peer
 //! ```
 //!
 //! `EXACT_PEER_REF` holds one distance per line in vertex order. Several comparisons can be
 //! given at once, separated by `;` in each variable. A source `F<face>` is the centroid of
 //! that face (compare with libigl's `exact_geodesic` face sources); `0,17,40` are several
-//! sources at once.
+//! sources at once. Prints one line per comparison (timings, propagations, peak RSS, the
+//! largest relative difference) and panics when a difference exceeds `EXACT_PEER_TOL`
+//! (default 1e-9); `EXACT_PEER_REPEAT` repeats each solve (medians printed).
 
 use geodesic::{ExactGeodesic, GeodesicSolver, SolveOptions, Source};
 use std::time::Instant;
 
-#[test]
-#[ignore = "needs peer output files; run by hand (see the file header)"]
-fn compare_with_peer() {
+fn main() {
     let (Ok(meshes), Ok(refs), Ok(srcs)) = (
         std::env::var("EXACT_PEER_MESH"),
         std::env::var("EXACT_PEER_REF"),
         std::env::var("EXACT_PEER_SOURCE"),
     ) else {
-        println!("skipped: EXACT_PEER_MESH / EXACT_PEER_REF / EXACT_PEER_SOURCE not set");
-        return;
+        eprintln!("EXACT_PEER_MESH, EXACT_PEER_REF and EXACT_PEER_SOURCE must be set (see the source's header)");
+        std::process::exit(2);
     };
     let tol: f64 = std::env::var("EXACT_PEER_TOL")
         .ok()

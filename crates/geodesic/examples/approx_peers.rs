@@ -1,11 +1,18 @@
-//! Side-by-side accuracy and timing of the approximate methods on the peer sphere meshes.
+//! Side-by-side accuracy and timing of the approximate methods, printed as Markdown tables:
 //!
-//! Needs the meshes written by `make_meshes.py` of `../shared/peers/geodesic` (and, for the
-//! "vs exact" and peer columns, the outputs of its `bench.py`) in the folder named by
-//! `GEODESIC_PEERS_DIR` (default `/tmp/peers-geo`); skips when they are absent. Slow (release
-//! build recommended), hence ignored:
+//! ```text
+//! cargo run --release -p geodesic --example approx_peers -- [peers] [faces]
+//! ```
 //!
-//! `cargo test --release -p geodesic --test approx_peers -- --ignored --nocapture`
+//! * `peers`: the peer sphere meshes. Needs the meshes written by `make_meshes.py` of
+//!   `../shared/peers/geodesic` (and, for the "vs exact" and peer columns, the outputs of its
+//!   `bench.py`) in the folder named by `GEODESIC_PEERS_DIR` (default `/tmp/peers-geo`); says
+//!   so and does nothing when they are absent. `GEODESIC_CASES`, `GEODESIC_METHODS`,
+//!   `GEODESIC_REPEAT`, `GEODESIC_PEERS_OUT`, `GEODESIC_BINS` and `GEODESIC_WHERE` choose the
+//!   cases, methods, repetitions, peer output folder and the extra error breakdowns.
+//! * `faces`: paper-set faces id1 and id2 against the exact solver (needs `../shared`).
+//!
+//! Without an argument both run.
 
 use geodesic::{
     Dijkstra, FastMarching, FmmUpdate, GeodesicSolver, HeatMethod, SolveOptions, Source, TriMesh,
@@ -87,8 +94,24 @@ fn fmt_t(s: f64) -> String {
     }
 }
 
-#[test]
-#[ignore = "slow: needs the peer meshes in /tmp/peers-geo and a release build"]
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    for a in &args {
+        assert!(
+            a == "peers" || a == "faces",
+            "unknown part {a:?} (peers or faces)"
+        );
+    }
+    let part = |name: &str| args.is_empty() || args.iter().any(|a| a == name);
+    if part("peers") {
+        peer_comparison();
+    }
+    if part("faces") {
+        face_comparison_against_exact();
+    }
+}
+
+/// The table of the peer sphere meshes (see the file header).
 fn peer_comparison() {
     faer::set_global_parallelism(faer::Par::Seq);
     let dir = PathBuf::from(
@@ -201,11 +224,12 @@ fn peer_comparison() {
     }
 }
 
-#[test]
-#[ignore = "slow: needs the paper-set faces and a release build"]
+/// The table of paper-set faces id1 and id2 against the exact solver from vertex 3721.
 fn face_comparison_against_exact() {
     faer::set_global_parallelism(faer::Par::Seq);
-    let dir = testsupport::require_shared!(testsupport::PAPER_SET);
+    let Some(dir) = testsupport::shared_path(testsupport::PAPER_SET) else {
+        return;
+    };
     println!(
         "| face | method | setup | solve | MAE vs exact | max vs exact | max rel (d > 1 cm) |"
     );
