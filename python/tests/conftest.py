@@ -19,12 +19,24 @@ def shared_dir():
 PAPER_SET = shared_dir() / "faces" / "ict-facekit" / "paper-set"
 
 
-@pytest.fixture(scope="session")
-def face_path():
-    p = PAPER_SET / "id1_neutral.obj"
+def shared_required():
+    """Whether BIPOLAR_REQUIRE_SHARED (set by CI) makes missing shared data a failure."""
+    return os.environ.get("BIPOLAR_REQUIRE_SHARED", "") not in ("", "0")
+
+
+def paper_face(name):
+    """PAPER_SET / name; without it the calling test skips, or fails when shared_required()."""
+    p = PAPER_SET / name
     if not p.exists():
+        if shared_required():
+            pytest.fail(f"shared data absent: {p}, and BIPOLAR_REQUIRE_SHARED is set")
         pytest.skip(f"shared data absent: {p}")
     return p
+
+
+@pytest.fixture(scope="session")
+def face_path():
+    return paper_face("id1_neutral.obj")
 
 
 @pytest.fixture(scope="session")

@@ -6,7 +6,7 @@ import pytest
 import bipolar
 from bipolar import errors
 
-from conftest import PAPER_SET
+from conftest import PAPER_SET, paper_face
 
 
 def test_detects_the_five_landmarks_on_a_paper_set_face(face, face_path):
@@ -43,7 +43,7 @@ def test_a_sphere_is_not_a_face():
 
 
 def test_a_range_scan_is_read_as_seen_from_its_scanner(tmp_path):
-    face = bipolar.read_mesh(PAPER_SET / "id4_neutral.obj")
+    face = bipolar.read_mesh(paper_face("id4_neutral.obj"))
     # A head turned by 35 degrees: the scanner loses the far side around the far eye corner.
     scan, _ = bipolar.scan(face, pitch=1.0, yaw=35.0, artifacts="structured-light", seed=7)
     assert scan.grid_index is not None
@@ -63,7 +63,7 @@ def test_a_range_scan_is_read_as_seen_from_its_scanner(tmp_path):
 
 
 def test_describe_names_the_corners_of_a_turned_scan():
-    face = bipolar.read_mesh(PAPER_SET / "id4_neutral.obj")
+    face = bipolar.read_mesh(paper_face("id4_neutral.obj"))
     scan, _ = bipolar.scan(face, pitch=1.0, yaw=35.0, artifacts="structured-light", seed=7)
     # Named references are detected as detect_landmarks does: the scan is seen from +z.
     d = bipolar.describe(scan, "outer-eye-right", "outer-eye-left", levels=10, max_level=10)
@@ -73,7 +73,7 @@ def test_describe_names_the_corners_of_a_turned_scan():
 
 
 def test_landmarks_the_scanner_did_not_see_are_reported_unseen():
-    face = bipolar.read_mesh(PAPER_SET / "id6_neutral.obj")
+    face = bipolar.read_mesh(paper_face("id6_neutral.obj"))
     # Turned by 50 degrees: the far inner eye corner hides behind the nose.
     scan, _ = bipolar.scan(face, pitch=1.0, yaw=50.0, artifacts="structured-light", seed=3)
     lm = bipolar.detect_landmarks(scan)

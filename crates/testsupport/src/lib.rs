@@ -1,10 +1,13 @@
 //! Test-side support shared by the tests and benchmarks of every crate (not published).
 //!
 //! * **Shared data, one skip rule.** [`shared_path`] (and the [`require_shared!`] macro around
-//!   it) returns a path inside the shared data folder found by [`facemodel::shared_dir`], or
-//!   prints one `skipped: ...` line and returns `None` when the folder (or the file inside it)
-//!   is absent. A `BIPOLAR_SHARED` that names no folder is a user error, not a reason to skip:
-//!   the test panics with the lookup's message.
+//!   it) returns a path inside the shared data folder found by [`facemodel::shared_dir`]. When
+//!   the folder (or the file inside it) is absent, it writes one `SKIPPED <test>: ...` line to
+//!   the process's standard error, past the test harness's capture (so `cargo test` shows it
+//!   without `--nocapture`), and returns `None`; with [`REQUIRE_SHARED_ENV`] set (as CI sets
+//!   it) it panics instead, naming the missing path, so that no data test passes unrun. A
+//!   `BIPOLAR_SHARED` that names no folder is a user error, not a reason to skip: the test
+//!   panics with the lookup's message.
 //! * **Paths**: [`PAPER_SET`], [`MODEL`], [`paper_face`] (and [`paper_meshes`], read).
 //! * **Meshes**: [`read_mesh`] (through `mesh-io`, the project's one reader) and the generators
 //!   of [`meshcore::shapes`], re-exported as [`shapes`], plus [`jittered_grid`],
@@ -99,15 +102,26 @@ pub fn uv_sphere_y_up(r: f64, n_lat: usize, n_lon: usize) -> TriMesh {
     TriMesh::new(pos, tris).expect("a reflected sphere is a valid mesh")
 }
 
-/// `rel` inside the shared data folder, or `None` after printing why the caller skips:
-/// `skipped: ../shared not found ...` when there is no shared folder, `skipped: <path> not
-/// found` when the folder lacks `rel`. Panics when `BIPOLAR_SHARED` names no folder.
+/// Environment variable that makes a missing shared data folder or file fail the test that
+/// needs it instead of skipping it (any value but empty or `0`); `.ci/run` sets it.
+pub const REQUIRE_SHARED_ENV: &str = "BIPOLAR_REQUIRE_SHARED";
+
+/// Whether [`REQUIRE_SHARED_ENV`] is set to a value other than empty or `0`.
+pub fn shared_required() -> bool {
+    std::env::var_os(REQUIRE_SHARED_ENV).is_some_and(|v| !v.is_empty() && v != "0")
+}
+
+/// `rel` inside the shared data folder, or `None` after reporting why the caller skips:
+/// `../shared not found (...)` when there is no shared folder, `<path> not found` when the
+/// folder lacks `rel`. The line `SKIPPED <test>: <why> ...` goes to the process's standard
+/// error directly (the harness captures `eprintln!`, not this), so `cargo test` shows every
+/// skip. Panics with the reason when [`shared_required`], and when `BIPOLAR_SHARED` names no
+/// folder.
 pub fn shared_path(rel: impl AsRef<Path>) -> Option<PathBuf> {
     let root = match facemodel::shared_dir() {
         Ok(root) => root,
         Err(e @ FaceModelError::SharedNotFound { .. }) => {
-            println!("skipped: ../shared not found ({e})");
-            return None;
+            return skip(&format!("../shared not found ({e})"));
         }
         Err(e) => panic!("{e}"),
     };
@@ -115,9 +129,27 @@ pub fn shared_path(rel: impl AsRef<Path>) -> Option<PathBuf> {
     if p.exists() {
         Some(p)
     } else {
-        println!("skipped: {} not found", p.display());
-        None
+        skip(&format!("{} not found", p.display()))
     }
+}
+
+/// The skip of [`shared_path`]: a panic with `why` when [`shared_required`], else the
+/// `SKIPPED` line on the uncaptured standard error and `None`.
+fn skip<T>(why: &str) -> Option<T> {
+    if shared_required() {
+        panic!("{why}, and {REQUIRE_SHARED_ENV} is set: this test needs the shared data");
+    }
+    // The test harness names each test's thread after the test (a program's is "main").
+    let thread = std::thread::current();
+    let test = match thread.name() {
+        Some(name) if name != "main" => format!(" {name}"),
+        _ => String::new(),
+    };
+    // Not eprintln!: the harness captures that (shown only for a failure or with --nocapture).
+    let line =
+        format!("SKIPPED{test}: {why} (set {REQUIRE_SHARED_ENV}=1 to make this a failure)\n");
+    let _ = std::io::Write::write_all(&mut std::io::stderr(), line.as_bytes());
+    None
 }
 
 /// `<shared>/faces/ict-facekit/paper-set/<name>` (e.g. `id1_neutral.obj`), under the rule of
