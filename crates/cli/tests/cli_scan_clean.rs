@@ -83,11 +83,49 @@ fn scan_an_ict_face_clean_it_and_read_it_back() {
     assert!(far <= 80.0, "{far}");
     let e = m.mean_edge_length();
     assert!(e > 1.0 && e < 2.2, "{e}");
+}
 
-    // Units override, and errors that name the problem.
-    let (ok, out, _) = bipolar(&["clean", &s(&bnt), &s(&ply), "--units", "mm"]);
-    assert!(ok);
+/// A frontal range grid of a spherical cap (radius 100 mm, 50 mm across at 1 mm pitch), the
+/// size of a face, written as `dir/cap.bnt`: a scan that needs no shared data.
+fn cap_bnt(dir: &std::path::Path) -> PathBuf {
+    let (n, zmin) = (51, -1e9);
+    let mut xyz = Vec::new();
+    for r in 0..n {
+        for c in 0..n {
+            let (x, y) = (c as f64 - 25.0, 25.0 - r as f64);
+            let rr = x * x + y * y;
+            xyz.push(if rr < 25.0 * 25.0 {
+                meshcore::DVec3::new(x, y, (100.0f64 * 100.0 - rr).sqrt())
+            } else {
+                meshcore::DVec3::splat(zmin)
+            });
+        }
+    }
+    let grid = mesh_io::BntGrid {
+        nrows: n,
+        ncols: n,
+        zmin,
+        image_file: String::new(),
+        xyz,
+        uv: vec![[0.0; 2]; n * n],
+    };
+    let p = dir.join("cap.bnt");
+    std::fs::write(&p, grid.to_bytes()).unwrap();
+    p
+}
+
+/// `bipolar clean --units` overrides the detected units; a unit, an output file or a crop
+/// centre that is wrong is an error naming the problem.
+#[test]
+fn clean_takes_given_units_and_names_bad_arguments() {
+    let dir = tempfile::tempdir().unwrap();
+    let bnt = cap_bnt(dir.path());
+    let ply = dir.path().join("clean.ply");
+    let s = |p: &PathBuf| p.to_str().unwrap().to_string();
+    let (ok, out, err) = bipolar(&["clean", &s(&bnt), &s(&ply), "--units", "mm"]);
+    assert!(ok, "{err}");
     assert!(out.contains("units: mm (given"), "{out}");
+    assert!(mesh_io::read_mesh(&ply).unwrap().mesh.n_vertices() > 100);
     let (ok, _, err) = bipolar(&["clean", &s(&bnt), &s(&ply), "--units", "inch"]);
     assert!(!ok);
     assert!(err.contains("unknown length unit"), "{err}");

@@ -497,7 +497,10 @@ fn bad_options_and_units_are_errors() {
                 artifacts: bad,
                 ..d()
             },
-            |_| true,
+            |e| {
+                matches!(e, ScanError::InvalidOption(s)
+                    if s.contains("spikes max_mm = 1") && s.contains("min_mm to"))
+            },
         ),
         // Seen edge-on from the side nothing is in view.
         (
