@@ -42,12 +42,7 @@ pub enum MatchError {
     /// A gallery without templates.
     #[error("gallery {0}: no templates (a gallery is a folder of .bpt files or one .bpg file)")]
     EmptyGallery(String),
-    /// Reading or writing a file.
-    #[error("{file}: {source}")]
-    Io {
-        /// The file.
-        file: String,
-        /// The error.
-        source: std::io::Error,
-    },
+    /// Reading, writing or listing a file or folder.
+    #[error(transparent)]
+    Io(#[from] meshcore::FileError),
 }

@@ -32,10 +32,7 @@ impl Gallery {
     pub fn open(path: &Path, options: &MatchOptions) -> Result<Self, MatchError> {
         let mut templates = Vec::new();
         if path.is_dir() {
-            let io = |source| MatchError::Io {
-                file: path.display().to_string(),
-                source,
-            };
+            let io = |source| meshcore::FileError::new("list", path, source);
             let mut files: Vec<_> = std::fs::read_dir(path)
                 .map_err(io)?
                 .filter_map(|e| e.ok().map(|e| e.path()))
@@ -62,12 +59,8 @@ impl Gallery {
 
     /// Writes the gallery as one `.bpg` file.
     pub fn write(&self, path: &Path) -> Result<(), MatchError> {
-        std::fs::write(path, Template::gallery_bytes(&self.templates)).map_err(|source| {
-            MatchError::Io {
-                file: path.display().to_string(),
-                source,
-            }
-        })
+        std::fs::write(path, Template::gallery_bytes(&self.templates))
+            .map_err(|source| meshcore::FileError::new("write", path, source).into())
     }
 
     /// The probe compared with every template (in parallel, in template order).

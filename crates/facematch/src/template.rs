@@ -118,10 +118,8 @@ impl Template {
 
     /// Writes the template to `path` (a `.bpt` file).
     pub fn write(&self, path: &Path) -> Result<(), MatchError> {
-        std::fs::write(path, self.to_bytes()).map_err(|source| MatchError::Io {
-            file: path.display().to_string(),
-            source,
-        })
+        std::fs::write(path, self.to_bytes())
+            .map_err(|source| meshcore::FileError::new("write", path, source).into())
     }
 
     /// Reads a template file.
@@ -273,10 +271,7 @@ impl Template {
 
 /// The bytes of a file, or an error naming it.
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, MatchError> {
-    std::fs::read(path).map_err(|source| MatchError::Io {
-        file: path.display().to_string(),
-        source,
-    })
+    std::fs::read(path).map_err(|source| meshcore::FileError::new("read", path, source).into())
 }
 
 struct Writer(Vec<u8>);

@@ -234,7 +234,7 @@ pub fn matching(e: facematch::MatchError) -> PyErr {
         E::InvalidOption(_) | E::EmptyGallery(_) => Kind::Input,
         E::Template { .. } => Kind::Format,
         E::Settings { .. } => Kind::Settings,
-        E::Io { .. } => Kind::File,
+        E::Io(_) => Kind::File,
     };
     err(kind, chain(&e))
 }
