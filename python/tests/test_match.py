@@ -9,7 +9,7 @@ import pytest
 import bipolar
 from bipolar import errors
 
-from conftest import PAPER_SET, ROOT
+from conftest import ROOT, paper_face
 
 FIXTURE = ROOT / "fixtures" / "facematch" / "small.bpt"
 GALLERY_FACES = ["id1_neutral", "id2_neutral", "id3_neutral"]
@@ -21,12 +21,11 @@ def same(a, b):
 
 
 @pytest.fixture(scope="module")
-def scans(face_path):
-    # face_path skips (or fails, as conftest says) when the shared data is absent.
+def scans():
+    # paper_face skips (or fails, with BIPOLAR_REQUIRE_SHARED) when a face is absent.
     names = GALLERY_FACES + ["id1_happiness"]
-    missing = [n for n in names if not (PAPER_SET / f"{n}.obj").exists()]
-    assert not missing, f"paper-set faces missing from {PAPER_SET}: {missing}"
-    return {n: bipolar.scan(PAPER_SET / f"{n}.obj")[0] for n in names}
+    paths = {n: paper_face(f"{n}.obj") for n in names}
+    return {n: bipolar.scan(p)[0] for n, p in paths.items()}
 
 
 @pytest.fixture(scope="module")

@@ -264,6 +264,8 @@ fn process(
 #[derive(Debug, Default, Clone)]
 struct Figures {
     probes: usize,
+    /// Gallery scans that could not be enrolled.
+    not_enrolled: usize,
     identified: usize,
     no_score: usize,
     eer: f64,
@@ -318,6 +320,7 @@ fn figures(p: &Processed, probe_ids: &[usize], o: &MatchOptions) -> Figures {
     let gallery = Gallery { templates };
     let mut f = Figures {
         probes: p.probes.len(),
+        not_enrolled: p.templates.iter().filter(|t| t.is_err()).count(),
         ..Figures::default()
     };
     for (d, &id) in p.probes.iter().zip(probe_ids) {
@@ -336,13 +339,17 @@ fn figures(p: &Processed, probe_ids: &[usize], o: &MatchOptions) -> Figures {
                 *f.fallbacks.entry(fallback_kind(&s)).or_default() += 1;
             }
         }
+        // A comparison without a score counts as refused: infinitely far.
         for (t, c) in gallery.templates.iter().zip(&cs) {
-            if c.score.is_finite() {
-                if t.identity == id.to_string() {
-                    f.genuine.push(c.score);
-                } else {
-                    f.impostor.push(c.score);
-                }
+            let score = if c.score.is_finite() {
+                c.score
+            } else {
+                f64::INFINITY
+            };
+            if t.identity == id.to_string() {
+                f.genuine.push(score);
+            } else {
+                f.impostor.push(score);
             }
         }
         let ranking = facematch::rank(&gallery.templates, cs);
@@ -497,6 +504,7 @@ pub fn run(a: Args) -> Result<()> {
     let header = [
         "set",
         "gate",
+        "gallery scans not enrolled",
         "probes",
         "rank-1",
         "no score",
@@ -510,6 +518,7 @@ pub fn run(a: Args) -> Result<()> {
             rows.push(vec![
                 name.to_string(),
                 gate_label(*g) + if *g == chosen { " (chosen)" } else { "" },
+                f.not_enrolled.to_string(),
                 f.probes.to_string(),
                 f4(rank1(f)),
                 f.no_score.to_string(),
@@ -522,13 +531,17 @@ pub fn run(a: Args) -> Result<()> {
     rep.heading(2, "Identification and verification");
     rep.table(&header, &rows);
     rep.csv("figures.csv", &header, &rows)?;
-    for ((name, _), (_, pr)) in sets.iter().zip(&processed) {
-        let failed: Vec<String> = pr
-            .templates
+    for ((name, (g, p)), (_, pr)) in sets.iter().zip(&processed) {
+        let named = |s: &Spec, r: Option<&String>| r.map(|e| format!("{}: {e}", s.name));
+        let failed: Vec<String> = g
             .iter()
-            .filter_map(|t| t.as_ref().err())
-            .chain(pr.probes.iter().filter_map(|d| d.as_ref().err()))
-            .cloned()
+            .zip(&pr.templates)
+            .filter_map(|(s, t)| named(s, t.as_ref().err()))
+            .chain(
+                p.iter()
+                    .zip(&pr.probes)
+                    .filter_map(|(s, d)| named(s, d.as_ref().err())),
+            )
             .collect();
         rep.heading(3, &format!("{name}: scans that could not be used"));
         if failed.is_empty() {

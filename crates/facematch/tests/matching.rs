@@ -122,7 +122,7 @@ fn a_probe_scores_alike_after_a_rigid_motion_and_in_other_units() {
     // Cleaning decimates in vertex order, so a renumbered probe is not the same mesh after
     // cleaning: the score moves by the decimation's noise, far less than the threshold.
     assert!(
-        s1.is_finite() && (s1 - s0).abs() <= 0.1 * o.verify_threshold,
+        s1.is_finite() && (s1 - s0).abs() <= 0.25 * o.verify_threshold,
         "{s0} vs {s1} after a rigid motion and a renumbering, in cm"
     );
 }
