@@ -249,11 +249,7 @@ fn probe_of(
     if is_template(path) {
         let t = Template::read(path)?;
         t.check_settings(o, &path.display().to_string())?;
-        let mut notes = t.notes.clone();
-        if t.description.moved.iter().all(Vec::is_empty) {
-            notes.push("the probe is a template without the reference-point search".into());
-        }
-        return Ok((t.description, notes));
+        return Ok(t.into_probe());
     }
     let t = template_of(path, "probe", o, args, true)?;
     Ok((t.description, t.notes))
@@ -362,7 +358,7 @@ pub fn run_verify(a: VerifyArgs) -> anyhow::Result<()> {
     };
     notes.extend(other.notes.iter().cloned());
     let c = facematch::compare(&probe, &other, &o);
-    let same = c.score.is_finite() && c.score <= o.verify_threshold;
+    let same = c.same_person(&o);
     if a.json {
         let j = serde_json::json!({
             "score": num(c.score), "same": same, "threshold": o.verify_threshold,

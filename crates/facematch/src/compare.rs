@@ -59,6 +59,12 @@ pub struct Comparison {
 }
 
 impl Comparison {
+    /// The decision of verification: the same person when the score is a number at or below
+    /// `options.verify_threshold`.
+    pub fn same_person(&self, options: &MatchOptions) -> bool {
+        self.score.is_finite() && self.score <= options.verify_threshold
+    }
+
     /// The substitutions this comparison made, as sentences (empty when none).
     pub fn fallbacks(&self) -> Vec<String> {
         let mut out = Vec::new();

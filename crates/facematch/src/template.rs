@@ -85,6 +85,16 @@ impl Template {
         })
     }
 
+    /// The template as a probe: its description and its notes, with one more when it holds no
+    /// reference-point search (a gallery template compared as a probe is scored without it).
+    pub fn into_probe(self) -> (Description, Vec<String>) {
+        let mut notes = self.notes;
+        if self.description.moved.iter().all(Vec::is_empty) {
+            notes.push("the probe is a template without the reference-point search".into());
+        }
+        (self.description, notes)
+    }
+
     /// Checks that the template was made with `options`' settings ([`MatchError::Settings`]).
     pub fn check_settings(&self, options: &MatchOptions, file: &str) -> Result<(), MatchError> {
         let expected = options.template_settings();

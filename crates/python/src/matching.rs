@@ -480,11 +480,7 @@ fn probe_of(
     units: Option<Units>,
 ) -> PyResult<(Description, Vec<String>)> {
     let t = template_arg(py, probe, "probe", o, scanner, units, true)?;
-    let mut notes = t.notes.clone();
-    if t.description.moved.iter().all(Vec::is_empty) {
-        notes.push("the probe is a template without the reference-point search".into());
-    }
-    Ok((t.description, notes))
+    Ok(t.into_probe())
 }
 
 /// A `Template` argument, a `.bpt` file read, or a scan made into a template (identity
@@ -731,7 +727,7 @@ pub fn verify<'py>(
     let other = template_arg(py, b, "b", &o, scanner, units, false)?;
     notes.extend(other.notes.iter().cloned());
     let c = py.detach(|| facematch::compare(&probe, &other, &o));
-    let same = c.score.is_finite() && c.score <= o.verify_threshold;
+    let same = c.same_person(&o);
     let d = PyDict::new(py);
     d.set_item("score", c.score)?;
     d.set_item("same", same)?;
