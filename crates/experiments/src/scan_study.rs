@@ -343,7 +343,7 @@ fn describe_mesh(
         }
         let seen = match v
             .max_incidence_deg
-            .map(|deg| crate::scans::seen_within(&mesh, view, deg))
+            .map(|deg| facematch::seen_within(&mesh, crate::scans::SCANNER_SIDE, view, deg))
         {
             Some(Err(e)) => {
                 notes.push(format!("{}: {e}", v.name));
@@ -736,18 +736,18 @@ fn variant_distance(a: &Described, b: &Described, k: usize) -> f64 {
 }
 
 /// The [`LEAST`] distance of two scans with view matching: each is cut to the faces the
-/// other's scanner would have measured (`scans::cut_to_view`, when the two directions differ by
+/// other's scanner would have measured (`facematch::cut_to_view`, when the two directions differ by
 /// at least `SCAN_VIEW_MATCH_DEG`) and described again; a side whose cut or any of whose three
 /// descriptions fails keeps its own description.
 fn view_matched_distance(a: &Described, b: &Described, args: &Args) -> f64 {
     let cut = |x: &Described, y: &Described| {
-        let c = crate::scans::cut_to_view(
-            &x.mesh,
-            &x.landmarks,
-            &y.landmarks,
-            crate::recognition::SCAN_VIEW_MATCH_DEG,
-        )?;
-        describe_mesh(c.mesh, &x.landmarks, &[], args, Some(c.toward))
+        let side = crate::scans::SCANNER_SIDE;
+        let toward = facematch::probe_direction(&y.landmarks, side, &x.landmarks)?;
+        if toward.angle_between(side).to_degrees() < crate::recognition::SCAN_VIEW_MATCH_DEG {
+            return None;
+        }
+        let c = facematch::cut_to_view(&x.mesh, toward, &facematch::ViewOptions::default()).ok()?;
+        describe_mesh(c.mesh, &x.landmarks, &[], args, Some(toward))
             .ok()
             .filter(|d| d.bip[LEAST].is_some() && d.sides[LEAST].is_some())
     };

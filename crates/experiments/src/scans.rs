@@ -367,7 +367,7 @@ pub fn scan_face(
         .map(|l| Truth {
             position: l.position,
             scanner: l.visibility,
-            vertex: match nearest_vertex(&mesh, l.position) {
+            vertex: match facematch::nearest_vertex(&mesh, l.position) {
                 Some((v, d)) if d <= MAX_SNAP_MM => Ok((v, d)),
                 Some((_, d)) => Err(format!(
                     "{} and {d:.1} mm from the cleaned surface",
@@ -421,83 +421,6 @@ pub fn scan_face(
     })
 }
 
-/// Incidence (degrees) beyond which a view-matched face loses its faces: the middle of the
-/// structured-light scanner model's grazing dropouts (70-80 degrees).
-pub const VIEW_MATCH_INCIDENCE_DEG: f64 = 75.0;
-
-/// Sample spacing (mm) of the z-buffer of the view matching: the scans' pitch.
-pub const VIEW_MATCH_PITCH_MM: f64 = 0.5;
-
-/// The vertices of a scan seen within `max_incidence_deg` from its own scanner
-/// ([`SCANNER_SIDE`]) and, when given, also from another scanner's direction `toward` (a
-/// view-matched cut: both must hold).
-pub fn seen_within(
-    mesh: &TriMesh,
-    toward: Option<DVec3>,
-    max_incidence_deg: f64,
-) -> Result<Vec<bool>, scanprep::ScanPrepError> {
-    let own = scanprep::incidence_mask(mesh, SCANNER_SIDE, max_incidence_deg)?;
-    Ok(match toward {
-        Some(t) => {
-            let other = scanprep::incidence_mask(mesh, t, max_incidence_deg)?;
-            own.iter().zip(&other).map(|(a, b)| *a && *b).collect()
-        }
-        None => own,
-    })
-}
-
-/// The part of a scanned face that another scan's scanner would have measured.
-pub struct ViewCut {
-    /// The faces seen from `toward` (vertices renumbered, unused ones dropped).
-    pub mesh: TriMesh,
-    /// New index of each vertex of the whole face (`u32::MAX`: dropped).
-    pub map: Vec<u32>,
-    /// The other scanner's direction in this face's frame.
-    pub toward: DVec3,
-}
-
-/// View matching: the faces of `mesh` (a scanned face in its own frame, scanner along
-/// [`SCANNER_SIDE`], landmarks `own`: right and left outer eye corners, nose tip) that a scanner
-/// would measure from another scan's direction. That direction is the other scan's
-/// [`SCANNER_SIDE`] carried into this frame by the rigid fit of its landmarks `other` onto
-/// `own`; the faces are those `rangescan::visible_faces` keeps (z-buffer of
-/// [`VIEW_MATCH_PITCH_MM`], incidence up to [`VIEW_MATCH_INCIDENCE_DEG`]). `None` when the two
-/// directions are within `min_angle_deg` (the scans saw the same) or a step fails.
-pub fn cut_to_view(
-    mesh: &TriMesh,
-    own: &[DVec3; 3],
-    other: &[DVec3; 3],
-    min_angle_deg: f64,
-) -> Option<ViewCut> {
-    let fit = meshcore::linalg::fit_rigid(other, own, None)?;
-    let toward = (fit.matrix3 * SCANNER_SIDE).normalize_or_zero();
-    if toward.angle_between(SCANNER_SIDE).to_degrees() < min_angle_deg {
-        return None;
-    }
-    let seen =
-        rangescan::visible_faces(mesh, toward, VIEW_MATCH_PITCH_MM, VIEW_MATCH_INCIDENCE_DEG)
-            .ok()?;
-    let tris = mesh
-        .triangles()
-        .iter()
-        .zip(&seen)
-        .filter(|(_, &s)| s)
-        .map(|(t, _)| *t)
-        .collect();
-    let (mesh, map) = scanprep::compact(mesh.positions(), tris, "view matching").ok()?;
-    Some(ViewCut { mesh, map, toward })
-}
-
-/// The vertex of `mesh` nearest to `p` and its distance (lowest index on ties).
-pub fn nearest_vertex(mesh: &TriMesh, p: DVec3) -> Option<(u32, f64)> {
-    mesh.positions()
-        .iter()
-        .enumerate()
-        .map(|(i, q)| (i as u32, (*q - p).length_squared()))
-        .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
-        .map(|(i, d2)| (i, d2.sqrt()))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -536,12 +459,5 @@ mod tests {
         v.sort_unstable();
         v.dedup();
         assert_eq!(v.len(), 2000);
-    }
-
-    #[test]
-    fn nearest_vertex_is_exact() {
-        let m = meshcore::shapes::icosphere(2);
-        let p = m.position(17) * 1.01;
-        assert_eq!(nearest_vertex(&m, p).map(|x| x.0), Some(17));
     }
 }

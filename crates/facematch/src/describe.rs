@@ -415,3 +415,133 @@ fn moved_descriptors(
     }
     (out, failed)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use geodesic::GeodesicSolver;
+
+    /// A flat sheet of `nx` x `ny` squares of 2 mm, its landmarks at the grid points `at` (r, q,
+    /// nose tip), its exact solver and the landmarks' fields.
+    fn plane_face(
+        nx: usize,
+        ny: usize,
+        at: [(u32, u32); 3],
+    ) -> (TriMesh, Poles, Box<dyn GeodesicSolver>, FaceFields) {
+        let m = meshcore::shapes::grid(nx, ny, meshcore::shapes::Diagonals::Alternating, |i, j| {
+            DVec3::new(2.0 * i as f64, 2.0 * j as f64, 0.0)
+        })
+        .unwrap();
+        let [r, q, nose] = at.map(|(i, j)| j * (nx as u32 + 1) + i);
+        let poles = Poles::new(r, q, nose);
+        let solver = geodesic::new_solver(&m, geodesic::Method::Exact).unwrap();
+        let f = face_fields(&m, solver.as_ref(), poles, 1.4).unwrap();
+        (m, poles, solver, f)
+    }
+
+    /// A solver that counts the fields it solves.
+    #[derive(Debug)]
+    struct Counting<'a>(&'a dyn GeodesicSolver, std::sync::atomic::AtomicUsize);
+
+    impl GeodesicSolver for Counting<'_> {
+        fn method(&self) -> geodesic::Method {
+            self.0.method()
+        }
+        fn n_vertices(&self) -> usize {
+            self.0.n_vertices()
+        }
+        fn distances(
+            &self,
+            sources: &[Source],
+            opts: &SolveOptions,
+        ) -> Result<Vec<f64>, geodesic::GeodesicError> {
+            self.1.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+            self.0.distances(sources, opts)
+        }
+    }
+
+    /// The options of the sheet tests: 8 levels, the least over the three pairs, nothing else.
+    fn sheet_options(search: Option<crate::SearchOptions>) -> MatchOptions {
+        MatchOptions {
+            levels: 8,
+            boundary_margin_mm: None,
+            max_incidence_deg: None,
+            side_pair_deg: None,
+            search,
+            view: None,
+            ..MatchOptions::default()
+        }
+    }
+
+    #[test]
+    fn the_search_moves_the_pairs_asked_for_and_solves_each_moved_pole_once() {
+        // An 80 x 50 mm sheet; poles moved by 4 mm (distinct vertices).
+        let (m, poles, exact, f) = plane_face(40, 25, [(8, 16), (32, 16), (20, 6)]);
+        let surface = Surface::new(m.clone());
+        let run = |all_pairs: bool| {
+            let o = sheet_options(Some(crate::SearchOptions {
+                radius_mm: 4.0,
+                directions: 6,
+                all_pairs,
+            }));
+            let solver = Counting(exact.as_ref(), Default::default());
+            let d = describe_with_fields(&surface, &solver, &f, poles, DVec3::Z, None, &o, true)
+                .unwrap();
+            assert_eq!(d.moved_failed, [0; 3]);
+            (d.moved.map(|v| v.len()), solver.1.into_inner())
+        };
+        // The probe's own pair (the corners) alone: 7 x 7 - 1 pole pairs, 6 moved fields per
+        // pole.
+        assert_eq!(run(false), ([48, 0, 0], 12));
+        // Every pair with shared candidates: 6 moved fields per landmark, 18.
+        assert_eq!(run(true), ([48; 3], 18));
+        // No search: nothing moved, nothing solved.
+        let solver = Counting(exact.as_ref(), Default::default());
+        let d = describe_with_fields(
+            &surface,
+            &solver,
+            &f,
+            poles,
+            DVec3::Z,
+            None,
+            &sheet_options(None),
+            true,
+        )
+        .unwrap();
+        assert!(d.moved.iter().all(Vec::is_empty));
+        assert_eq!(solver.1.into_inner(), 0);
+    }
+
+    #[test]
+    fn side_pairs_on_a_plane() {
+        // A 100 x 60 mm sheet: geodesic distance = straight distance.
+        let (m, poles, solver, f) = plane_face(50, 30, [(5, 20), (45, 20), (25, 5)]);
+        let [r, q, nose] = poles.positions(&m);
+        let frame = face_frame(&m, r, q, nose);
+        let corners = pair_refs(&m, &f, poles, Pair::Corners, frame).unwrap();
+        assert!((corners.d - 80.0).abs() < 1e-9, "{}", corners.d);
+        for (pair, corner) in [(Pair::RightNose, r), (Pair::LeftNose, q)] {
+            let side = pair_refs(&m, &f, poles, pair, frame).unwrap();
+            assert!((side.d - (corner - nose).length()).abs() < 1e-9, "{pair:?}");
+            assert_eq!((side.a, side.b, side.nose), (corner, nose, nose));
+            // The frame stays the landmarks' own.
+            assert_eq!(side.frame, frame);
+        }
+        // The left corner lost: its true place still sets the frame; only the right pair.
+        let lost = Poles {
+            q: poles.nose,
+            lost: Some(crate::Lost {
+                right: false,
+                position: q,
+            }),
+            ..poles
+        };
+        assert_eq!(lost.positions(&m), [r, q, nose]);
+        let f = face_fields(&m, solver.as_ref(), lost, 1.4).unwrap();
+        assert!(f.uq.is_empty() && f.scale(lost).is_err());
+        assert!(pair_refs(&m, &f, lost, Pair::Corners, frame).is_err());
+        assert!(pair_refs(&m, &f, lost, Pair::LeftNose, frame).is_err());
+        let side = pair_refs(&m, &f, lost, Pair::RightNose, frame).unwrap();
+        assert!((side.d - (r - nose).length()).abs() < 1e-9);
+    }
+}

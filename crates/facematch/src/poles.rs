@@ -255,4 +255,57 @@ mod tests {
             Pair::RightNose
         );
     }
+
+    #[test]
+    fn a_turned_probe_takes_the_corner_nearer_its_scanner() {
+        // Eye line along x, 100 mm, turned about the vertical y axis; the scanner looks down z.
+        let eyes = |yaw_deg: f64| {
+            let t = meshcore::DQuat::from_rotation_y(yaw_deg.to_radians());
+            (
+                t * DVec3::new(-50.0, 0.0, 0.0),
+                t * DVec3::new(50.0, 0.0, 0.0),
+            )
+        };
+        let pick = |yaw: f64, limit: Option<f64>| {
+            let (r, q) = eyes(yaw);
+            Pair::for_probe(r, q, DVec3::Z, limit, None)
+        };
+        assert_eq!(pick(0.0, Some(30.0)), Pair::Corners);
+        assert_eq!(pick(25.0, Some(30.0)), Pair::Corners);
+        assert_eq!(pick(-25.0, Some(30.0)), Pair::Corners);
+        assert_eq!(pick(40.0, None), Pair::Corners);
+        // Turned by 40 degrees: the corner with the larger z faces the scanner.
+        for yaw in [35.0, 40.0, -35.0, -40.0] {
+            let (r, q) = eyes(yaw);
+            let near = if q.z > r.z {
+                Pair::LeftNose
+            } else {
+                Pair::RightNose
+            };
+            assert_eq!(pick(yaw, Some(30.0)), near, "yaw {yaw}");
+        }
+        // A pitch of the head (about x) barely moves the estimate.
+        let nod = meshcore::DQuat::from_rotation_x(0.4);
+        let (r, q) = eyes(20.0);
+        assert_eq!(
+            Pair::for_probe(nod * r, nod * q, DVec3::Z, Some(30.0), None),
+            Pair::Corners
+        );
+        // A lost corner leaves the other's pair, whatever the turn.
+        let lost = |right| {
+            Some(Lost {
+                right,
+                position: DVec3::ZERO,
+            })
+        };
+        let (r, q) = eyes(0.0);
+        assert_eq!(
+            Pair::for_probe(r, q, DVec3::Z, None, lost(true)),
+            Pair::LeftNose
+        );
+        assert_eq!(
+            Pair::for_probe(r, q, DVec3::Z, Some(30.0), lost(false)),
+            Pair::RightNose
+        );
+    }
 }

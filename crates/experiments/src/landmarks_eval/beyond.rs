@@ -435,7 +435,7 @@ fn depth_camera(
     let mesh = cleaned.mesh;
     let truth = std::array::from_fn(|k| {
         let l = &scan.landmarks[k];
-        match crate::scans::nearest_vertex(&mesh, l.position) {
+        match facematch::nearest_vertex(&mesh, l.position) {
             Some((_, d)) if d <= crate::scans::MAX_SNAP_MM => Ok(l.position),
             Some((_, d)) => Err(format!(
                 "{} and {d:.1} mm from the cleaned surface",

@@ -19,9 +19,7 @@ use crate::curves::{
     reference_iso_levels,
 };
 use crate::paths::{ModelArgs, ResolutionArgs};
-use crate::pipeline::{
-    bar, bipolar, dist, kept_vertices, resolve_methods, single_thread, DescriptorRule, Refs, Region,
-};
+use crate::pipeline::{bar, dist, resolve_methods, single_thread};
 use crate::polar::{self, polar_descriptor, PolarOptions, Pole};
 use crate::report::{f4, line_plot, Report, Series};
 use crate::scans::ScanArgs;
@@ -29,7 +27,7 @@ use crate::walk::Walker;
 use anyhow::{bail, Context, Result};
 use bipolar::PolarDescriptor;
 use facecurves::{ElasticOptions, FacialCurvesDescriptor, IsoLevels};
-use facemodel::{face_frame, random_rigid_motion, FaceFrame, FaceModel};
+use facemodel::{random_rigid_motion, FaceModel};
 use geodesic::{SolveOptions, Source};
 use meshcore::linalg::fit_rigid;
 use meshcore::{DVec3, FaceLocator, Surface, TriMesh};
@@ -191,93 +189,9 @@ struct Sample {
     mesh: TriMesh,
 }
 
-/// Three reference vertices of a face.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Lm {
-    r: u32,
-    q: u32,
-    nose: u32,
-    /// An outer eye corner that is not on the surface (its vertex above is not used): only the
-    /// other corner's side pair can describe the face.
-    lost: Option<Lost>,
-}
-
-/// An outer eye corner that is not on the surface, and where it is (the ground truth, or where
-/// the fitted face of the detector predicts it).
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Lost {
-    /// The right corner (r); else the left (q).
-    right: bool,
-    position: DVec3,
-}
-
-impl Lm {
-    /// The three landmarks without a lost corner.
-    fn new(r: u32, q: u32, nose: u32) -> Self {
-        Lm {
-            r,
-            q,
-            nose,
-            lost: None,
-        }
-    }
-
-    /// Positions of r, q and the nose tip (for a lost corner, its [`Lost::position`]).
-    fn positions(self, mesh: &TriMesh) -> [DVec3; 3] {
-        let mut p = [self.r, self.q, self.nose].map(|v| mesh.position(v));
-        if let Some(l) = self.lost {
-            p[usize::from(!l.right)] = l.position;
-        }
-        p
-    }
-
-    /// The two poles of `pair`, in the places of r and q.
-    fn poles(self, pair: Pair) -> (u32, u32) {
-        match pair {
-            Pair::Corners => (self.r, self.q),
-            Pair::RightNose => (self.r, self.nose),
-            Pair::LeftNose => (self.q, self.nose),
-        }
-    }
-}
-
-/// The two poles of a bipolar descriptor: the outer eye corners (the paper's), or one outer eye
-/// corner with the nose tip. The discriminant indexes [`Described::bip`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Pair {
-    Corners = 0,
-    /// The right outer eye corner (r) and the nose tip.
-    RightNose = 1,
-    /// The left outer eye corner (q) and the nose tip.
-    LeftNose = 2,
-}
-
-impl Pair {
-    const ALL: [Pair; 3] = [Pair::Corners, Pair::RightNose, Pair::LeftNose];
-
-    /// The pair a probe is compared by: the corners, or, when `limit_deg` is given and the
-    /// face is turned from its scanner (direction [`crate::scans::SCANNER_SIDE`]) by more
-    /// than it, the corner nearer the scanner with the nose tip. The turn is estimated from
-    /// the eye line alone, `asin(|x . scanner|)` (x: the unit eye line r to q), so a pitch of
-    /// the head barely changes it.
-    /// A face with a lost corner has only the other corner's pair.
-    fn for_probe(r: DVec3, q: DVec3, limit_deg: Option<f64>, lost: Option<Lost>) -> Pair {
-        match lost {
-            Some(l) if l.right => return Pair::LeftNose,
-            Some(_) => return Pair::RightNose,
-            None => {}
-        }
-        let Some(limit) = limit_deg else {
-            return Pair::Corners;
-        };
-        let s = (q - r).normalize_or_zero().dot(crate::scans::SCANNER_SIDE);
-        match s.abs().clamp(0.0, 1.0).asin().to_degrees() {
-            t if t <= limit => Pair::Corners,
-            _ if s > 0.0 => Pair::LeftNose,
-            _ => Pair::RightNose,
-        }
-    }
-}
+/// The reference vertices of a face (outer eye corners, nose tip; a lost corner explicit):
+/// `facematch`'s, as are the pole pairs.
+type Lm = facematch::Poles;
 
 /// Default of `--scan-edge`, mm.
 const SCAN_EDGE_MM: f64 = 1.5;
@@ -338,23 +252,18 @@ fn elastic_options(samples: usize) -> ElasticOptions {
 /// Per face and landmark set: descriptors, landmark positions and description times.
 #[derive(Debug)]
 struct Described {
-    /// Bipolar descriptors, one per [`Pair`] (indexed by its discriminant).
-    bip: [Result<bipolar::Descriptor, String>; 3],
-    /// The pair this face is compared by as a probe ([`Pair::for_probe`]).
-    pair: Pair,
-    /// Its score is the least distance over the three pairs ([`DescribeOptions::least_pair`]).
-    least_pair: bool,
-    /// The weight of the second least pair distance ([`DescribeOptions::second_weight`]).
-    second_weight: f64,
-    /// Bipolar descriptors from moved poles, per [`Pair`] (`DescribeOptions::ref_search`): of
-    /// `pair`, or of all three with [`DescribeOptions::search_all_pairs`]; else empty.
-    bip_alt: [Vec<bipolar::Descriptor>; 3],
+    /// The bipolar descriptions ([`facematch::describe_with_fields`]: the three pole pairs, the
+    /// pair it is compared by as a probe, with the reference-point search a probe's moved
+    /// descriptors), or why there are none.
+    bip: Result<facematch::Description, String>,
+    /// The options of its comparisons ([`facematch::compare`]: least pair, second weight).
+    matching: facematch::MatchOptions,
     pol: PolarDescriptor,
     facial: Result<FacialCurvesDescriptor, String>,
     /// The iso-curvature network's points prepared for ICP (the network itself is not kept).
     iso: Result<PreparedSet, String>,
     lm_pos: [DVec3; 3],
-    /// A gallery face's mesh and settings for view matching (`None` for probes and when off).
+    /// A gallery face's mesh for view matching (`None` for probes and when off).
     view: Option<Box<ViewSource>>,
     /// Wall time of each description (bipolar, single pole, facial curves, iso-curvature): the
     /// geodesic fields it needs (both corners; the nose tip) and its own build.
@@ -398,13 +307,40 @@ struct DescribeOptions {
     predicted_corners: bool,
 }
 
+impl DescribeOptions {
+    /// The bipolar settings as `facematch` options (exact geodesics for the views; the caller
+    /// sets another method where it uses one): levels, the fields' cut-off of 1.4, the band,
+    /// the incidence limit, side pairs, the score's rule, the search's radius in mesh units and
+    /// [`SEARCH_DIRECTIONS`], the snap distance of a carried landmark; no gate, no stored views.
+    fn matching(&self) -> facematch::MatchOptions {
+        facematch::MatchOptions {
+            method: geodesic::Method::Exact,
+            levels: self.levels,
+            field_cutoff: 1.4,
+            boundary_margin_mm: self.boundary_margin,
+            max_incidence_deg: self.max_incidence_deg,
+            side_pair_deg: self.side_pair_deg,
+            least_pair: self.least_pair,
+            second_weight: self.second_weight,
+            search: self.ref_search.map(|r| facematch::SearchOptions {
+                radius_mm: r,
+                directions: SEARCH_DIRECTIONS,
+                all_pairs: self.search_all_pairs,
+            }),
+            view: None,
+            predicted_corners: self.predicted_corners,
+            snap_mm: crate::scans::MAX_SNAP_MM,
+            gate_mm: None,
+            ..facematch::MatchOptions::default()
+        }
+    }
+}
+
 /// The fields of a face cut off at 1.4 |q - r| (corners r, q; nose tip, when asked for: else
-/// `un` is empty), D, and the wall time of the corner fields and of the nose field.
+/// `un` is empty), D, and the wall time of the corner fields and of the nose field
+/// ([`facematch::face_fields`] with the two timed apart).
 struct Fields {
-    ur: Vec<f64>,
-    uq: Vec<f64>,
-    un: Vec<f64>,
-    d: f64,
+    f: facematch::FaceFields,
     secs: [f64; 2],
 }
 
@@ -451,70 +387,8 @@ fn fields(
         None => 0.5 * (ur[lm.q as usize] + uq[lm.r as usize]),
     };
     Ok(Fields {
-        ur,
-        uq,
-        un,
-        d,
+        f: facematch::FaceFields { ur, uq, un, d },
         secs: [t_corners, t_nose],
-    })
-}
-
-impl Fields {
-    /// D, the geodesic distance between the outer eye corners, or why there is none.
-    fn scale(&self, lm: Lm) -> Result<f64, String> {
-        if lm.lost.is_some() {
-            return Err("an outer eye corner is not on the surface".into());
-        }
-        let d = self.d;
-        if !d.is_finite() || d <= 0.0 {
-            return Err(format!(
-                "the geodesic distance between the outer eye corners is {d} (not reachable within 1.4 times their distance)"
-            ));
-        }
-        Ok(d)
-    }
-}
-
-/// The reference fields of `pair` on a face with fields `f` (the nose tip's needed for a side
-/// pair) and landmark frame `frame`; the two poles stand in `Refs`' r and q, D is their
-/// geodesic distance. The frame and the nose tip stay the landmarks' own for every pair, so
-/// the static area of a side pair is its lens above the nose tip's horizontal plane.
-fn pair_refs(
-    mesh: &TriMesh,
-    f: &Fields,
-    lm: Lm,
-    pair: Pair,
-    frame: FaceFrame,
-) -> Result<Refs, String> {
-    let (ua, ub) = match pair {
-        Pair::Corners => (&f.ur, &f.uq),
-        Pair::RightNose => (&f.ur, &f.un),
-        Pair::LeftNose => (&f.uq, &f.un),
-    };
-    if ua.is_empty() || ub.is_empty() {
-        return Err(format!(
-            "{pair:?}: a pole has no geodesic field (an outer eye corner not on the surface)"
-        ));
-    }
-    let (a, b) = lm.poles(pair);
-    let d = match pair {
-        Pair::Corners => f.scale(lm)?,
-        _ => 0.5 * (ua[b as usize] + ub[a as usize]),
-    };
-    if !(d.is_finite() && d > 0.0) {
-        return Err(format!(
-            "{pair:?}: the geodesic distance between the poles is {d} (not reachable within the fields' cut-off)"
-        ));
-    }
-    let [_, _, nose] = lm.positions(mesh);
-    Ok(Refs {
-        ur: ua.clone(),
-        uq: ub.clone(),
-        d,
-        r: mesh.position(a),
-        q: mesh.position(b),
-        nose,
-        frame,
     })
 }
 
@@ -526,30 +400,12 @@ fn iso_levels_of(
     lm: Lm,
     count: usize,
 ) -> Result<IsoLevels> {
-    let f = fields(mesh, solver, lm, true).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let f = fields(mesh, solver, lm, true)
+        .map_err(|e| anyhow::anyhow!("{e}"))?
+        .f;
     let d = f.scale(lm).map_err(|e| anyhow::anyhow!("{e}"))?;
     reference_iso_levels(&Surface::new(mesh.clone()), &f.un, d, count)
         .context("iso-curvature levels of the reference face")
-}
-
-/// The benchmark's bipolar descriptor on `surface` from `refs`: static area, rule `All`, the
-/// options' levels, on the vertices `kept` ([`kept_vertices`]: the scanner's incidence mask
-/// without the boundary band).
-fn static_bipolar(
-    surface: &Surface,
-    refs: &Refs,
-    o: &DescribeOptions,
-    kept: Option<&[bool]>,
-) -> Result<bipolar::Descriptor, bipolar::BipolarError> {
-    bipolar(
-        surface,
-        refs,
-        o.levels,
-        Region::Static,
-        DescriptorRule::CrateAll,
-        None,
-        kept,
-    )
 }
 
 /// The four descriptions of one face for one landmark set: bipolar (static area, grid
@@ -564,47 +420,25 @@ fn describe_face(
     lm: Lm,
     o: &DescribeOptions,
 ) -> Result<Described, String> {
-    let f = fields(mesh, solver, lm, true)?;
+    let Fields { f, secs } = fields(mesh, solver, lm, true)?;
     let [r, q, nose] = lm.positions(mesh);
-    let [t_corners, t_nose] = f.secs;
-    let frame = face_frame(mesh, r, q, nose);
+    let [t_corners, t_nose] = secs;
     let t = Instant::now();
-    let seen = match o.max_incidence_deg {
-        Some(deg) => Some(
-            scanprep::incidence_mask(mesh, crate::scans::SCANNER_SIDE, deg)
-                .map_err(|e| format!("incidence mask: {e}"))?,
-        ),
-        None => None,
-    };
-    let pair = Pair::for_probe(r, q, o.side_pair_deg, lm.lost);
     let t_surface = Instant::now();
     let surface = Surface::new(mesh.clone());
     let t_surface = t_surface.elapsed().as_secs_f64();
-    let kept = kept_vertices(&surface, seen, o.boundary_margin)
-        .map_err(|e| format!("bipolar descriptor: {e}"));
-    let refs = Pair::ALL.map(|p| pair_refs(mesh, &f, lm, p, frame));
-    let bip = Pair::ALL.map(|p| {
-        let refs = refs[p as usize].as_ref().map_err(Clone::clone)?;
-        let kept = kept.as_ref().map_err(Clone::clone)?;
-        static_bipolar(&surface, refs, o, kept.as_deref())
-            .map_err(|e| format!("bipolar descriptor: {e}"))
-    });
-    let all = o.least_pair && o.search_all_pairs;
-    let searched = Pair::ALL.map(|p| p == pair || all);
-    // Without the kept vertices every descriptor fails: no moved ones either.
-    let bip_alt = match &kept {
-        Ok(kept) => moved_pole_descriptors(
-            &surface,
-            solver,
-            lm,
-            &refs,
-            searched,
-            all,
-            o,
-            kept.as_deref(),
-        ),
-        Err(_) => Default::default(),
-    };
+    let matching = o.matching();
+    let bip = facematch::describe_with_fields(
+        &surface,
+        solver,
+        &f,
+        lm,
+        crate::scans::SCANNER_SIDE,
+        None,
+        &matching,
+        o.ref_search.is_some(),
+    )
+    .map_err(|e| e.to_string());
     let t_bip = t.elapsed().as_secs_f64();
     // The descriptions scaled by D need both corners.
     let scale = f.scale(lm);
@@ -641,10 +475,7 @@ fn describe_face(
     let t_iso = t.elapsed().as_secs_f64();
     Ok(Described {
         bip,
-        pair,
-        least_pair: o.least_pair,
-        second_weight: o.second_weight,
-        bip_alt,
+        matching,
         pol,
         facial,
         iso,
@@ -663,179 +494,55 @@ fn describe_face(
 /// scan-study).
 pub(crate) const SEARCH_DIRECTIONS: usize = 6;
 
-/// Bipolar descriptors of a face, per [`Pair`] (indexed by its discriminant), from the poles of
-/// each pair in `searched` (with reference fields `refs`; a pair whose `refs` failed is left
-/// empty) moved by the search radius `o.ref_search` (none without it) in [`SEARCH_DIRECTIONS`]
-/// directions of their tangent planes (`bipolar::SearchedPole`, paired by
-/// `bipolar::moved_pairs`; each pole at its place or moved: 48 pairs), with the options and vertices `kept` of the face's own descriptors; pairs whose fields or
-/// descriptor fail are left out. The first direction of a pole points toward the pair's other
-/// pole, or, with `shared_candidates`, the same for every pair: an outer eye corner toward the
-/// other, the nose tip toward their midpoint, so that each landmark's moved fields are solved
-/// once for all pairs. Moved corners get the frame of their new eye line; a side pair keeps
-/// the landmarks' frame.
-#[allow(clippy::too_many_arguments)]
-fn moved_pole_descriptors(
-    surface: &Surface,
-    solver: &dyn geodesic::GeodesicSolver,
-    lm: Lm,
-    refs: &[Result<Refs, String>; 3],
-    searched: [bool; 3],
-    shared_candidates: bool,
-    o: &DescribeOptions,
-    kept: Option<&[bool]>,
-) -> [Vec<bipolar::Descriptor>; 3] {
-    let mut out: [Vec<bipolar::Descriptor>; 3] = Default::default();
-    let Some(rho) = o.ref_search else {
-        return out;
-    };
-    let mesh = surface.mesh();
-    let search: Vec<(Pair, &Refs)> = Pair::ALL
-        .into_iter()
-        .filter(|p| searched[*p as usize])
-        .filter_map(|p| refs[p as usize].as_ref().ok().map(|r| (p, r)))
-        .collect();
-    let Some(span) = search
-        .iter()
-        .map(|(_, r)| (r.q - r.r).length())
-        .reduce(f64::max)
-    else {
-        return out;
-    };
-    let cut = SolveOptions {
-        max_distance: Some(1.4 * span + 4.0 * rho),
-    };
-    let lm_vertex = [lm.r, lm.q, lm.nose];
-    let [pr, pq, _] = lm.positions(mesh);
-    // A landmark's searched pole, by (landmark, the point its first direction points toward);
-    // the given pole keeps its field, each moved one is solved.
-    let mut cache: Vec<((usize, [u64; 3]), bipolar::SearchedPole)> = Vec::new();
-    let mut moved = |k: usize, toward: DVec3, given: &[f64]| -> usize {
-        let key = (k, toward.to_array().map(f64::to_bits));
-        if let Some(i) = cache.iter().position(|(c, _)| *c == key) {
-            return i;
-        }
-        let pole = bipolar::SearchedPole::new(
-            mesh,
-            solver,
-            lm_vertex[k],
-            toward,
-            given,
-            rho,
-            SEARCH_DIRECTIONS,
-            &cut,
-        )
-        .unwrap_or_default();
-        cache.push((key, pole));
-        cache.len() - 1
-    };
-    let toward = |k: usize, other: DVec3| match (shared_candidates, k) {
-        (false, _) => other,
-        (true, 0) => pq,
-        (true, 1) => pr,
-        (true, _) => 0.5 * (pr + pq),
-    };
-    let jobs: Vec<(Pair, &Refs, usize, usize)> = search
-        .into_iter()
-        .map(|(pair, refs)| {
-            let (ka, kb) = match pair {
-                Pair::Corners => (0, 1),
-                Pair::RightNose => (0, 2),
-                Pair::LeftNose => (1, 2),
-            };
-            let ia = moved(ka, toward(ka, refs.q), &refs.ur);
-            let ib = moved(kb, toward(kb, refs.r), &refs.uq);
-            (pair, refs, ia, ib)
-        })
-        .collect();
-    for (pair, refs, ia, ib) in jobs {
-        for m in bipolar::moved_pairs(&cache[ia].1, &cache[ib].1) {
-            let (pr, pq) = (mesh.position(m.r), mesh.position(m.q));
-            let moved = Refs {
-                ur: m.ur.to_vec(),
-                uq: m.uq.to_vec(),
-                d: m.d,
-                r: pr,
-                q: pq,
-                nose: refs.nose,
-                frame: match pair {
-                    Pair::Corners => face_frame(mesh, pr, pq, refs.nose),
-                    _ => refs.frame,
-                },
-            };
-            if let Ok(b) = static_bipolar(surface, &moved, o, kept) {
-                out[pair as usize].push(b);
-            }
-        }
-    }
-    out
-}
-
 /// What a gallery face needs to be described again as a probe's scanner would see it.
 #[derive(Debug)]
 struct ViewSource {
     mesh: TriMesh,
     lm: Lm,
-    method: geodesic::Method,
     /// The gallery's own description settings.
-    opts: DescribeOptions,
+    matching: facematch::MatchOptions,
     /// Below this angle (degrees) between the two scanner directions the face's own
     /// description is used.
     min_angle_deg: f64,
 }
 
 impl ViewSource {
-    /// The bipolar descriptors, one per [`Pair`] (indexed by its discriminant), of the part of
-    /// the gallery face a scanner would measure from the probe's scanner direction (+z in the
-    /// probe's frame, carried into the gallery's frame by the rigid fit of the probe's
-    /// landmarks `probe_lm` onto the gallery's), with the gallery's own options; their points
-    /// must also be within the incidence limit from the probe's direction. `None` when the
-    /// directions are within `min_angle_deg` or the cut fails, and `None` for a pair whose
-    /// description fails (the caller then uses the face's own description).
-    fn describe_from(&self, probe_lm: &[DVec3; 3]) -> Option<[Option<bipolar::Descriptor>; 3]> {
-        let m = &self.mesh;
-        // A lost corner aligns by its place (true or predicted).
-        let own = self.lm.positions(m);
-        let crate::scans::ViewCut {
-            mesh: cut,
-            map,
+    /// The view-matching settings: the benchmark describes each view from the probe's exact
+    /// direction (no stored turns).
+    fn view_options(&self) -> facematch::ViewOptions {
+        facematch::ViewOptions {
+            min_angle_deg: self.min_angle_deg,
+            yaws_deg: Vec::new(),
+            ..facematch::ViewOptions::default()
+        }
+    }
+
+    /// The gallery face described as a scanner would measure it from the probe's scanner
+    /// direction ([`crate::scans::SCANNER_SIDE`] in the probe's frame, carried into the
+    /// gallery's by the rigid fit of the probe's landmarks `probe_lm` onto the gallery's;
+    /// [`facematch::describe_view`]), as the template's one view. `None` when the directions
+    /// are within `min_angle_deg` or the fit fails; a view that cannot be described is the
+    /// view's error (the comparison then falls back on the face's own description, counted).
+    fn view_from(&self, probe_lm: &[DVec3; 3]) -> Option<facematch::TemplateView> {
+        let side = crate::scans::SCANNER_SIDE;
+        let own = self.lm.positions(&self.mesh);
+        let toward = facematch::probe_direction(probe_lm, side, &own)?;
+        if toward.angle_between(side).to_degrees() < self.min_angle_deg {
+            return None;
+        }
+        let sets = facematch::describe_view(
+            &self.mesh,
+            self.lm,
+            side,
             toward,
-        } = crate::scans::cut_to_view(m, &own, probe_lm, self.min_angle_deg)?;
-        let surface = Surface::new(cut);
-        let cut = surface.mesh();
-        // A landmark whose faces are all gone is placed as a probe's ground truth is: on the
-        // nearest vertex left, within `MAX_SNAP_MM`.
-        let place = |v: u32| match map[v as usize] {
-            u32::MAX => match crate::scans::nearest_vertex(cut, m.position(v)) {
-                Some((w, d)) if d <= crate::scans::MAX_SNAP_MM => Some(w),
-                _ => None,
-            },
-            w => Some(w),
-        };
-        let nose = place(self.lm.nose)?;
-        // A lost corner's vertex is the nose tip's, as in [`lm_from`].
-        let corner = |v: u32, right: bool| match self.lm.lost {
-            Some(l) if l.right == right => Some(nose),
-            _ => place(v),
-        };
-        let lm = Lm {
-            r: corner(self.lm.r, true)?,
-            q: corner(self.lm.q, false)?,
-            nose,
-            lost: self.lm.lost,
-        };
-        let solver = geodesic::new_solver(cut, self.method).ok()?;
-        let f = fields(cut, solver.as_ref(), lm, true).ok()?;
-        let [r, q, nose] = lm.positions(cut);
-        let frame = face_frame(cut, r, q, nose);
-        let seen = match self.opts.max_incidence_deg {
-            Some(deg) => Some(crate::scans::seen_within(cut, Some(toward), deg).ok()?),
-            None => None,
-        };
-        let kept = kept_vertices(&surface, seen, self.opts.boundary_margin).ok()?;
-        Some(Pair::ALL.map(|pair| {
-            let refs = pair_refs(cut, &f, lm, pair, frame).ok()?;
-            static_bipolar(&surface, &refs, &self.opts, kept.as_deref()).ok()
-        }))
+            &self.matching,
+            &self.view_options(),
+        );
+        Some(facematch::TemplateView {
+            yaw_deg: f64::NAN,
+            toward,
+            sets,
+        })
     }
 }
 
@@ -1035,50 +742,48 @@ fn icp_points(mesh: &TriMesh, n: usize) -> Vec<DVec3> {
     mesh.positions().iter().step_by(stride).copied().collect()
 }
 
-/// The bipolar distance of a probe `x` to a gallery face `y` by each [`Pair`] (indexed by its
-/// discriminant; NaN where a side has no descriptor or the distance fails). With view matching,
-/// against the gallery face as the probe's scanner would see it. With a reference-point search,
-/// a searched pair's distance is `bipolar::least_searched_distance` of the probe's own and
-/// moved descriptors against the gallery's one (a failed one skipped; when the probe's own
-/// failed, the least over its moved ones).
+/// A probe `x` compared with a gallery face `y` by [`facematch::compare`] (with view matching
+/// against the gallery face as the probe's scanner would see it; per pair the least over the
+/// probe's own and moved descriptors), or `None` when a side has no descriptions.
+fn bipolar_compare(x: &Described, y: &Described) -> Option<facematch::Comparison> {
+    let (Ok(xd), Ok(yd)) = (&x.bip, &y.bip) else {
+        return None;
+    };
+    let views = y
+        .view
+        .as_ref()
+        .and_then(|v| v.view_from(&xd.landmarks))
+        .into_iter()
+        .collect();
+    let template = facematch::Template {
+        identity: String::new(),
+        source: String::new(),
+        settings: String::new(),
+        description: yd.clone(),
+        views,
+        notes: Vec::new(),
+    };
+    let o = facematch::MatchOptions {
+        view: y.view.as_ref().map(|v| v.view_options()),
+        ..x.matching.clone()
+    };
+    Some(facematch::compare(xd, &template, &o))
+}
+
+/// The bipolar distance of a probe `x` to a gallery face `y` by each pole pair (NaN where a
+/// side has no descriptor or the distance fails; [`bipolar_compare`]).
 fn bipolar_pairs(x: &Described, y: &Described) -> [f64; 3] {
-    let matched = y.view.as_ref().and_then(|v| v.describe_from(&x.lm_pos));
-    Pair::ALL.map(|p| {
-        let i = p as usize;
-        let Ok(own) = &y.bip[i] else {
-            return f64::NAN;
-        };
-        let yb = matched.as_ref().and_then(|m| m[i].as_ref()).unwrap_or(own);
-        let (xa, moved) = match (&x.bip[i], x.bip_alt[i].split_first()) {
-            (Ok(xa), _) => (xa, &x.bip_alt[i][..]),
-            (Err(_), Some((first, rest))) => (first, rest),
-            (Err(_), None) => return f64::NAN,
-        };
-        bipolar::least_searched_distance(xa, moved, yb, &[], dist).unwrap_or(f64::NAN)
-    })
+    bipolar_compare(x, y).map_or([f64::NAN; 3], |c| c.pairs.map(|u| u.distance))
 }
 
 /// The bipolar score of a probe `x` from its distances by each pair `d` ([`bipolar_pairs`]):
-/// the least of them ([`Described::least_pair`]; with [`Described::second_weight`] blended with
-/// the second least), else its own pair's.
+/// [`facematch::pair_score`] with the probe's pair and its options.
 fn bipolar_score(x: &Described, d: [f64; 3]) -> f64 {
-    pair_score(d, x.pair, x.least_pair, x.second_weight)
-}
-
-/// With `least`: `(1 - second)` x the least of the distances by each pair `d` + `second` x the
-/// second least (NaN ones skipped; the least alone when only one is a number, or when
-/// `second` is 0; NaN when none is); else the one of the probe's pair `own`.
-fn pair_score(d: [f64; 3], own: Pair, least: bool, second: f64) -> f64 {
-    if !least {
-        return d[own as usize];
-    }
-    let mut f: Vec<f64> = d.into_iter().filter(|x| !x.is_nan()).collect();
-    f.sort_by(f64::total_cmp);
-    match f[..] {
-        [] => f64::NAN,
-        [a] => a,
-        [a, ..] if second == 0.0 => a,
-        [a, b, ..] => (1.0 - second) * a + second * b,
+    match &x.bip {
+        Ok(xd) => {
+            facematch::pair_score(d, xd.pair, x.matching.least_pair, x.matching.second_weight).0
+        }
+        Err(_) => f64::NAN,
     }
 }
 
@@ -1752,256 +1457,60 @@ mod tests {
         assert!((p / 8.940066542253267e-6 - 1.0).abs() < 1e-9, "{p}");
     }
 
-    #[test]
-    fn a_turned_probe_takes_the_corner_nearer_its_scanner() {
-        // Eye line along x, 100 mm, turned about the vertical y axis; the scanner looks down z.
-        let eyes = |yaw_deg: f64| {
-            let t = DQuat::from_rotation_y(yaw_deg.to_radians());
-            (
-                t * DVec3::new(-50.0, 0.0, 0.0),
-                t * DVec3::new(50.0, 0.0, 0.0),
-            )
-        };
-        let pick = |yaw: f64, limit: Option<f64>| {
-            let (r, q) = eyes(yaw);
-            Pair::for_probe(r, q, limit, None)
-        };
-        assert_eq!(pick(0.0, Some(30.0)), Pair::Corners);
-        assert_eq!(pick(25.0, Some(30.0)), Pair::Corners);
-        assert_eq!(pick(-25.0, Some(30.0)), Pair::Corners);
-        assert_eq!(pick(40.0, None), Pair::Corners);
-        // Turned by 40 degrees: the corner with the larger z faces the scanner.
-        for yaw in [35.0, 40.0, -35.0, -40.0] {
-            let (r, q) = eyes(yaw);
-            let near = if q.z > r.z {
-                Pair::LeftNose
-            } else {
-                Pair::RightNose
-            };
-            assert_eq!(pick(yaw, Some(30.0)), near, "yaw {yaw}");
-        }
-        // A pitch of the head (about x) barely moves the estimate.
-        let nod = DQuat::from_rotation_x(0.4);
-        let (r, q) = eyes(20.0);
-        assert_eq!(
-            Pair::for_probe(nod * r, nod * q, Some(30.0), None),
-            Pair::Corners
-        );
-        // A lost corner leaves the other's pair, whatever the turn.
-        let lost = |right| {
-            Some(Lost {
-                right,
-                position: DVec3::ZERO,
-            })
-        };
-        let (r, q) = eyes(0.0);
-        assert_eq!(Pair::for_probe(r, q, None, lost(true)), Pair::LeftNose);
-        assert_eq!(
-            Pair::for_probe(r, q, Some(30.0), lost(false)),
-            Pair::RightNose
-        );
-    }
-
-    #[test]
-    fn the_score_is_the_least_pair_distance_or_the_probe_pair() {
-        let nan = f64::NAN;
-        assert_eq!(pair_score([0.3, 0.1, 0.2], Pair::Corners, true, 0.0), 0.1);
-        assert_eq!(pair_score([nan, 0.4, 0.2], Pair::RightNose, true, 0.0), 0.2);
-        assert_eq!(pair_score([0.3, nan, nan], Pair::LeftNose, true, 0.0), 0.3);
-        assert!(pair_score([nan; 3], Pair::Corners, true, 0.0).is_nan());
-        assert_eq!(pair_score([0.3, 0.1, 0.2], Pair::Corners, false, 0.0), 0.3);
-        assert_eq!(
-            pair_score([0.3, 0.1, 0.2], Pair::LeftNose, false, 0.25),
-            0.2
-        );
-        assert!(pair_score([0.3, nan, 0.2], Pair::RightNose, false, 0.0).is_nan());
-        // The blend: 0.75 x 0.1 + 0.25 x 0.2; NaN skipped; one number alone is the score.
-        let b = pair_score([0.3, 0.1, 0.2], Pair::Corners, true, 0.25);
-        assert!((b - 0.125).abs() < 1e-15, "{b}");
-        let b = pair_score([nan, 0.4, 0.2], Pair::Corners, true, 0.5);
-        assert!((b - 0.3).abs() < 1e-15, "{b}");
-        assert_eq!(pair_score([nan, 0.4, nan], Pair::Corners, true, 0.25), 0.4);
-        assert!(pair_score([nan; 3], Pair::Corners, true, 0.25).is_nan());
-    }
-
-    /// A flat sheet of `nx` x `ny` squares of 2 mm, its landmarks at the grid points `at` (r, q,
-    /// nose tip), its exact solver, their fields and frame.
-    fn plane_face(
-        nx: usize,
-        ny: usize,
-        at: [(u32, u32); 3],
-    ) -> (
-        TriMesh,
-        Lm,
-        Box<dyn geodesic::GeodesicSolver>,
-        Fields,
-        FaceFrame,
-    ) {
+    /// A flat sheet of `nx` x `ny` squares of 2 mm and its landmarks at the grid points `at`
+    /// (r, q, nose tip).
+    fn plane_face(nx: usize, ny: usize, at: [(u32, u32); 3]) -> (TriMesh, Lm) {
         let m = meshcore::shapes::grid(nx, ny, meshcore::shapes::Diagonals::Alternating, |i, j| {
             DVec3::new(2.0 * i as f64, 2.0 * j as f64, 0.0)
         })
         .unwrap();
         let [r, q, nose] = at.map(|(i, j)| j * (nx as u32 + 1) + i);
-        let lm = Lm::new(r, q, nose);
-        let solver = geodesic::new_solver(&m, geodesic::Method::Exact).unwrap();
-        let f = fields(&m, solver.as_ref(), lm, true).unwrap();
-        let [r, q, nose] = lm.positions(&m);
-        let frame = face_frame(&m, r, q, nose);
-        (m, lm, solver, f, frame)
-    }
-
-    /// Options of the sheet tests: 8 levels and sectors, the least over the three pairs with
-    /// every pair searched, nothing else.
-    fn sheet_options() -> DescribeOptions {
-        DescribeOptions {
-            levels: 8,
-            sectors: 8,
-            iso_levels: None,
-            boundary_margin: None,
-            max_incidence_deg: None,
-            ref_search: None,
-            view_match: None,
-            side_pair_deg: None,
-            least_pair: true,
-            search_all_pairs: true,
-            second_weight: 0.0,
-            predicted_corners: false,
-        }
-    }
-
-    /// `lm` with its left outer eye corner lost at `at` (its vertex the nose tip's).
-    fn left_lost(lm: Lm, at: DVec3) -> Lm {
-        Lm {
-            q: lm.nose,
-            lost: Some(Lost {
-                right: false,
-                position: at,
-            }),
-            ..lm
-        }
-    }
-
-    /// A solver that counts the fields it solves.
-    #[derive(Debug)]
-    struct Counting<'a>(
-        &'a dyn geodesic::GeodesicSolver,
-        std::sync::atomic::AtomicUsize,
-    );
-
-    impl geodesic::GeodesicSolver for Counting<'_> {
-        fn method(&self) -> geodesic::Method {
-            self.0.method()
-        }
-        fn n_vertices(&self) -> usize {
-            self.0.n_vertices()
-        }
-        fn distances(
-            &self,
-            sources: &[Source],
-            opts: &SolveOptions,
-        ) -> Result<Vec<f64>, geodesic::GeodesicError> {
-            self.1.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            self.0.distances(sources, opts)
-        }
-    }
-
-    #[test]
-    fn the_search_moves_the_pairs_asked_for_and_solves_each_moved_pole_once() {
-        // An 80 x 50 mm sheet; poles moved by 4 mm (distinct vertices).
-        let (m, lm, exact, f, frame) = plane_face(40, 25, [(8, 16), (32, 16), (20, 6)]);
-        let refs = Pair::ALL.map(|p| pair_refs(&m, &f, lm, p, frame));
-        let o = DescribeOptions {
-            ref_search: Some(4.0),
-            ..sheet_options()
-        };
-        let surface = Surface::new(m.clone());
-        let run = |searched: [bool; 3], shared: bool| {
-            let solver = Counting(exact.as_ref(), Default::default());
-            let out =
-                moved_pole_descriptors(&surface, &solver, lm, &refs, searched, shared, &o, None);
-            (out.map(|v| v.len()), solver.1.into_inner())
-        };
-        // The own pair alone: 7 x 7 - 1 pole pairs, 6 moved fields per pole.
-        assert_eq!(run([false, true, false], false), ([0, 48, 0], 12));
-        // Every pair, each pole's first direction toward its pair's other pole: a corner's
-        // candidates differ between its two pairs, 36 fields.
-        assert_eq!(run([true; 3], false), ([48; 3], 36));
-        // Shared candidates: 6 moved fields per landmark, 18.
-        assert_eq!(run([true; 3], true), ([48; 3], 18));
-        // No search radius: nothing.
-        let off = DescribeOptions {
-            ref_search: None,
-            ..o.clone()
-        };
-        let none = moved_pole_descriptors(
-            &surface,
-            exact.as_ref(),
-            lm,
-            &refs,
-            [true; 3],
-            true,
-            &off,
-            None,
-        );
-        assert!(none.iter().all(Vec::is_empty));
-    }
-
-    #[test]
-    fn side_pairs_on_a_plane() {
-        // A 100 x 60 mm sheet: geodesic distance = straight distance.
-        let (m, lm, solver, f, frame) = plane_face(50, 30, [(5, 20), (45, 20), (25, 5)]);
-        let [r, q, nose] = lm.positions(&m);
-        let corners = pair_refs(&m, &f, lm, Pair::Corners, frame).unwrap();
-        assert!((corners.d - 80.0).abs() < 1e-9, "{}", corners.d);
-        for (pair, corner) in [(Pair::RightNose, r), (Pair::LeftNose, q)] {
-            let side = pair_refs(&m, &f, lm, pair, frame).unwrap();
-            assert!((side.d - (corner - nose).length()).abs() < 1e-9, "{pair:?}");
-            assert_eq!((side.r, side.q, side.nose), (corner, nose, nose));
-            // The frame stays the landmarks' own.
-            assert_eq!(side.frame, frame);
-        }
-        // The left corner lost: its true place still sets the frame; only the right pair.
-        let lost = left_lost(lm, q);
-        assert_eq!(lost.positions(&m), [r, q, nose]);
-        let f = fields(&m, solver.as_ref(), lost, true).unwrap();
-        assert!(f.uq.is_empty() && f.scale(lost).is_err());
-        assert!(pair_refs(&m, &f, lost, Pair::Corners, frame).is_err());
-        assert!(pair_refs(&m, &f, lost, Pair::LeftNose, frame).is_err());
-        let side = pair_refs(&m, &f, lost, Pair::RightNose, frame).unwrap();
-        assert!((side.d - (r - nose).length()).abs() < 1e-9);
+        (m, Lm::new(r, q, nose))
     }
 
     #[test]
     fn view_matching_keeps_a_face_with_a_lost_corner() {
         // A 100 x 60 mm sheet, seen by a probe turned 30 degrees about the vertical.
-        let (m, lm, _, _, _) = plane_face(50, 30, [(5, 20), (45, 20), (25, 5)]);
-        let o = DescribeOptions {
-            view_match: Some(10.0),
-            side_pair_deg: Some(30.0),
-            ..sheet_options()
-        };
+        let (m, lm) = plane_face(50, 30, [(5, 20), (45, 20), (25, 5)]);
         let source = |lm: Lm| ViewSource {
             mesh: m.clone(),
             lm,
-            method: geodesic::Method::Exact,
-            opts: o.clone(),
+            matching: facematch::MatchOptions {
+                levels: 8,
+                boundary_margin_mm: None,
+                max_incidence_deg: None,
+                search: None,
+                view: None,
+                ..facematch::MatchOptions::default()
+            },
             min_angle_deg: 10.0,
         };
         let [r, q, nose] = lm.positions(&m);
         let turn = DQuat::from_rotation_y(30f64.to_radians());
         let probe = [r, q, nose].map(|p| turn * p);
-        let whole = source(lm).describe_from(&probe).unwrap();
-        assert!(whole.iter().all(Option::is_some));
+        let whole = source(lm).view_from(&probe).unwrap().sets.unwrap();
+        assert!(whole.iter().all(Result::is_ok), "{whole:?}");
         // The left corner lost at its true place: the cut is the same and the right side
         // pair's descriptor too (its frame from the lost corner's place); no other pair.
-        let lost = left_lost(lm, q);
-        let cut = source(lost).describe_from(&probe).unwrap();
-        assert!(cut[Pair::Corners as usize].is_none() && cut[Pair::LeftNose as usize].is_none());
-        let right = Pair::RightNose as usize;
+        let lost = Lm {
+            q: lm.nose,
+            lost: Some(facematch::Lost {
+                right: false,
+                position: q,
+            }),
+            ..lm
+        };
+        let cut = source(lost).view_from(&probe).unwrap().sets.unwrap();
+        let (corners, left) = (
+            facematch::Pair::Corners as usize,
+            facematch::Pair::LeftNose as usize,
+        );
+        assert!(cut[corners].is_err() && cut[left].is_err());
+        let right = facematch::Pair::RightNose as usize;
         assert_eq!(cut[right], whole[right]);
         assert!(!cut[right].as_ref().unwrap().points.is_empty());
-        // Below the angle, no cut.
-        assert!(source(lost).describe_from(&[r, q, nose]).is_none());
+        // Below the angle, no view.
+        assert!(source(lost).view_from(&[r, q, nose]).is_none());
     }
 
     #[test]

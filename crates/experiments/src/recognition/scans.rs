@@ -15,14 +15,14 @@
 use super::{
     describe_face, elastic_options, icp_points, iso_levels_of, median, order_stat, paired_table,
     results_table, roc_figure, score_row, summarize, time_comparisons, time_descriptions,
-    timed_pairs, write_summary, Args, DescribeOptions, Described, Lm, Lost, Metrics, Row,
-    ViewSource, SCORES, SEARCH_DIRECTIONS, TIMED_FACES,
+    timed_pairs, write_summary, Args, DescribeOptions, Described, Lm, Metrics, Row, ViewSource,
+    SCORES, SEARCH_DIRECTIONS, TIMED_FACES,
 };
 use crate::pipeline::{bar, resolve_methods};
 use crate::report::{line_plot, Report, Series};
 use crate::scans::{
-    nearest_vertex, sample_weights, scan_face, scan_seed, FaceSpec, ScanSetOptions, ScanSettings,
-    ScannedFace, MAX_SNAP_MM, REFERENCE_LANDMARKS, VIEW_MATCH_INCIDENCE_DEG,
+    sample_weights, scan_face, scan_seed, FaceSpec, ScanSetOptions, ScanSettings, ScannedFace,
+    MAX_SNAP_MM, REFERENCE_LANDMARKS,
 };
 use crate::walk::Walker;
 use anyhow::{bail, Context, Result};
@@ -130,77 +130,25 @@ fn process(
     out
 }
 
-/// The reference landmarks from the vertices of the outer eye corners and the nose tip (or why
-/// each is missing) and the corners' places (`at`: true or predicted): all three, or, with
-/// `allow_lost`, one corner missing (kept at its place: [`Lost`]; its vertex in [`Lm`] is the
-/// nose tip's, unused). Otherwise the first missing one's reason.
-fn lm_from(
-    [r, q, nose]: [Result<u32, String>; 3],
-    at: [DVec3; 2],
-    allow_lost: bool,
-) -> Result<Lm, String> {
-    let lost = |right: bool| {
-        Some(Lost {
-            right,
-            position: at[usize::from(!right)],
-        })
-    };
-    match (r, q, nose?) {
-        (Ok(r), Ok(q), nose) => Ok(Lm::new(r, q, nose)),
-        (Err(_), Ok(q), nose) if allow_lost => Ok(Lm {
-            r: nose,
-            q,
-            nose,
-            lost: lost(true),
-        }),
-        (Ok(r), Err(_), nose) if allow_lost => Ok(Lm {
-            r,
-            q: nose,
-            nose,
-            lost: lost(false),
-        }),
-        (Err(e), _, _) | (_, Err(e), _) => Err(e),
-    }
-}
-
-/// The ground-truth landmarks of a scan ([`lm_from`]; a corner off the cleaned scan, see
-/// [`ScannedFace::truth_vertices`], may be lost).
+/// The ground-truth landmarks of a scan ([`Lm::from_parts`]; a corner off the cleaned scan,
+/// see [`ScannedFace::truth_vertices`], may be lost).
 fn truth_lm(s: &ScannedFace, allow_lost: bool) -> Result<Lm, String> {
     use landmarks::LandmarkName as L;
     let v = |n: L| s.truth_vertex(n);
     let at = |n: L| s.truth[n as usize].position;
-    lm_from(
+    Lm::from_parts(
         [v(L::OuterEyeRight), v(L::OuterEyeLeft), v(L::NoseTip)],
         [at(L::OuterEyeRight), at(L::OuterEyeLeft)],
         allow_lost,
     )
 }
 
-/// The detected landmarks of a scan ([`lm_from`]; a corner the detector reported unseen may be
-/// lost, at the place the fitted face predicts, or with `predicted` placed at the vertex
-/// nearest that place when it is within [`MAX_SNAP_MM`] of the scan).
+/// The detected landmarks of a scan ([`Lm::from_detected`]: a corner the detector reported
+/// unseen may be lost, at the place the fitted face predicts, or with `predicted` placed at the
+/// vertex nearest that place when it is within [`MAX_SNAP_MM`] of the scan).
 fn detected_lm(s: &ScannedFace, allow_lost: bool, predicted: bool) -> Result<Lm, String> {
-    use landmarks::LandmarkName as L;
     let d = s.detected.as_ref().map_err(|e| format!("detection: {e}"))?;
-    let v = |n: L| {
-        d.get(n).map(|l| l.vertex).or_else(|u| {
-            let placed = (predicted && n != L::NoseTip)
-                .then(|| nearest_vertex(&s.mesh, d.predicted[n as usize]))
-                .flatten();
-            match placed {
-                Some((w, dist)) if dist <= MAX_SNAP_MM => Ok(w),
-                _ => Err(format!("detection: {n} {u}")),
-            }
-        })
-    };
-    lm_from(
-        [v(L::OuterEyeRight), v(L::OuterEyeLeft), v(L::NoseTip)],
-        [
-            d.predicted[L::OuterEyeRight as usize],
-            d.predicted[L::OuterEyeLeft as usize],
-        ],
-        allow_lost,
-    )
+    Lm::from_detected(&s.mesh, d, allow_lost, predicted, MAX_SNAP_MM)
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -284,8 +232,10 @@ fn describe_spec(
                 d.view = Some(Box::new(ViewSource {
                     mesh: s.mesh.clone(),
                     lm,
-                    method,
-                    opts: dopt.clone(),
+                    matching: facematch::MatchOptions {
+                        method,
+                        ..dopt.matching()
+                    },
                     min_angle_deg,
                 }));
             }
@@ -340,7 +290,9 @@ fn score_group(
                         p.name.clone(),
                         p.identity.to_string(),
                         set.to_string(),
-                        format!("{:?}", x.pair),
+                        x.bip
+                            .as_ref()
+                            .map_or(String::new(), |b| format!("{:?}", b.pair)),
                         g.identity.to_string(),
                     ]
                     .into_iter()
@@ -421,7 +373,11 @@ fn failures(faces: &[Face], group: &str) -> Vec<[String; 4]> {
             let what: Vec<String> = match &f.desc[k] {
                 Err(e) => vec![e.clone()],
                 Ok(d) => [
-                    d.bip[d.pair as usize].as_ref().err(),
+                    match &d.bip {
+                        Ok(b) => b.sets[b.pair as usize].as_ref().err().cloned(),
+                        Err(e) => Some(e.clone()),
+                    }
+                    .as_ref(),
                     d.facial.as_ref().err(),
                     d.iso.as_ref().err(),
                 ]
@@ -908,7 +864,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
             .unwrap_or_default()
             + &dopt
                 .view_match
-                .map(|a| format!("; view matching: where a probe's scanner direction, carried into a gallery scan's frame by the 3-landmark alignment, is more than {a} degrees from the gallery's own, the gallery scan is described again on the faces a scanner would measure from that direction (`rangescan::visible_faces`, incidence up to {VIEW_MATCH_INCIDENCE_DEG} degrees; landmarks whose faces are all gone moved to the nearest vertex left, within {MAX_SNAP_MM} mm), so a bipolar comparison includes that description"))
+                .map(|a| format!("; view matching: where a probe's scanner direction, carried into a gallery scan's frame by the 3-landmark alignment, is more than {a} degrees from the gallery's own, the gallery scan is described again on the faces a scanner would measure from that direction (`rangescan::visible_faces`, incidence up to {} degrees; landmarks whose faces are all gone moved to the nearest vertex left, within {MAX_SNAP_MM} mm), so a bipolar comparison includes that description", facematch::ViewOptions::default().incidence_deg))
                 .unwrap_or_default()
             + &dopt
                 .side_pair_deg
