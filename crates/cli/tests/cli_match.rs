@@ -62,6 +62,21 @@ fn enrol_identify_and_verify_scans_of_paper_faces() {
         "{}",
         r.stdout
     );
+    // The ranking is the library's, as the benchmark (`cargo xtask match-eval`) computes it:
+    // the same identities in the same order with the same scores.
+    let o = facematch::MatchOptions::default();
+    let lib_gallery = facematch::Gallery::open(std::path::Path::new(&gallery), &o).unwrap();
+    let grid = mesh_io::read_bnt_grid(p("probe.bnt")).unwrap();
+    let probe = facematch::prepare(facematch::ScanInput::Grid(&grid), &o)
+        .unwrap()
+        .describe(&o, true)
+        .unwrap();
+    let lib = lib_gallery.identify(&probe, &o);
+    assert_eq!(lib.len(), ranking.len());
+    for (l, c) in lib.iter().zip(ranking) {
+        assert_eq!(c["identity"], l.identity.as_str());
+        assert_eq!(c["score"].as_f64().unwrap(), l.score, "{}", l.identity);
+    }
     // --top 1 and the text form.
     let r = bipolar_cmd(
         "identify",
