@@ -307,14 +307,6 @@ fn error_rates(genuine: &[f64], impostor: &[f64], th: f64) -> (f64, f64) {
     (frr, far)
 }
 
-/// The kind of a fallback sentence (its text up to the first parenthesis or digit).
-fn fallback_kind(s: &str) -> String {
-    let cut = s
-        .find(|c: char| c == '(' || c.is_ascii_digit())
-        .unwrap_or(s.len());
-    s[..cut].trim().to_string()
-}
-
 fn figures(p: &Processed, probe_ids: &[usize], o: &MatchOptions) -> Figures {
     let templates: Vec<Template> = p.templates.iter().flatten().cloned().collect();
     let gallery = Gallery { templates };
@@ -335,8 +327,8 @@ fn figures(p: &Processed, probe_ids: &[usize], o: &MatchOptions) -> Figures {
             if !fb.is_empty() {
                 f.with_fallback += 1;
             }
-            for s in fb {
-                *f.fallbacks.entry(fallback_kind(&s)).or_default() += 1;
+            for k in c.fallback_kinds() {
+                *f.fallbacks.entry(k).or_default() += 1;
             }
         }
         // A comparison without a score counts as refused: infinitely far.
@@ -647,21 +639,5 @@ mod tests {
         // One genuine above one impostor of two each: one error each side at the best threshold.
         let e = eer(&[0.1, 0.55], &[0.5, 0.6]);
         assert!((e - 0.5).abs() < 1e-12, "{e}");
-    }
-
-    #[test]
-    fn fallback_kinds_drop_the_numbers() {
-        assert_eq!(
-            fallback_kind(
-                "corners: the probe's own descriptor failed, the least of its 48 moved ones used"
-            ),
-            "corners: the probe's own descriptor failed, the least of its"
-        );
-        assert_eq!(
-            fallback_kind(
-                "view matching: the template's own description (the template has no views)"
-            ),
-            "view matching: the template's own description"
-        );
     }
 }

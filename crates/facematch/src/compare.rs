@@ -65,6 +65,25 @@ impl Comparison {
         self.score.is_finite() && self.score <= options.verify_threshold
     }
 
+    /// The kinds of the substitutions this comparison made, one per [`Comparison::fallbacks`]
+    /// sentence without its numbers and reasons (`view matching: own description`,
+    /// `corners: view failed`, `left-nose: probe's own failed`), for counting.
+    pub fn fallback_kinds(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        if let ViewUse::Fallback { .. } = &self.view {
+            out.push("view matching: own description".to_string());
+        }
+        for (p, u) in Pair::ALL.iter().zip(&self.pairs) {
+            if u.view_fallback {
+                out.push(format!("{}: view failed", p.name()));
+            }
+            if u.probe_own_failed {
+                out.push(format!("{}: probe's own failed", p.name()));
+            }
+        }
+        out
+    }
+
     /// The substitutions this comparison made, as sentences (empty when none).
     pub fn fallbacks(&self) -> Vec<String> {
         let mut out = Vec::new();
@@ -241,5 +260,43 @@ mod tests {
             pair_score([n, 0.4, n], Pair::Corners, true, 0.5),
             (0.4, Some(Pair::RightNose))
         );
+    }
+
+    #[test]
+    fn every_fallback_has_a_sentence_and_a_kind() {
+        let used = |view_fallback, probe_own_failed| PairUse {
+            distance: 0.1,
+            view_fallback,
+            probe_own_failed,
+            moved: 48,
+        };
+        let c = Comparison {
+            score: 0.1,
+            pairs: [used(true, false), used(false, false), used(true, true)],
+            probe_pair: Pair::Corners,
+            scored_by: Some(Pair::Corners),
+            view: ViewUse::Fallback {
+                reason: "the template has no views".into(),
+            },
+        };
+        assert_eq!(
+            c.fallback_kinds(),
+            [
+                "view matching: own description",
+                "corners: view failed",
+                "left-nose: view failed",
+                "left-nose: probe's own failed"
+            ]
+        );
+        let s = c.fallbacks();
+        assert_eq!(s.len(), 4);
+        assert!(s[0].contains("the template has no views"), "{s:?}");
+        assert!(s[3].contains("48 moved ones"), "{s:?}");
+        let none = Comparison {
+            pairs: [used(false, false); 3],
+            view: ViewUse::Off,
+            ..c
+        };
+        assert!(none.fallbacks().is_empty() && none.fallback_kinds().is_empty());
     }
 }

@@ -771,10 +771,16 @@ fn bipolar_compare(x: &Described, y: &Described) -> Option<facematch::Comparison
 }
 
 /// The bipolar distance of a probe `x` to a gallery face `y` by each pole pair (NaN where a
-/// side has no descriptor or the distance fails; [`bipolar_compare`]).
-fn bipolar_pairs(x: &Described, y: &Described) -> [f64; 3] {
-    bipolar_compare(x, y).map_or([f64::NAN; 3], |c| c.pairs.map(|u| u.distance))
+/// side has no descriptor or the distance fails; [`bipolar_compare`]) and the kinds of the
+/// fallbacks the comparison took ([`facematch::Comparison::fallback_kinds`]).
+fn bipolar_pairs(x: &Described, y: &Described) -> PairDistances {
+    bipolar_compare(x, y).map_or(([f64::NAN; 3], Vec::new()), |c| {
+        (c.pairs.map(|u| u.distance), c.fallback_kinds())
+    })
 }
+
+/// The bipolar distances of one comparison by each pole pair, and the kinds of its fallbacks.
+type PairDistances = ([f64; 3], Vec<String>);
 
 /// The bipolar score of a probe `x` from its distances by each pair `d` ([`bipolar_pairs`]):
 /// [`facematch::pair_score`] with the probe's pair and its options.
@@ -799,7 +805,7 @@ fn score_one(
     elastic: &ElasticOptions,
 ) -> f64 {
     match k {
-        0 => bipolar_score(x, bipolar_pairs(x, y)),
+        0 => bipolar_score(x, bipolar_pairs(x, y).0),
         1 => dist(&x.pol, &y.pol).unwrap_or(f64::NAN),
         2 => icp_score(pts, &x.lm_pos, loc, &y.lm_pos),
         3 => match (&x.facial, &y.facial) {
@@ -822,18 +828,18 @@ type Row = [Vec<f64>; 5];
 /// Scores of one probe (its description and ICP points) against every gallery face: bipolar,
 /// single pole, ICP, facial curves (elastic distance with `elastic`) and iso-curvature (ICP of
 /// the networks' points from the landmark alignment); with the bipolar distance by each pair
-/// ([`bipolar_pairs`]).
+/// and the comparison's fallbacks ([`bipolar_pairs`]).
 fn score_row(
     probe: Option<&Described>,
     pts: &[DVec3],
     gallery: &[Option<(&Described, &FaceLocator<'_>)>],
     elastic: &ElasticOptions,
-) -> (Row, Vec<[f64; 3]>) {
-    let pairs: Vec<[f64; 3]> = gallery
+) -> (Row, Vec<PairDistances>) {
+    let pairs: Vec<PairDistances> = gallery
         .iter()
         .map(|g| match (probe, g) {
             (Some(x), Some((y, _))) => bipolar_pairs(x, y),
-            _ => [f64::NAN; 3],
+            _ => ([f64::NAN; 3], Vec::new()),
         })
         .collect();
     let row = std::array::from_fn(|k| {
@@ -841,7 +847,7 @@ fn score_row(
             .iter()
             .zip(&pairs)
             .map(|(g, d)| match (probe, g) {
-                (Some(x), Some(_)) if k == 0 => bipolar_score(x, *d),
+                (Some(x), Some(_)) if k == 0 => bipolar_score(x, d.0),
                 (Some(x), Some((y, loc))) => score_one(k, x, pts, y, loc, elastic),
                 _ => f64::NAN,
             })

@@ -15,8 +15,8 @@
 use super::{
     describe_face, elastic_options, icp_points, iso_levels_of, median, order_stat, paired_table,
     results_table, roc_figure, score_row, summarize, time_comparisons, time_descriptions,
-    timed_pairs, write_summary, Args, DescribeOptions, Described, Lm, Metrics, Row, ViewSource,
-    SCORES, SEARCH_DIRECTIONS, TIMED_FACES,
+    timed_pairs, write_summary, Args, DescribeOptions, Described, Lm, Metrics, PairDistances, Row,
+    ViewSource, SCORES, SEARCH_DIRECTIONS, TIMED_FACES,
 };
 use crate::pipeline::{bar, resolve_methods};
 use crate::report::{line_plot, Report, Series};
@@ -261,13 +261,14 @@ fn score_group(
     let mut all = Vec::new();
     let mut per_probe = Vec::new();
     let mut by_pair = Vec::new();
+    let mut fallbacks = Vec::new();
     for (k, set) in SETS.iter().enumerate() {
         let gal: Vec<Option<(&Described, &FaceLocator<'_>)>> = gallery
             .iter()
             .zip(locators)
             .map(|(g, l)| g.desc[k].as_ref().ok().zip(l.as_ref()))
             .collect();
-        let (rows, pairs): (Vec<Row>, Vec<Vec<[f64; 3]>>) = probes
+        let (rows, pairs): (Vec<Row>, Vec<Vec<PairDistances>>) = probes
             .par_iter()
             .map(|p| score_row(p.desc[k].as_ref().ok(), &p.pts, &gal, elastic))
             .unzip();
@@ -282,9 +283,16 @@ fn score_group(
                 per_probe.push(probe_rank(&p.name, p.identity, set, score, &row[j], &gid));
             }
         }
+        let mut kinds = std::collections::BTreeMap::<String, usize>::new();
+        let (mut with, mut total) = (0, 0);
         for (p, ds) in probes.iter().zip(&pairs) {
             let Ok(x) = &p.desc[k] else { continue };
-            for (g, d) in gallery.iter().zip(ds) {
+            for (g, (d, fb)) in gallery.iter().zip(ds) {
+                total += 1;
+                with += usize::from(!fb.is_empty());
+                for f in fb {
+                    *kinds.entry(f.clone()).or_default() += 1;
+                }
                 by_pair.push(
                     [
                         p.name.clone(),
@@ -297,24 +305,38 @@ fn score_group(
                     ]
                     .into_iter()
                     .chain(d.iter().map(|v| format!("{v:.6}")))
+                    .chain([fb.join("; ")])
                     .collect(),
                 );
             }
         }
+        let kinds: Vec<String> = kinds.iter().map(|(k, n)| format!("{k}: {n}")).collect();
+        fallbacks.push(format!(
+            "{set}: {with} of {total} bipolar comparisons took a fallback{}{}",
+            if kinds.is_empty() { "" } else { " (" },
+            if kinds.is_empty() {
+                String::new()
+            } else {
+                kinds.join("; ") + ")"
+            }
+        ));
     }
     Ok(Scored {
         metrics: all,
         per_probe,
         by_pair,
+        fallbacks,
     })
 }
 
 /// What [`score_group`] gives: the figures, the lines of `probes.csv` and those of
-/// `bipolar-pairs.csv`.
+/// `bipolar-pairs.csv`, and per landmark set the count of bipolar comparisons that took a
+/// fallback ([`facematch::Comparison::fallbacks`]), by kind.
 struct Scored {
     metrics: Vec<Metrics>,
     per_probe: Vec<Vec<String>>,
     by_pair: Vec<Vec<String>>,
+    fallbacks: Vec<String>,
 }
 
 /// One line of `probes.csv`: where the probe's own identity ranks among the gallery for one
@@ -810,6 +832,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         metrics: main,
         per_probe,
         by_pair,
+        fallbacks,
     } = score_group(&gallery, &locators, &probes, &elastic, &ms_desc)?;
     let mut fails = failures(&gallery, "gallery");
     fails.extend(failures(&probes, "probes"));
@@ -931,10 +954,15 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
             "corners",
             "right corner and nose",
             "left corner and nose",
+            "fallbacks",
         ],
         &by_pair,
     )?;
-    rep.para("The bipolar distance of every probe to every gallery face by each pole pair (`bipolar-pairs.csv`; NaN where a side has no descriptor): the probe's own pair is its score.");
+    rep.para("The bipolar distance of every probe to every gallery face by each pole pair (`bipolar-pairs.csv`; NaN where a side has no descriptor), with the fallbacks the comparison took (a view's descriptor that failed replaced by the gallery face's own, a probe's own descriptor that failed replaced by its moved ones): the probe's own pair is its score.");
+    rep.list(&fallbacks);
+    for f in &fallbacks {
+        println!("{f}");
+    }
     roc_figure(&mut rep, &main, "roc.svg", "ROC on scans (verification)")?;
     // Landmark detection on every scan of the run.
     let everyone: Vec<&Face> = gallery.iter().chain(&probes).chain(&sweep_faces).collect();
