@@ -277,6 +277,30 @@ struct Figures {
     with_fallback: usize,
     fallbacks: std::collections::BTreeMap<String, usize>,
     comparisons: usize,
+    /// Per comparison: probe, template, same person, score, the pair that scored, the view
+    /// used, the fallbacks.
+    rows: Vec<Vec<String>>,
+}
+
+/// The columns of [`Figures::rows`] (`scores-SET.csv`).
+const SCORE_COLUMNS: [&str; 7] = [
+    "probe",
+    "template",
+    "same person",
+    "score",
+    "scored by",
+    "view",
+    "fallbacks",
+];
+
+/// A view use in a word or two (the kind, and the matched view's turn).
+fn view_label(v: &facematch::ViewUse) -> String {
+    match v {
+        facematch::ViewUse::Off => "off".into(),
+        facematch::ViewUse::Own { .. } => "own".into(),
+        facematch::ViewUse::Matched { yaw_deg, .. } => format!("view {yaw_deg:+}"),
+        facematch::ViewUse::Fallback { .. } => "own (fallback)".into(),
+    }
 }
 
 /// Equal error rate of genuine (lower is same) and impostor scores.
@@ -307,7 +331,7 @@ fn error_rates(genuine: &[f64], impostor: &[f64], th: f64) -> (f64, f64) {
     (frr, far)
 }
 
-fn figures(p: &Processed, probe_ids: &[usize], o: &MatchOptions) -> Figures {
+fn figures(p: &Processed, probes: &[Spec], o: &MatchOptions) -> Figures {
     let templates: Vec<Template> = p.templates.iter().flatten().cloned().collect();
     let gallery = Gallery { templates };
     let mut f = Figures {
@@ -315,7 +339,8 @@ fn figures(p: &Processed, probe_ids: &[usize], o: &MatchOptions) -> Figures {
         not_enrolled: p.templates.iter().filter(|t| t.is_err()).count(),
         ..Figures::default()
     };
-    for (d, &id) in p.probes.iter().zip(probe_ids) {
+    for (d, spec) in p.probes.iter().zip(probes) {
+        let id = spec.identity;
         let Ok(d) = d else {
             f.no_score += 1;
             continue;
@@ -338,11 +363,21 @@ fn figures(p: &Processed, probe_ids: &[usize], o: &MatchOptions) -> Figures {
             } else {
                 f64::INFINITY
             };
-            if t.identity == id.to_string() {
+            let same = t.identity == id.to_string();
+            if same {
                 f.genuine.push(score);
             } else {
                 f.impostor.push(score);
             }
+            f.rows.push(vec![
+                spec.name.clone(),
+                t.source.clone(),
+                same.to_string(),
+                f4(c.score),
+                c.scored_by.map_or("", |p| p.name()).to_string(),
+                view_label(&c.view),
+                c.fallback_kinds().join("; "),
+            ]);
         }
         let ranking = facematch::rank(&gallery.templates, cs);
         match ranking.first() {
@@ -469,7 +504,6 @@ pub fn run(a: Args) -> Result<()> {
     rep.para("Scans made by the virtual scanner and written as .bnt files (scans/), then only the public facematch API, as `bipolar enroll`, `identify` and `verify` use it: no ground truth anywhere, the crop around the detected nose tip. Gallery templates are in gallery/. The gate (residual rule of the keyed distance) is chosen on the tuning set (lowest EER, then highest rank-1); the held-out set's figures at that gate are the reported ones.");
     let mut per_set = Vec::new();
     for ((name, (_, p)), (_, pr)) in sets.iter().zip(&processed) {
-        let ids: Vec<usize> = p.iter().map(|s| s.identity).collect();
         let fs: Vec<(f64, Figures)> = a
             .gates
             .iter()
@@ -478,7 +512,7 @@ pub fn run(a: Args) -> Result<()> {
                     gate_mm: gate_of(g),
                     ..o.clone()
                 };
-                (g, figures(pr, &ids, &og))
+                (g, figures(pr, p, &og))
             })
             .collect();
         per_set.push((*name, fs));
@@ -584,6 +618,7 @@ pub fn run(a: Args) -> Result<()> {
             } else {
                 rep.list(&l);
             }
+            rep.csv(&format!("scores-{name}.csv"), &SCORE_COLUMNS, &f.rows)?;
             let file = format!("scores-{name}.svg");
             viz::histogram(
                 rep.path(&file),
