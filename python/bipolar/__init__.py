@@ -27,6 +27,7 @@ from __future__ import annotations
 from . import errors
 from ._bipolar import (
     LANDMARK_NAMES,
+    VERIFY_THRESHOLD,
     Descriptor,
     DistanceOptions,
     FacialCurves,
@@ -88,6 +89,7 @@ from .errors import (
 
 __all__ = [
     "LANDMARK_NAMES",
+    "VERIFY_THRESHOLD",
     "BipolarError",
     "ComputationError",
     "Descriptor",

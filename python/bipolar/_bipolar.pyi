@@ -8,6 +8,8 @@ import numpy.typing as npt
 
 __version__: str
 LANDMARK_NAMES: List[str]
+#: ``verify``'s threshold: scores at or below it are the same person (docs/matching.md).
+VERIFY_THRESHOLD: float
 
 PathLike = Union[str, "os.PathLike[str]"]
 ArrayLike = npt.ArrayLike

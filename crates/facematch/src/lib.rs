@@ -39,7 +39,9 @@ pub use describe::{describe, describe_with_fields, face_fields, Description, Fac
 pub use error::MatchError;
 pub use gallery::{rank, Gallery, Ranked};
 pub use keyed::KeyedSet;
-pub use options::{MatchOptions, PrepareOptions, SearchOptions, ViewOptions};
+pub use options::{
+    MatchOptions, PrepareOptions, SearchOptions, ViewOptions, DEFAULT_EDGE_MM, VERIFY_THRESHOLD,
+};
 pub use poles::{Lost, Pair, Poles};
 pub use prepare::{prepare, prepare_with, PreparedScan, ScanInput, StepTimes};
 pub use template::{enroll, Template, TemplateView, FORMAT_VERSION};

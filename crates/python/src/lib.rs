@@ -30,6 +30,7 @@ use pyo3::prelude::*;
 fn _bipolar(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("LANDMARK_NAMES", landmark::names())?;
+    m.add("VERIFY_THRESHOLD", facematch::VERIFY_THRESHOLD)?;
     m.add_class::<mesh::PyMesh>()?;
     m.add_class::<geodesic::PyGeodesicSolver>()?;
     m.add_class::<descriptor::PyDescriptor>()?;
