@@ -19,6 +19,9 @@ pub struct FaceFields {
     /// D: the geodesic distance between the outer eye corners (mean of the two fields' values;
     /// NaN with a lost corner).
     pub d: f64,
+    /// Wall time (s) of each field's solve: right corner, left corner, nose tip (0 for a lost
+    /// corner), for benchmarks that report a description's cost.
+    pub secs: [f64; 3],
 }
 
 impl FaceFields {
@@ -66,21 +69,29 @@ pub fn face_fields(
     };
     let field = |v: u32, lost: bool| {
         if lost {
-            return Ok(Vec::new());
+            return Ok((Vec::new(), 0.0));
         }
+        let t = std::time::Instant::now();
         solver
             .distances(&[Source::Vertex(v)], &cut)
+            .map(|u| (u, t.elapsed().as_secs_f64()))
             .map_err(|e| format!("geodesic field: {e}"))
     };
     let lost_right = poles.lost.map(|l| l.right);
-    let ur = field(poles.r, lost_right == Some(true))?;
-    let uq = field(poles.q, lost_right == Some(false))?;
-    let un = field(poles.nose, false)?;
+    let (ur, tr) = field(poles.r, lost_right == Some(true))?;
+    let (uq, tq) = field(poles.q, lost_right == Some(false))?;
+    let (un, tn) = field(poles.nose, false)?;
     let d = match poles.lost {
         Some(_) => f64::NAN,
         None => 0.5 * (ur[poles.q as usize] + uq[poles.r as usize]),
     };
-    Ok(FaceFields { ur, uq, un, d })
+    Ok(FaceFields {
+        ur,
+        uq,
+        un,
+        d,
+        secs: [tr, tq, tn],
+    })
 }
 
 /// The reference configuration of one pair: its two fields, D, the poles' places, the nose tip

@@ -31,7 +31,6 @@ use anyhow::{bail, Context, Result};
 use bipolar::PolarDescriptor;
 use facecurves::{ElasticOptions, FacialCurvesDescriptor, IsoLevels};
 use facemodel::{random_rigid_motion, FaceModel};
-use geodesic::{SolveOptions, Source};
 use meshcore::linalg::fit_rigid;
 use meshcore::{DVec3, FaceLocator, Surface, TriMesh};
 use rand::SeedableRng;
@@ -319,7 +318,7 @@ impl DescribeOptions {
         facematch::MatchOptions {
             method: geodesic::Method::Exact,
             levels: self.levels,
-            field_cutoff: 1.4,
+            field_cutoff: FIELD_CUTOFF,
             boundary_margin_mm: self.boundary_margin,
             max_incidence_deg: self.max_incidence_deg,
             side_pair_deg: self.side_pair_deg,
@@ -339,61 +338,8 @@ impl DescribeOptions {
     }
 }
 
-/// The fields of a face cut off at 1.4 |q - r| (corners r, q; nose tip, when asked for: else
-/// `un` is empty), D, and the wall time of the corner fields and of the nose field
-/// ([`facematch::face_fields`] with the two timed apart).
-struct Fields {
-    f: facematch::FaceFields,
-    secs: [f64; 2],
-}
-
-fn fields(
-    mesh: &TriMesh,
-    solver: &dyn geodesic::GeodesicSolver,
-    lm: Lm,
-    nose: bool,
-) -> Result<Fields, String> {
-    if lm.lost.is_none() && lm.r == lm.q {
-        return Err(format!(
-            "the two outer eye corners are the same vertex {}",
-            lm.r
-        ));
-    }
-    let [pr, pq, _] = lm.positions(mesh);
-    let cut = SolveOptions {
-        max_distance: Some(1.4 * (pq - pr).length()),
-    };
-    let field = |v: u32, lost: bool| {
-        if lost {
-            return Ok(Vec::new());
-        }
-        solver
-            .distances(&[Source::Vertex(v)], &cut)
-            .map_err(|e| format!("geodesic field: {e}"))
-    };
-    let lost_right = lm.lost.map(|l| l.right);
-    let t = Instant::now();
-    let (ur, uq) = (
-        field(lm.r, lost_right == Some(true))?,
-        field(lm.q, lost_right == Some(false))?,
-    );
-    let t_corners = t.elapsed().as_secs_f64();
-    let t = Instant::now();
-    let un = if nose {
-        field(lm.nose, false)?
-    } else {
-        Vec::new()
-    };
-    let t_nose = t.elapsed().as_secs_f64();
-    let d = match lm.lost {
-        Some(_) => f64::NAN,
-        None => 0.5 * (ur[lm.q as usize] + uq[lm.r as usize]),
-    };
-    Ok(Fields {
-        f: facematch::FaceFields { ur, uq, un, d },
-        secs: [t_corners, t_nose],
-    })
-}
+/// The landmarks' fields are cut off at this factor times |q - r|.
+const FIELD_CUTOFF: f64 = 1.4;
 
 /// The iso-curvature levels of a benchmark: `count` per principal field from the reference
 /// face `mesh` with landmarks `lm` ([`reference_iso_levels`] on its nose disc of radius D).
@@ -403,9 +349,8 @@ fn iso_levels_of(
     lm: Lm,
     count: usize,
 ) -> Result<IsoLevels> {
-    let f = fields(mesh, solver, lm, true)
-        .map_err(|e| anyhow::anyhow!("{e}"))?
-        .f;
+    let f = facematch::face_fields(mesh, solver, lm, FIELD_CUTOFF)
+        .map_err(|e| anyhow::anyhow!("{e}"))?;
     let d = f.scale(lm).map_err(|e| anyhow::anyhow!("{e}"))?;
     reference_iso_levels(&Surface::new(mesh.clone()), &f.un, d, count)
         .context("iso-curvature levels of the reference face")
@@ -423,9 +368,9 @@ fn describe_face(
     lm: Lm,
     o: &DescribeOptions,
 ) -> Result<Described, String> {
-    let Fields { f, secs } = fields(mesh, solver, lm, true)?;
+    let f = facematch::face_fields(mesh, solver, lm, FIELD_CUTOFF)?;
     let [r, q, nose] = lm.positions(mesh);
-    let [t_corners, t_nose] = secs;
+    let (t_corners, t_nose) = (f.secs[0] + f.secs[1], f.secs[2]);
     let t = Instant::now();
     let t_surface = Instant::now();
     let surface = Surface::new(mesh.clone());
