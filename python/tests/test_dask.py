@@ -12,17 +12,6 @@ from conftest import bump, rotation  # noqa: E402
 
 
 @pytest.fixture(scope="module")
-def client():
-    cluster = distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
-    )
-    c = distributed.Client(cluster)
-    yield c
-    c.close()
-    cluster.close()
-
-
-@pytest.fixture(scope="module")
 def mesh_files(tmp_path_factory):
     d = tmp_path_factory.mktemp("meshes")
     paths = []

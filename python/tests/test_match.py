@@ -197,18 +197,6 @@ def test_templates_and_galleries_round_trip_through_files(gallery, probe, tmp_pa
 # Dask: the same rankings from shards of templates on a LocalCluster of two worker processes.
 
 
-@pytest.fixture(scope="module")
-def client():
-    distributed = pytest.importorskip("distributed")
-    cluster = distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
-    )
-    c = distributed.Client(cluster)
-    yield c
-    c.close()
-    cluster.close()
-
-
 @pytest.mark.parametrize("shard_size", [1, 2, None])
 def test_dask_identify_templates_equals_one_process(client, gallery, probe, shard_size):
     from bipolar import dask as bdask
