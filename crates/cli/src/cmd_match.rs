@@ -283,7 +283,7 @@ fn comparison_json(c: &Comparison) -> serde_json::Value {
         "probe_pair": c.probe_pair.name(),
         "scored_by": c.scored_by.map(|p| p.name()),
         "pairs": facematch::Pair::ALL.iter().zip(&c.pairs).map(|(p, u)| serde_json::json!({
-            "pair": p.name(), "distance": num(u.distance), "moved": u.moved,
+            "pair": p.name(), "distance": num(u.distance), "moved": u.moved, "moved_failed": u.moved_failed,
         })).collect::<Vec<_>>(),
         "view": view_json(&c.view),
         "fallbacks": c.fallbacks(),

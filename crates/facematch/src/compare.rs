@@ -41,6 +41,8 @@ pub struct PairUse {
     pub probe_own_failed: bool,
     /// The probe's moved descriptors compared (the reference-point search).
     pub moved: usize,
+    /// The probe's moved descriptors that failed and are left out.
+    pub moved_failed: usize,
 }
 
 /// The result of [`compare`].
@@ -67,43 +69,50 @@ impl Comparison {
 
     /// The kinds of the substitutions this comparison made, one per [`Comparison::fallbacks`]
     /// sentence without its numbers and reasons (`view matching: own description`,
-    /// `corners: view failed`, `left-nose: probe's own failed`), for counting.
+    /// `corners: view failed`, `left-nose: probe's own failed`, `corners: moved left out`), for
+    /// counting.
     pub fn fallback_kinds(&self) -> Vec<String> {
-        let mut out = Vec::new();
-        if let ViewUse::Fallback { .. } = &self.view {
-            out.push("view matching: own description".to_string());
-        }
-        for (p, u) in Pair::ALL.iter().zip(&self.pairs) {
-            if u.view_fallback {
-                out.push(format!("{}: view failed", p.name()));
-            }
-            if u.probe_own_failed {
-                out.push(format!("{}: probe's own failed", p.name()));
-            }
-        }
-        out
+        self.substitutions().into_iter().map(|(k, _)| k).collect()
     }
 
     /// The substitutions this comparison made, as sentences (empty when none).
     pub fn fallbacks(&self) -> Vec<String> {
+        self.substitutions().into_iter().map(|(_, s)| s).collect()
+    }
+
+    /// Each substitution as its kind and its sentence.
+    fn substitutions(&self) -> Vec<(String, String)> {
         let mut out = Vec::new();
         if let ViewUse::Fallback { reason } = &self.view {
-            out.push(format!(
-                "view matching: the template's own description ({reason})"
+            out.push((
+                "view matching: own description".to_string(),
+                format!("view matching: the template's own description ({reason})"),
             ));
         }
         for (p, u) in Pair::ALL.iter().zip(&self.pairs) {
+            let name = p.name();
             if u.view_fallback {
-                out.push(format!(
-                    "{}: the template's view failed, its own descriptor used",
-                    p.name()
+                out.push((
+                    format!("{name}: view failed"),
+                    format!("{name}: the template's view failed, its own descriptor used"),
                 ));
             }
             if u.probe_own_failed {
-                out.push(format!(
-                    "{}: the probe's own descriptor failed, the least of its {} moved ones used",
-                    p.name(),
-                    u.moved
+                out.push((
+                    format!("{name}: probe's own failed"),
+                    format!(
+                        "{name}: the probe's own descriptor failed, the least of its {} moved ones used",
+                        u.moved
+                    ),
+                ));
+            }
+            if u.moved_failed > 0 {
+                out.push((
+                    format!("{name}: moved left out"),
+                    format!(
+                        "{name}: {} of the search's moved descriptors failed and were left out ({} used)",
+                        u.moved_failed, u.moved
+                    ),
                 ));
             }
         }
@@ -199,6 +208,7 @@ pub fn compare(probe: &Description, template: &Template, options: &MatchOptions)
             view_fallback: false,
             probe_own_failed: false,
             moved: probe.moved[i].len(),
+            moved_failed: probe.moved_failed[i],
         };
         let Ok(own) = &template.description.sets[i] else {
             return u;
@@ -269,6 +279,7 @@ mod tests {
             view_fallback,
             probe_own_failed,
             moved: 48,
+            moved_failed: 0,
         };
         let c = Comparison {
             score: 0.1,
@@ -298,5 +309,14 @@ mod tests {
             ..c
         };
         assert!(none.fallbacks().is_empty() && none.fallback_kinds().is_empty());
+        // Moved descriptors of the search that failed are left out, and said.
+        let mut short = none.clone();
+        short.pairs[1].moved_failed = 5;
+        assert_eq!(short.fallback_kinds(), ["right-nose: moved left out"]);
+        assert!(
+            short.fallbacks()[0].contains("5 of the search's moved descriptors failed"),
+            "{:?}",
+            short.fallbacks()
+        );
     }
 }

@@ -556,6 +556,7 @@ fn comparison_dict<'py>(py: Python<'py>, c: &Comparison) -> PyResult<Bound<'py, 
         e.set_item("moved", u.moved)?;
         e.set_item("view_fallback", u.view_fallback)?;
         e.set_item("probe_own_failed", u.probe_own_failed)?;
+        e.set_item("moved_failed", u.moved_failed)?;
         pairs.append(e)?;
     }
     d.set_item("pairs", pairs)?;
