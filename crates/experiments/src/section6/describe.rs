@@ -1,0 +1,222 @@
+//! The four descriptors of one face configuration and the four distances between two, with
+//! the refusals listed instead of stopping the run.
+
+use super::Args;
+use crate::curves::{facial_curves, facial_distance, iso_curves, iso_distance};
+use crate::pipeline::{bipolar, dist, DescriptorRule, Refs, Region};
+use crate::polar::{self, polar_descriptor, PolarOptions, Pole};
+use crate::walk::Walker;
+use anyhow::Result;
+use bipolar::PolarDescriptor;
+use facecurves::{ElasticOptions, FacialCurvesDescriptor, IsoCurvatureDescriptor, IsoLevels};
+use facemodel::Face;
+use geodesic::{GeodesicSolver, Method};
+use meshcore::{Surface, TriMesh};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+/// The four descriptors of one face configuration (`None`: not asked for, or refused and
+/// listed in the failures; a single pole whose rays reach no level is the empty set).
+#[derive(Debug, Clone)]
+pub(super) struct Descs {
+    pub bipolar: Option<bipolar::Descriptor>,
+    pub polar: Option<PolarDescriptor>,
+    pub facial: Option<FacialCurvesDescriptor>,
+    pub iso: Option<IsoCurvatureDescriptor>,
+}
+
+/// Errors met (listed in the report); their cells are NaN.
+#[derive(Debug, Default)]
+pub(super) struct Failures(Mutex<Vec<String>>);
+
+impl Failures {
+    /// Lists an error.
+    fn list(&self, s: String) {
+        self.0
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .push(s);
+    }
+    /// The errors listed, sorted.
+    pub(super) fn sorted(&self) -> Vec<String> {
+        let mut v = self
+            .0
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .clone();
+        v.sort();
+        v
+    }
+}
+
+/// Which descriptors [`Ctx::describe`] builds.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Which {
+    /// The bipolar descriptor (moves with the eye corners).
+    pub bipolar: bool,
+    /// Single pole, facial curves and iso-curvature (move with the nose tip).
+    pub nose: bool,
+}
+
+/// All four.
+pub(super) const ALL: Which = Which {
+    bipolar: true,
+    nose: true,
+};
+
+/// One face's geodesic set-up.
+pub(super) struct Prep {
+    /// The exact geodesic solver of the face.
+    pub solver: Box<dyn GeodesicSolver>,
+    /// The reference configuration (corner fields, D, frame).
+    pub refs: Refs,
+    /// The nose tip's field.
+    pub un: Vec<f64>,
+}
+
+/// What describing a configuration needs besides the fields.
+pub(super) struct Ctx<'a> {
+    /// The task's arguments (resolution).
+    pub args: &'a Args,
+    /// The iso-curvature levels, the same for every face.
+    pub iso_levels: IsoLevels,
+    /// Where refusals are listed.
+    pub failures: &'a Failures,
+}
+
+impl Ctx<'_> {
+    /// `r`'s value, or `None` with its error listed (described by `what`).
+    fn ok<T, E: std::fmt::Display>(
+        &self,
+        r: Result<T, E>,
+        what: impl FnOnce() -> String,
+    ) -> Option<T> {
+        match r {
+            Ok(x) => Some(x),
+            Err(e) => {
+                self.failures.list(format!("{}: {e}", what()));
+                None
+            }
+        }
+    }
+
+    /// The descriptors asked for by `which`: bipolar from `refs`; single pole, facial curves
+    /// and iso-curvature (the `nose` group) from the nose field `un` with the pole `nose`
+    /// (region of radius D).
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn describe(
+        &self,
+        mesh: &TriMesh,
+        walker: &Walker<'_>,
+        refs: &Refs,
+        un: &[f64],
+        nose: Pole,
+        name: &str,
+        which: Which,
+    ) -> Descs {
+        let n = self.args.set.res.levels;
+        let bip = which.bipolar.then(|| {
+            self.ok(
+                bipolar(
+                    &bipolar::Surface::new(mesh.clone()),
+                    refs,
+                    n,
+                    Region::Static,
+                    DescriptorRule::CrateAll,
+                    None,
+                    None,
+                ),
+                || format!("bipolar descriptor of {name}"),
+            )
+        });
+        if !which.nose {
+            return Descs {
+                bipolar: bip.flatten(),
+                polar: None,
+                facial: None,
+                iso: None,
+            };
+        }
+        let popts = PolarOptions {
+            step: refs.d / f64::from(n),
+            levels: n,
+            sectors: self.args.set.res.sectors,
+        };
+        let polar = self
+            .ok(
+                polar_descriptor(walker, un, nose, 0.5 * (refs.r + refs.q), &popts),
+                || format!("single pole of {name}"),
+            )
+            .unwrap_or_else(|| polar::empty(&popts));
+        let surface = Surface::new(mesh.clone());
+        let facial = self.ok(facial_curves(&surface, un, refs.d, n), || {
+            format!("facial curves of {name}")
+        });
+        let iso = self.ok(iso_curves(&surface, un, refs.d, &self.iso_levels), || {
+            format!("iso-curvature curves of {name}")
+        });
+        Descs {
+            bipolar: bip.flatten(),
+            polar: Some(polar),
+            facial,
+            iso,
+        }
+    }
+
+    /// The four distances (NaN where a descriptor is missing or the distance failed) and the
+    /// time each took.
+    pub(super) fn distances(&self, a: &Descs, b: &Descs, what: &str) -> ([f64; 4], [Duration; 4]) {
+        let mut d = [f64::NAN; 4];
+        let mut t = [Duration::ZERO; 4];
+        let t0 = Instant::now();
+        d[0] = dist(&a.bipolar, &b.bipolar).unwrap_or(f64::NAN);
+        t[0] = t0.elapsed();
+        let t0 = Instant::now();
+        d[1] = dist(&a.polar, &b.polar).unwrap_or(f64::NAN);
+        t[1] = t0.elapsed();
+        if let (Some(x), Some(y)) = (&a.facial, &b.facial) {
+            let t0 = Instant::now();
+            let r = facial_distance(x, y, &ElasticOptions::default());
+            t[2] = t0.elapsed();
+            d[2] = self
+                .ok(r, || format!("facial distance {what}"))
+                .unwrap_or(f64::NAN);
+        }
+        if let (Some(x), Some(y)) = (&a.iso, &b.iso) {
+            let t0 = Instant::now();
+            let r = iso_distance(x, y);
+            t[3] = t0.elapsed();
+            d[3] = self
+                .ok(r, || format!("iso-curvature distance {what}"))
+                .unwrap_or(f64::NAN);
+        }
+        (d, t)
+    }
+}
+
+/// The exact solver, reference configuration and nose field of a face.
+pub(super) fn prepare(f: &Face) -> Result<Prep> {
+    let solver = geodesic::new_solver(&f.mesh, Method::Exact)?;
+    let (refs, un) = Refs::of_face(f, solver.as_ref())?;
+    Ok(Prep { solver, refs, un })
+}
+
+/// `mesh` with Gaussian noise of standard deviation `sigma` (mesh units) along its vertex
+/// normals.
+pub(super) fn noisy(mesh: &TriMesh, sigma: f64, seed: u64) -> Result<TriMesh> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let normals = mesh.vertex_normals();
+    let pos = mesh
+        .positions()
+        .iter()
+        .zip(&normals)
+        .map(|(p, n)| {
+            let z: f64 = StandardNormal.sample(&mut rng);
+            *p + *n * (sigma * z)
+        })
+        .collect();
+    Ok(TriMesh::new(pos, mesh.triangles().to_vec())?)
+}
