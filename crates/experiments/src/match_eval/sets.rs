@@ -1,0 +1,219 @@
+//! The two scan sets of `match-eval` (tuning: the benchmark's scanner; held-out: another
+//! one), their scanning into `.bnt` files and their passage through the public API.
+
+use super::Args;
+use crate::pipeline::bar;
+use crate::scans::{sample_weights, scan_seed, ScanSettings};
+use anyhow::{Context, Result};
+use facematch::{prepare, Description, MatchOptions, ScanInput, Template};
+use facemodel::FaceModel;
+use mesh_io::BntGrid;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rangescan::{Artifacts, HeadPose, Holes, ScanOptions, Spikes};
+use rayon::prelude::*;
+use std::path::Path;
+
+/// A scan to make: name, identity, face weights, scanner options.
+pub(super) struct Spec {
+    pub name: String,
+    pub identity: usize,
+    pub identity_weights: Vec<f64>,
+    pub expression_weights: Vec<f64>,
+    pub scan: ScanOptions,
+}
+
+/// The scanner options of the tuning set's scans (the scan benchmark's scanner).
+fn benchmark_scan(settings: ScanSettings, seed: u64) -> ScanOptions {
+    ScanOptions {
+        input_mm_per_unit: 10.0,
+        pitch_mm: settings.pitch_mm,
+        pose: HeadPose {
+            yaw_deg: settings.yaw_deg,
+            pitch_deg: settings.pitch_deg,
+        },
+        artifacts: settings.artifacts(),
+        seed,
+        ..ScanOptions::default()
+    }
+}
+
+/// The tuning set: gallery specs (neutral, frontal) and probe specs, as the scan benchmark
+/// samples them.
+pub(super) fn tuning_specs(model: &FaceModel, a: &Args) -> (Vec<Spec>, Vec<Spec>) {
+    let base = ScanSettings {
+        pitch_mm: 0.5,
+        noise_mm: 0.1,
+        quantisation_mm: 0.0,
+        spikes: true,
+        holes: true,
+        yaw_deg: 0.0,
+        pitch_deg: 0.0,
+    };
+    let weights = sample_weights(model, a.identities, a.expressions, a.seed);
+    let mut rng = ChaCha8Rng::seed_from_u64(scan_seed(a.seed, u64::MAX));
+    let mut n = 0u64;
+    let mut spec = |i: usize, e: usize, st: ScanSettings, tag: String| {
+        n += 1;
+        Spec {
+            name: format!("id{i:02}-e{e}{tag}"),
+            identity: i,
+            identity_weights: weights[i].0.clone(),
+            expression_weights: weights[i].1[e].clone(),
+            scan: benchmark_scan(st, scan_seed(a.seed, n)),
+        }
+    };
+    let gallery = (0..a.identities)
+        .map(|i| spec(i, 0, base, String::new()))
+        .collect();
+    let mut probes = Vec::new();
+    for i in 0..a.identities {
+        for e in 1..a.expressions {
+            let yaw = rng.random_range(0..=45) as f64 * if rng.random() { 1.0 } else { -1.0 };
+            let noise = [0.1, 0.2, 0.4][rng.random_range(0..3)];
+            let st = ScanSettings {
+                yaw_deg: yaw,
+                noise_mm: noise,
+                ..base
+            };
+            probes.push(spec(i, e, st, format!("-yaw{yaw}-noise{noise}")));
+        }
+    }
+    (gallery, probes)
+}
+
+/// The held-out set's scanner: settings drawn from `rng` outside the benchmark's.
+fn other_scanner(rng: &mut ChaCha8Rng, seed: u64) -> ScanOptions {
+    let sl = Artifacts::structured_light();
+    let spike_min = rng.random_range(3.0..8.0);
+    let hole_min = rng.random_range(1.0..3.0);
+    ScanOptions {
+        input_mm_per_unit: 10.0,
+        pitch_mm: rng.random_range(0.4..=0.8),
+        pose: HeadPose {
+            yaw_deg: rng.random_range(-20.0..=20.0),
+            pitch_deg: rng.random_range(-10.0..=10.0),
+        },
+        artifacts: Artifacts {
+            noise: Some(rangescan::DepthNoise {
+                sigma_mm: rng.random_range(0.05..0.3),
+            }),
+            spikes: Some(Spikes {
+                fraction: rng.random_range(0.0005..0.003),
+                min_mm: spike_min,
+                max_mm: rng.random_range(spike_min..=15.0),
+            }),
+            holes: Some(Holes {
+                count: rng.random_range(2..=8),
+                min_radius_mm: hole_min,
+                max_radius_mm: rng.random_range(hole_min..=6.0),
+            }),
+            ..sl
+        },
+        seed,
+        ..ScanOptions::default()
+    }
+}
+
+/// The held-out set: per person a gallery scan and a probe scan, each from its own draw of the
+/// other scanner, the probe with an expression half the time.
+pub(super) fn held_out_specs(model: &FaceModel, a: &Args) -> (Vec<Spec>, Vec<Spec>) {
+    let weights = sample_weights(model, a.held_out, 2, a.held_out_seed);
+    let mut rng = ChaCha8Rng::seed_from_u64(scan_seed(a.held_out_seed, u64::MAX));
+    let mut gallery = Vec::new();
+    let mut probes = Vec::new();
+    for (i, (w, ex)) in weights.iter().enumerate() {
+        for k in 0..2 {
+            let seed = scan_seed(a.held_out_seed, (2 * i + k) as u64);
+            let expression = if k == 1 && rng.random::<bool>() {
+                ex[1].clone()
+            } else {
+                Vec::new()
+            };
+            let s = Spec {
+                name: format!("p{i:02}-s{k}"),
+                identity: i,
+                identity_weights: w.clone(),
+                expression_weights: expression,
+                scan: other_scanner(&mut rng, seed),
+            };
+            if k == 0 {
+                gallery.push(s)
+            } else {
+                probes.push(s)
+            }
+        }
+    }
+    (gallery, probes)
+}
+
+/// Scans every spec (in parallel, in order) and writes each grid as `dir/NAME.bnt`.
+pub(super) fn scan_all(
+    model: &FaceModel,
+    specs: &[Spec],
+    dir: &Path,
+    msg: &str,
+) -> Result<Vec<BntGrid>> {
+    std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
+    let pb = bar(specs.len(), msg);
+    let out = specs
+        .par_iter()
+        .map(|s| {
+            let face = model.sample(&s.identity_weights, &s.expression_weights)?;
+            let grid = rangescan::scan(&face, &s.scan)?.grid;
+            mesh_io::write_bnt(dir.join(format!("{}.bnt", s.name)), &grid)?;
+            pb.inc(1);
+            Ok(grid)
+        })
+        .collect::<Result<Vec<_>>>();
+    pb.finish();
+    out
+}
+
+/// One side of a set through the public API: templates of the gallery (`Err`: why not) and
+/// the probes' descriptions with the search.
+pub(super) struct Processed {
+    pub templates: Vec<Result<Template, String>>,
+    pub probes: Vec<Result<Description, String>>,
+}
+
+/// Enrols the gallery scans and describes the probes (with the search), in parallel.
+pub(super) fn process(
+    gallery: &[Spec],
+    grids_g: &[BntGrid],
+    probes: &[Spec],
+    grids_p: &[BntGrid],
+    o: &MatchOptions,
+) -> Processed {
+    let pb = bar(gallery.len(), "enrol");
+    let templates = gallery
+        .par_iter()
+        .zip(grids_g)
+        .map(|(s, g)| {
+            let t = facematch::enroll(
+                ScanInput::Grid(g),
+                &s.identity.to_string(),
+                &format!("{}.bnt", s.name),
+                o,
+            )
+            .map_err(|e| e.to_string());
+            pb.inc(1);
+            t
+        })
+        .collect();
+    pb.finish();
+    let pb = bar(probes.len(), "probes");
+    let probes = probes
+        .par_iter()
+        .zip(grids_p)
+        .map(|(_, g)| {
+            let d = prepare(ScanInput::Grid(g), o)
+                .and_then(|s| s.describe(o, true))
+                .map_err(|e| e.to_string());
+            pb.inc(1);
+            d
+        })
+        .collect();
+    pb.finish();
+    Processed { templates, probes }
+}
