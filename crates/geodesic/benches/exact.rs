@@ -2,10 +2,12 @@
 //! Criterion benches of the exact geodesic solver: setup and one solve on the level-5
 //! icosphere (10,242 vertices), one solve on the level-6 icosphere (40,962 vertices), and
 //! solves on a paper-set face (skipped when the data is absent), among them the two fields of
-//! `bipolar describe` (vertex 1507, uncut and cut at 11.8 cm).
+//! `bipolar describe` (vertex 1507, uncut and cut at 11.8 cm), and the many-sources cases of
+//! the reference-point search (3 poles, 18 moved poles: one by one, with a reused
+//! [`ExactWorkspace`], and through `ExactGeodesic::distances_many`).
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use geodesic::{ExactGeodesic, GeodesicSolver, SolveOptions, Source};
+use geodesic::{ExactGeodesic, ExactWorkspace, GeodesicSolver, SolveOptions, Source};
 use meshcore::shapes::icosphere;
 use std::hint::black_box;
 
@@ -31,7 +33,8 @@ fn bench(c: &mut Criterion) {
         })
     });
     if let Some(face) = testsupport::paper_face("id1_neutral.obj") {
-        let s = ExactGeodesic::new(&testsupport::read_mesh(face)).unwrap();
+        let mesh = testsupport::read_mesh(face);
+        let s = ExactGeodesic::new(&mesh).unwrap();
         for (name, v, max_distance) in [
             ("solve/face_id1_neutral", 3000, None),
             ("solve_v1507/face_id1_neutral", 1507, None),
@@ -47,6 +50,49 @@ fn bench(c: &mut Criterion) {
                 b.iter(|| s.distances(&[Source::Vertex(black_box(v))], &o).unwrap())
             });
         }
+        // Many sources on one mesh (the face matcher's reference-point search): three poles
+        // and each moved by 0.2 cm in 6 directions of the x-y plane, cut at 11.8 cm; the
+        // poles' three fields one after another, and the 18 moved fields one by one, with a
+        // reused workspace, and through `distances_many` (parallel, reused buffers).
+        let poles = [1507u32, 3721, 3000];
+        let own: Vec<Vec<Source>> = poles.iter().map(|&p| vec![Source::Vertex(p)]).collect();
+        let mut moved: Vec<Vec<Source>> = Vec::new();
+        for &p in &poles {
+            let c = mesh.positions()[p as usize];
+            for k in 0..6 {
+                let t = std::f64::consts::TAU * f64::from(k) / 6.0;
+                let q = c + 0.2 * glam::DVec3::new(t.cos(), t.sin(), 0.0);
+                moved.push(vec![Source::Vertex(testsupport::nearest_vertex(&mesh, q))]);
+            }
+        }
+        let o = SolveOptions {
+            max_distance: Some(11.8),
+        };
+        g.bench_function("many/own_3_one_by_one/face_id1_neutral", |b| {
+            b.iter(|| {
+                for x in &own {
+                    black_box(s.distances(x, &o).unwrap());
+                }
+            })
+        });
+        g.bench_function("many/moved_18_one_by_one/face_id1_neutral", |b| {
+            b.iter(|| {
+                for x in &moved {
+                    black_box(s.distances(x, &o).unwrap());
+                }
+            })
+        });
+        g.bench_function("many/moved_18_workspace/face_id1_neutral", |b| {
+            let mut ws = ExactWorkspace::new();
+            b.iter(|| {
+                for x in &moved {
+                    black_box(s.distances_with(&mut ws, x, &o).unwrap());
+                }
+            })
+        });
+        g.bench_function("many/moved_18_distances_many/face_id1_neutral", |b| {
+            b.iter(|| black_box(s.distances_many(&moved, &o).unwrap()))
+        });
     }
     g.finish();
 }

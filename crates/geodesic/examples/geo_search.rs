@@ -1,13 +1,14 @@
 //! Times the reference-point search's fields on one face mesh (mm): the poles' own fields and
 //! the whole search set (each pole plus the vertices nearest to it moved by RADIUS in 6
 //! directions of the x-y plane, the scanner's image plane), every field cut at CUT, through
-//! [`geodesic::distances_many`] (rayon over the fields):
+//! [`geodesic::distances_many`] (rayon over the fields; the own fields also one after
+//! another, as `facematch::face_fields` solves them):
 //!
 //! ```text
 //! cargo run --release -p geodesic --example geo_search -- MESH CUT RADIUS POLE [POLE ...]
 //! ```
 
-use geodesic::{distances_many, ExactGeodesic, SolveOptions, Source};
+use geodesic::{distances_many, ExactGeodesic, GeodesicSolver, SolveOptions, Source};
 use std::time::Instant;
 
 fn main() {
@@ -47,11 +48,30 @@ fn main() {
         v.sort_by(f64::total_cmp);
         v[1]
     };
-    let (t_own, t_all) = (time(&own), time(&all));
+    // The own fields one after another (as `facematch::face_fields` solves them).
+    let time_seq = |sets: &[Vec<Source>]| {
+        let mut v: Vec<f64> = (0..3)
+            .map(|_| {
+                let t = Instant::now();
+                for s in sets {
+                    solver.distances(s, &opts).expect("solve");
+                }
+                t.elapsed().as_secs_f64()
+            })
+            .collect();
+        v.sort_by(f64::total_cmp);
+        v[1]
+    };
+    let moved = &all[own.len()..];
+    let (t_own, t_own_seq, t_moved, t_all) = (time(&own), time_seq(&own), time(moved), time(&all));
     println!(
-        "setup {setup:.3} s; own fields ({}) {t_own:.3} s; search set ({}) {t_all:.3} s (ratio {:.2})",
+        "setup {setup:.3} s; own fields ({}) {t_own:.3} s in parallel, {t_own_seq:.3} s one after another; \
+         moved fields ({}) {t_moved:.3} s; search set with the own ({}) {t_all:.3} s \
+         (moved / own in parallel {:.2}, moved / own one after another {:.2})",
         own.len(),
+        moved.len(),
         all.len(),
-        t_all / t_own
+        t_moved / t_own,
+        t_moved / t_own_seq
     );
 }

@@ -8,7 +8,8 @@
 //!
 //! Besides the [`GeodesicSolver`](crate::GeodesicSolver) trait: [`ExactGeodesic::distances_with_stats`] (also returns
 //! the number of window propagations), [`ExactGeodesic::distances_many`] (several source sets
-//! in parallel with rayon) and [`ExactGeodesic::trace_path`] (the shortest path itself, unfolded
+//! in parallel with rayon, reusing per-thread buffers), [`ExactGeodesic::distances_with`] (one
+//! solve reusing the buffers of an [`ExactWorkspace`]) and [`ExactGeodesic::trace_path`] (the shortest path itself, unfolded
 //! back through the windows).
 //!
 //! Mesh handling (done once in [`ExactGeodesic::new`], reported by [`ExactGeodesic::report`]):
@@ -87,6 +88,22 @@ impl HeGeom {
     }
 }
 
+/// Reusable per-solve buffers of [`ExactGeodesic`] (vertex states, window-list headers and
+/// flags, queues, a pool of window lists) for [`ExactGeodesic::distances_with`]: a caller
+/// solving many fields on one mesh keeps one per thread instead of allocating them per solve.
+/// Holds about `10 n + 25 h` bytes for a mesh of `n` vertices and `h` half-edges after a solve.
+#[derive(Debug, Default)]
+pub struct ExactWorkspace {
+    buf: solve::Buffers,
+}
+
+impl ExactWorkspace {
+    /// An empty workspace (sized on its first solve).
+    pub fn new() -> Self {
+        Self::default()
+    }
+}
+
 /// What [`ExactGeodesic::new`] found and repaired in the mesh.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct ExactMeshReport {
@@ -139,22 +156,76 @@ impl ExactGeodesic {
     /// One propagation from `sources`, stopped past `cut`: the field and the number of window
     /// propagations.
     fn propagate(&self, sources: &[Source], cut: f64) -> Result<(Vec<f64>, u64), GeodesicError> {
-        let mut s = Solve::new(self, cut, false);
-        s.seed(sources)?;
-        s.run();
-        let props = s.propagations;
-        Ok((s.finish(), props))
+        let mut ws = ExactWorkspace::default();
+        self.propagate_in(&mut ws, sources, cut)
     }
 
-    /// One distance field per source set, solved in parallel with rayon (one independent
-    /// propagation per set; results in input order, identical to calling
-    /// [`GeodesicSolver::distances`](crate::GeodesicSolver::distances) for each set).
+    /// [`ExactGeodesic::propagate`] with the buffers of `ws` (left in `ws` for the next solve).
+    fn propagate_in(
+        &self,
+        ws: &mut ExactWorkspace,
+        sources: &[Source],
+        cut: f64,
+    ) -> Result<(Vec<f64>, u64), GeodesicError> {
+        let mut s = Solve::with_buffers(self, cut, false, std::mem::take(&mut ws.buf));
+        let seeded = s.seed(sources);
+        if seeded.is_ok() {
+            s.run();
+        }
+        let props = s.propagations;
+        let (d, buf) = s.finish_into();
+        ws.buf = buf;
+        seeded.map(|()| (d, props))
+    }
+
+    /// Distance field from `sources` like
+    /// [`GeodesicSolver::distances`](crate::GeodesicSolver::distances) (bit-identical result),
+    /// reusing the per-solve buffers of `ws` instead of allocating them: for several solves in
+    /// a row on one mesh. `ws` may come from another solver (it is then resized).
+    pub fn distances_with(
+        &self,
+        ws: &mut ExactWorkspace,
+        sources: &[Source],
+        opts: &SolveOptions,
+    ) -> Result<Vec<f64>, GeodesicError> {
+        self.propagate_in(ws, sources, opts.cutoff()?)
+            .map(|(d, _)| d)
+    }
+
+    /// One distance field per source set (results in input order, each bit-identical to
+    /// [`GeodesicSolver::distances`](crate::GeodesicSolver::distances) of that set), solved in
+    /// parallel with rayon, each worker reusing one [`ExactWorkspace`] across its sets. All
+    /// sets are validated first; the first invalid one (in input order) is the error and
+    /// nothing is solved.
     pub fn distances_many(
         &self,
         source_sets: &[Vec<Source>],
         opts: &SolveOptions,
     ) -> Result<Vec<Vec<f64>>, GeodesicError> {
-        crate::distances_many(self, source_sets, opts)
+        self.fields_many(source_sets, opts.cutoff()?)
+    }
+
+    /// [`ExactGeodesic::distances_many`] with a validated cut-off.
+    fn fields_many(
+        &self,
+        source_sets: &[Vec<Source>],
+        cut: f64,
+    ) -> Result<Vec<Vec<f64>>, GeodesicError> {
+        use rayon::prelude::*;
+        for set in source_sets {
+            if set.is_empty() {
+                return Err(GeodesicError::NoSource);
+            }
+            for s in set {
+                Solve::classify(self, s)?;
+            }
+        }
+        source_sets
+            .par_iter()
+            .map_init(ExactWorkspace::default, |ws, set| {
+                self.propagate_in(ws, set, cut).map(|(d, _)| d)
+            })
+            .collect()
     }
 
     #[inline]
@@ -199,5 +270,8 @@ impl Field for ExactGeodesic {
     }
     fn field(&self, sources: &[Source], cut: f64) -> Result<Vec<f64>, GeodesicError> {
         self.propagate(sources, cut).map(|(d, _)| d)
+    }
+    fn fields(&self, sets: &[Vec<Source>], cut: f64) -> Result<Vec<Vec<f64>>, GeodesicError> {
+        self.fields_many(sets, cut)
     }
 }

@@ -11,7 +11,9 @@
 //! | [`Method::Heat`] | [`HeatMethod`] | heat method with reused sparse Cholesky factorisations; smooth, approximate |
 //! | [`Method::Dijkstra`] | [`Dijkstra`] | shortest paths along mesh edges (the paper's baseline; overestimates) |
 //!
-//! Many sources at once (one field each) run in parallel with [`distances_many`].
+//! Many sources at once (one field each) run in parallel with [`distances_many`]
+//! ([`GeodesicSolver::distances_many`]); the exact solver reuses its per-solve buffers across
+//! them ([`ExactWorkspace`]).
 //!
 //! Straightest geodesics (walk a length in a tangent direction, unfolding across edges) are in
 //! [`straightest`] ([`Walker`]).
@@ -28,7 +30,7 @@ pub mod straightest;
 
 pub use dijkstra::Dijkstra;
 pub use error::GeodesicError;
-pub use exact::{ExactGeodesic, ExactMeshReport};
+pub use exact::{ExactGeodesic, ExactMeshReport, ExactWorkspace};
 #[doc(hidden)]
 pub use fmm::trace_curved_front;
 pub use fmm::{FastMarching, FmmUpdate};
@@ -97,6 +99,22 @@ pub trait GeodesicSolver: Send + Sync + std::fmt::Debug {
     /// Distance from the nearest of `sources` to every vertex, in vertex order.
     fn distances(&self, sources: &[Source], opts: &SolveOptions)
         -> Result<Vec<f64>, GeodesicError>;
+    /// One distance field per entry of `sources` (in input order), each equal to
+    /// [`GeodesicSolver::distances`] of that entry; computed in parallel (rayon), and by the
+    /// exact solver with per-thread reused buffers ([`ExactGeodesic::distances_many`]). The
+    /// first error in input order is returned.
+    fn distances_many(
+        &self,
+        sources: &[Vec<Source>],
+        opts: &SolveOptions,
+    ) -> Result<Vec<Vec<f64>>, GeodesicError> {
+        use rayon::prelude::*;
+        let out: Vec<_> = sources
+            .par_iter()
+            .map(|s| self.distances(s, opts))
+            .collect();
+        out.into_iter().collect()
+    }
 }
 
 /// Prepares a solver of the given method for `mesh`.
@@ -113,16 +131,13 @@ pub fn new_solver(
 }
 
 /// One distance field per entry of `sources`, computed in parallel (rayon) with the same solver
-/// and options. Equivalent to calling [`GeodesicSolver::distances`] for each entry in turn; the
-/// first error (in input order) is returned.
+/// and options: [`GeodesicSolver::distances_many`]. Equivalent to calling
+/// [`GeodesicSolver::distances`] for each entry in turn; the first error (in input order) is
+/// returned.
 pub fn distances_many(
     solver: &dyn GeodesicSolver,
     sources: &[Vec<Source>],
     opts: &SolveOptions,
 ) -> Result<Vec<Vec<f64>>, GeodesicError> {
-    use rayon::prelude::*;
-    sources
-        .par_iter()
-        .map(|s| solver.distances(s, opts))
-        .collect()
+    solver.distances_many(sources, opts)
 }

@@ -17,6 +17,14 @@ pub trait Field: Send + Sync + std::fmt::Debug {
     /// Distances from `sources`; the method may stop propagating past `cut` (a validated
     /// cut-off, `+inf` without one), values beyond it are discarded by the caller.
     fn field(&self, sources: &[Source], cut: f64) -> Result<Vec<f64>, GeodesicError>;
+    /// [`Field::field`] for each source set, in parallel (rayon); a method may share work
+    /// between the sets as long as each result equals its own [`Field::field`]. The first
+    /// error in input order is returned.
+    fn fields(&self, sets: &[Vec<Source>], cut: f64) -> Result<Vec<Vec<f64>>, GeodesicError> {
+        use rayon::prelude::*;
+        let out: Vec<_> = sets.par_iter().map(|s| self.field(s, cut)).collect();
+        out.into_iter().collect()
+    }
 }
 
 impl<T: Field> GeodesicSolver for T {
@@ -39,6 +47,23 @@ impl<T: Field> GeodesicSolver for T {
                 .for_each(|d| *d = f64::INFINITY);
         }
         Ok(dist)
+    }
+    fn distances_many(
+        &self,
+        sources: &[Vec<Source>],
+        opts: &SolveOptions,
+    ) -> Result<Vec<Vec<f64>>, GeodesicError> {
+        let cut = opts.cutoff()?;
+        let mut out = self.fields(sources, cut)?;
+        if cut.is_finite() {
+            out.iter_mut()
+                .flatten()
+                .filter(|d| **d > cut)
+                .for_each(|d| {
+                    *d = f64::INFINITY;
+                });
+        }
+        Ok(out)
     }
 }
 
@@ -90,7 +115,7 @@ pub(crate) fn seeds(
 
 /// Priority-queue entry `(distance, vertex)` of a max-heap that pops the smallest distance
 /// first, ties to the smallest vertex id (the deterministic order of every solver).
-#[derive(PartialEq)]
+#[derive(Debug, PartialEq)]
 pub(crate) struct Item(pub f64, pub u32);
 impl Eq for Item {}
 impl Ord for Item {

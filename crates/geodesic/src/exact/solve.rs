@@ -99,24 +99,91 @@ pub(crate) struct Solve<'a> {
     cur_origin: Origin,
 }
 
-impl<'a> Solve<'a> {
-    pub(crate) fn new(g: &'a ExactGeodesic, cut: f64, record: bool) -> Self {
+/// The per-solve arrays of [`Solve`] that can be reused by the next solve on the same mesh
+/// (everything but the distances, which are the result): vertex states, per-half-edge list
+/// headers and flags, queues, and a pool of emptied window lists.
+#[derive(Debug, Default)]
+pub(crate) struct Buffers {
+    state: Vec<u8>,
+    emitted: Vec<f64>,
+    emit_flag: Vec<bool>,
+    lists: Vec<Vec<Window>>,
+    flags: Vec<u8>,
+    fifo: VecDeque<u32>,
+    heap: BinaryHeap<Item>,
+    pool: Vec<Vec<Window>>,
+    pending_emit: Vec<u32>,
+    tc_buf: Vec<f64>,
+}
+
+impl Buffers {
+    /// Puts the buffers in the state of a fresh solve on `g` (allocating them on first use or
+    /// when they were sized for another mesh). The result of a solve does not depend on what
+    /// the buffers held before: every array is reset to the values [`Solve::new`] starts from.
+    fn reset(&mut self, g: &ExactGeodesic) {
         let n = g.positions.len();
         let nh = g.twin.len();
+        self.state.clear();
+        self.state.resize(n, OUTSIDE);
+        self.emitted.clear();
+        self.emitted.resize(n, f64::NAN);
+        self.emit_flag.clear();
+        self.emit_flag.extend_from_slice(&g.pseudo);
+        if self.lists.len() != nh || self.flags.len() != nh {
+            self.lists = (0..nh).map(|_| Vec::new()).collect();
+            self.flags = vec![0; nh];
+        } else {
+            // A finished solve leaves every list empty and every flag clear; a solve stopped
+            // early (an error while seeding) may not.
+            for (h, f) in self.flags.iter_mut().enumerate() {
+                if *f != 0 {
+                    *f = 0;
+                    let mut l = std::mem::take(&mut self.lists[h]);
+                    l.clear();
+                    if self.pool.len() < POOL_MAX {
+                        self.pool.push(l);
+                    }
+                }
+            }
+        }
+        self.fifo.clear();
+        self.heap.clear();
+        self.pending_emit.clear();
+        self.tc_buf.clear();
+    }
+}
+
+/// Most emptied window lists kept for reuse.
+const POOL_MAX: usize = 4096;
+
+impl<'a> Solve<'a> {
+    pub(crate) fn new(g: &'a ExactGeodesic, cut: f64, record: bool) -> Self {
+        Self::with_buffers(g, cut, record, Buffers::default())
+    }
+
+    /// A solve that uses (and resets) `buf`; [`Solve::finish_into`] hands them back.
+    pub(crate) fn with_buffers(
+        g: &'a ExactGeodesic,
+        cut: f64,
+        record: bool,
+        mut buf: Buffers,
+    ) -> Self {
+        buf.reset(g);
+        let n = g.positions.len();
         Self {
             g,
             cut,
             d: vec![f64::INFINITY; n],
-            state: vec![OUTSIDE; n],
-            emitted: vec![f64::NAN; n],
-            emit_flag: g.pseudo.clone(),
-            lists: (0..nh).map(|_| Vec::new()).collect(),
-            flags: vec![0; nh],
-            fifo: VecDeque::new(),
-            heap: BinaryHeap::new(),
-            pool: Vec::new(),
-            pending_emit: Vec::new(),
-            tc_buf: Vec::new(),
+            state: buf.state,
+            emitted: buf.emitted,
+            emit_flag: buf.emit_flag,
+            lists: buf.lists,
+            flags: buf.flags,
+            fifo: buf.fifo,
+            heap: buf.heap,
+            pool: buf.pool,
+            pending_emit: buf.pending_emit,
+            tc_buf: buf.tc_buf,
             bound_stats: BoundStats::default(),
             draining: false,
             prune: true,
@@ -392,7 +459,13 @@ impl<'a> Solve<'a> {
         }
     }
 
-    pub(crate) fn finish(mut self) -> Vec<f64> {
+    #[cfg(test)]
+    pub(crate) fn finish(self) -> Vec<f64> {
+        self.finish_into().0
+    }
+
+    /// The distances (beyond the cut-off: infinity) and the buffers for the next solve.
+    pub(crate) fn finish_into(mut self) -> (Vec<f64>, Buffers) {
         if self.cut.is_finite() {
             for d in &mut self.d {
                 if *d > self.cut {
@@ -400,7 +473,19 @@ impl<'a> Solve<'a> {
                 }
             }
         }
-        self.d
+        let buf = Buffers {
+            state: self.state,
+            emitted: self.emitted,
+            emit_flag: self.emit_flag,
+            lists: self.lists,
+            flags: self.flags,
+            fifo: self.fifo,
+            heap: self.heap,
+            pool: self.pool,
+            pending_emit: self.pending_emit,
+            tc_buf: self.tc_buf,
+        };
+        (self.d, buf)
     }
 
     /// The triangle step: filters the list of `h` and pushes its windows across face(h).
@@ -508,7 +593,7 @@ impl<'a> Solve<'a> {
 
     fn recycle(&mut self, mut ws: Vec<Window>) {
         ws.clear();
-        if ws.capacity() > 0 && self.pool.len() < 4096 {
+        if ws.capacity() > 0 && self.pool.len() < POOL_MAX {
             self.pool.push(ws);
         }
     }
