@@ -111,6 +111,12 @@ pub fn write_csv(path: &Path, header: &[&str], rows: &[Vec<String>]) -> Result<(
     std::fs::write(path, out).with_context(|| format!("writing {}", path.display()))
 }
 
+/// Writes `value` as pretty-printed JSON with a final newline.
+pub fn write_json(path: &Path, value: &serde_json::Value) -> Result<()> {
+    let text = serde_json::to_string_pretty(value)? + "\n";
+    std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
+}
+
 /// Formats a number with 4 significant decimals.
 pub fn f4(x: f64) -> String {
     if x.is_finite() {

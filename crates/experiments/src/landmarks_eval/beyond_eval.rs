@@ -3,8 +3,9 @@
 //! errors, and per non-face whether it was refused.
 
 use super::beyond::{make, non_faces, BeyondFace, Kind};
-use super::{stats, Stats};
+use super::stats::{stats, Stats};
 use crate::pipeline::bar;
+use crate::report::write_json;
 use anyhow::{Context, Result};
 use facemodel::FaceModel;
 use landmarks::{detect_visible, DetectOptions, GenericModel, LandmarkName, VisibleLandmarks};
@@ -266,10 +267,7 @@ pub(super) fn run_beyond(
         "seed": args.seed, "faces_per_kind": args.beyond_faces, "kinds": kinds_json,
         "non_faces": refused, "seconds": t0.elapsed().as_secs_f64(),
     });
-    std::fs::write(
-        out.join("summary.json"),
-        serde_json::to_string_pretty(&summary)? + "\n",
-    )?;
+    write_json(&out.join("summary.json"), &summary)?;
     println!("wall time {:.1} s", t0.elapsed().as_secs_f64());
     println!("{}", out.display());
     Ok(())

@@ -1,13 +1,16 @@
 //! `landmarks-eval --scans`: detection on range scans of sampled ICT faces against the ground
 //! truth the scanner projected.
 
-use super::{stats, test_seed, Args, Stats};
+use super::stats::{error_histogram, stats, Stats};
+use super::{test_seed, Args};
 use crate::pipeline::bar;
-use crate::scans::{sample_weights, scan_faces, scan_seed, FaceSpec, ScanSetOptions};
+use crate::report::write_json;
+use crate::scans::{sample_weights, scan_faces, scan_seed, FaceSpec, ScanSetOptions, ScanSettings};
 use anyhow::{Context, Result};
 use facemodel::FaceModel;
 use landmarks::{DetectOptions, GenericModel, LandmarkName};
 use meshcore::DVec3;
+use std::path::Path;
 use std::time::Instant;
 
 /// Outcome of one scanned test face: per landmark the error in mm (`inf`: not found, the face
@@ -30,11 +33,71 @@ pub(super) fn run_scans(
     ict: &FaceModel,
     generic: &GenericModel,
     dopt: &DetectOptions,
-    out: &std::path::Path,
+    out: &Path,
 ) -> Result<()> {
     let t0 = Instant::now();
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let settings = args.scan.settings();
+    let specs = scan_specs(args, ict, settings)?;
+    let (outcomes, scan_failures) = scan_and_detect(args, ict, generic, dopt, &specs);
+    anyhow::ensure!(
+        !outcomes.is_empty(),
+        "no scan could be made: {}",
+        scan_failures.join("; ")
+    );
+    let s = Summary::of(&outcomes);
+    print_summary(args, settings, generic, &s, &scan_failures);
+    let targets = s.targets();
+    for (what, ok) in &targets {
+        println!("target {what}: {}", if *ok { "met" } else { "NOT met" });
+    }
+    let secs = t0.elapsed().as_secs_f64();
+    println!("wall time {secs:.1} s");
+    let summary = serde_json::json!({
+        "faces": s.n,
+        "seed": args.seed,
+        "expressions": !args.neutral,
+        "scan": settings.label(),
+        "crop_radius_mm": args.scan.crop_radius,
+        "units_of_errors": "mm",
+        "median_valid_samples": s.med_valid,
+        "median_vertices_after_cleaning": s.med_vertices,
+        "median_detect_ms": s.med_detect,
+        "per_landmark": s.st,
+        "not_found": s.not_found.iter().map(|(f, e)| serde_json::json!({"face": f, "error": e})).collect::<Vec<_>>(),
+        "not_found_rate": s.nf_rate,
+        "silent_wrong": s.silent.iter().map(|(f, w)| serde_json::json!({"face": f, "what": w})).collect::<Vec<_>>(),
+        "truth_not_on_cleaned_scan": s.unseen,
+        "reported_unseen": {"truth_not_on_scan": s.unseen_right, "truth_on_scan": s.unseen_missed},
+        "scan_failures": scan_failures,
+        "targets": targets.iter().map(|(w, ok)| serde_json::json!({"target": w, "met": ok})).collect::<Vec<_>>(),
+        "seconds": secs,
+    });
+    write_json(&out.join("summary.json"), &summary)?;
+    write_csv(&out.join("per-face.csv"), &outcomes)?;
+    let series = LandmarkName::ALL
+        .iter()
+        .map(|&n| {
+            (
+                n.key().to_string(),
+                outcomes
+                    .iter()
+                    .filter_map(|o| o.errors[n as usize].as_ref().ok().copied())
+                    .collect(),
+            )
+        })
+        .collect();
+    error_histogram(
+        &out.join("errors-histogram.svg"),
+        &format!("Landmark errors on range scans ({})", settings.label()),
+        series,
+    )?;
+    println!("{}", out.display());
+    Ok(())
+}
+
+/// The test faces to scan (the test stream of `--seed`; only `--only` if given).
+fn scan_specs(args: &Args, ict: &FaceModel, settings: ScanSettings) -> Result<Vec<FaceSpec>> {
     let seed = test_seed(args.seed);
     let weights = sample_weights(ict, args.faces, 2, seed);
     let mut specs: Vec<FaceSpec> = weights
@@ -61,6 +124,18 @@ pub(super) fn run_scans(
         );
         specs = vec![specs.swap_remove(i)];
     }
+    Ok(specs)
+}
+
+/// Scans, cleans (cropped around the nose tip) and detects every spec; returns the outcomes
+/// and the scans that failed.
+fn scan_and_detect(
+    args: &Args,
+    ict: &FaceModel,
+    generic: &GenericModel,
+    dopt: &DetectOptions,
+    specs: &[FaceSpec],
+) -> (Vec<ScanOutcome>, Vec<String>) {
     let pb = bar(specs.len(), "scanning and detecting");
     let opts = ScanSetOptions {
         clean: scanprep::CleanOptions {
@@ -73,7 +148,7 @@ pub(super) fn run_scans(
         detect: Some(*dopt),
         ..ScanSetOptions::default()
     };
-    let faces = scan_faces(ict, generic, &specs, &opts, &pb);
+    let faces = scan_faces(ict, generic, specs, &opts, &pb);
     pb.finish_and_clear();
     let mut scan_failures = Vec::new();
     let mut outcomes = Vec::new();
@@ -112,77 +187,163 @@ pub(super) fn run_scans(
             detect_ms: f.times.detect.as_secs_f64() * 1e3,
         });
     }
-    anyhow::ensure!(
-        !outcomes.is_empty(),
-        "no scan could be made: {}",
-        scan_failures.join("; ")
-    );
-    let names: Vec<&str> = LandmarkName::ALL.iter().map(|n| n.key()).collect();
-    // Errors of the landmarks whose truth is on the cleaned scan (inf: not found).
-    let st: Vec<Stats> = LandmarkName::ALL
-        .iter()
-        .map(|&n| {
-            let e: Vec<f64> = outcomes
+    (outcomes, scan_failures)
+}
+
+/// The figures of the scanned faces.
+struct Summary<'a> {
+    /// Faces scanned.
+    n: usize,
+    /// Per landmark, the errors where the truth is on the cleaned scan (inf: not found).
+    st: Vec<Stats>,
+    /// Silent wrong landmarks (face, what): reported more than 10 mm off, or reported where the
+    /// truth is not on the cleaned scan.
+    silent: Vec<(String, String)>,
+    /// Faces not found, with the detector's message.
+    not_found: Vec<(&'a str, &'a str)>,
+    /// Share of the faces not found.
+    nf_rate: f64,
+    /// Landmarks of found faces reported unseen whose truth is not on the cleaned scan.
+    unseen_right: usize,
+    /// Landmarks of found faces reported unseen whose truth is on it.
+    unseen_missed: usize,
+    /// Ground-truth landmarks not on the cleaned scan.
+    unseen: usize,
+    /// Median valid samples per scan.
+    med_valid: f64,
+    /// Median vertices after cleaning.
+    med_vertices: f64,
+    /// Median detection wall time (ms).
+    med_detect: f64,
+}
+
+impl<'a> Summary<'a> {
+    fn of(outcomes: &'a [ScanOutcome]) -> Self {
+        // Errors of the landmarks whose truth is on the cleaned scan (inf: not found).
+        let st: Vec<Stats> = LandmarkName::ALL
+            .iter()
+            .map(|&n| {
+                let e: Vec<f64> = outcomes
+                    .iter()
+                    .filter_map(|o| o.errors[n as usize].as_ref().ok().copied())
+                    .collect();
+                stats(n.key(), &e)
+            })
+            .collect();
+        // Silent wrong landmarks: reported more than 10 mm off, or reported where the truth is
+        // not on the cleaned scan (occluded, outside the grid or the crop).
+        let silent: Vec<(String, String)> = outcomes
+            .iter()
+            .filter(|o| o.not_found.is_none())
+            .flat_map(|o| {
+                LandmarkName::ALL
+                    .iter()
+                    .filter(|&&n| o.unseen[n as usize].is_none())
+                    .filter_map(|&n| match &o.errors[n as usize] {
+                        Ok(e) if *e > 10.0 => Some((o.name.clone(), format!("{n} {e:.1} mm off"))),
+                        Err(why) => Some((o.name.clone(), format!("{n} reported but {why}"))),
+                        _ => None,
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        let not_found: Vec<(&str, &str)> = outcomes
+            .iter()
+            .filter_map(|o| o.not_found.as_deref().map(|e| (o.name.as_str(), e)))
+            .collect();
+        let n = outcomes.len();
+        let nf_rate = not_found.len() as f64 / n as f64;
+        // Landmarks of found faces reported unseen: where the truth is not on the cleaned scan
+        // (right) and where it is (a landmark not found).
+        let reported_unseen = |truth_on_scan: bool| -> usize {
+            outcomes
                 .iter()
-                .filter_map(|o| o.errors[n as usize].as_ref().ok().copied())
-                .collect();
-            stats(n.key(), &e)
-        })
-        .collect();
-    // Silent wrong landmarks: reported more than 10 mm off, or reported where the truth is not
-    // on the cleaned scan (occluded, outside the grid or the crop).
-    let silent: Vec<(String, String)> = outcomes
-        .iter()
-        .filter(|o| o.not_found.is_none())
-        .flat_map(|o| {
-            LandmarkName::ALL
-                .iter()
-                .filter(|&&n| o.unseen[n as usize].is_none())
-                .filter_map(|&n| match &o.errors[n as usize] {
-                    Ok(e) if *e > 10.0 => Some((o.name.clone(), format!("{n} {e:.1} mm off"))),
-                    Err(why) => Some((o.name.clone(), format!("{n} reported but {why}"))),
-                    _ => None,
+                .map(|o| {
+                    (0..5)
+                        .filter(|&k| o.unseen[k].is_some() && o.errors[k].is_ok() == truth_on_scan)
+                        .count()
                 })
-                .collect::<Vec<_>>()
-        })
-        .collect();
-    let silent_of = |n: LandmarkName| {
-        silent
+                .sum()
+        };
+        let unseen: usize = outcomes
+            .iter()
+            .map(|o| o.errors.iter().filter(|e| e.is_err()).count())
+            .sum();
+        let med = |v: &mut Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+        };
+        let mut vs: Vec<f64> = outcomes.iter().map(|o| o.valid_samples as f64).collect();
+        let mut vv: Vec<f64> = outcomes.iter().map(|o| o.vertices as f64).collect();
+        let mut dt: Vec<f64> = outcomes.iter().map(|o| o.detect_ms).collect();
+        Summary {
+            n,
+            st,
+            silent,
+            not_found,
+            nf_rate,
+            unseen_right: reported_unseen(false),
+            unseen_missed: reported_unseen(true),
+            unseen,
+            med_valid: med(&mut vs),
+            med_vertices: med(&mut vv),
+            med_detect: med(&mut dt),
+        }
+    }
+
+    /// Silent wrong landmarks of `n`.
+    fn silent_of(&self, n: LandmarkName) -> usize {
+        self.silent
             .iter()
             .filter(|(_, w)| w.starts_with(n.key()))
             .count()
-    };
-    let not_found: Vec<(&str, &str)> = outcomes
-        .iter()
-        .filter_map(|o| o.not_found.as_deref().map(|e| (o.name.as_str(), e)))
-        .collect();
-    let n = outcomes.len();
-    let nf_rate = not_found.len() as f64 / n as f64;
-    // Landmarks of found faces reported unseen: where the truth is not on the cleaned scan
-    // (right) and where it is (a landmark not found).
-    let reported_unseen = |truth_on_scan: bool| -> usize {
-        outcomes
-            .iter()
-            .map(|o| {
-                (0..5)
-                    .filter(|&k| o.unseen[k].is_some() && o.errors[k].is_ok() == truth_on_scan)
-                    .count()
-            })
-            .sum()
-    };
-    let (unseen_right, unseen_missed) = (reported_unseen(false), reported_unseen(true));
-    let unseen: usize = outcomes
-        .iter()
-        .map(|o| o.errors.iter().filter(|e| e.is_err()).count())
-        .sum();
-    let med = |v: &mut Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
-    };
-    let mut vs: Vec<f64> = outcomes.iter().map(|o| o.valid_samples as f64).collect();
-    let mut vv: Vec<f64> = outcomes.iter().map(|o| o.vertices as f64).collect();
-    let mut dt: Vec<f64> = outcomes.iter().map(|o| o.detect_ms).collect();
-    let (med_valid, med_vertices, med_detect) = (med(&mut vs), med(&mut vv), med(&mut dt));
+    }
+
+    /// The accuracy targets and whether each is met.
+    fn targets(&self) -> [(&'static str, bool); 5] {
+        let by = |n: LandmarkName| &self.st[n as usize];
+        let corners = [
+            by(LandmarkName::OuterEyeRight),
+            by(LandmarkName::OuterEyeLeft),
+        ];
+        [
+            (
+                "outer eye corners median < 2 mm",
+                corners.iter().all(|s| s.median_mm < 2.0),
+            ),
+            (
+                "outer eye corners p95 < 4 mm",
+                corners.iter().all(|s| s.p95_mm < 4.0),
+            ),
+            (
+                "nose tip median < 2 mm",
+                by(LandmarkName::NoseTip).median_mm < 2.0,
+            ),
+            ("not found < 2 %", self.nf_rate < 0.02),
+            (
+                "no outer corner or nose tip > 10 mm off unreported",
+                [
+                    LandmarkName::OuterEyeRight,
+                    LandmarkName::OuterEyeLeft,
+                    LandmarkName::NoseTip,
+                ]
+                .iter()
+                .all(|&n| self.silent_of(n) == 0),
+            ),
+        ]
+    }
+}
+
+/// Prints the set-up, the per-landmark table, the faces not found, the unseen landmarks, the
+/// silent wrong landmarks and the scans that failed.
+fn print_summary(
+    args: &Args,
+    settings: ScanSettings,
+    generic: &GenericModel,
+    s: &Summary<'_>,
+    scan_failures: &[String],
+) {
+    let n = s.n;
     println!(
         "{n} scanned test faces ({}; {}), generic model from {} training faces; errors in mm",
         if args.neutral {
@@ -194,110 +355,60 @@ pub(super) fn run_scans(
         generic.n_training
     );
     println!(
-        "median {med_valid:.0} valid samples, {med_vertices:.0} vertices after cleaning; detection wall time median {med_detect:.0} ms"
+        "median {:.0} valid samples, {:.0} vertices after cleaning; detection wall time median {:.0} ms",
+        s.med_valid, s.med_vertices, s.med_detect
     );
     println!(
         "{:<16} {:>5} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7}",
         "landmark", "n", "mean", "median", "p95", "max", "<2.5", "<5", "<10", ">10 silent"
     );
-    for (s, &nm) in st.iter().zip(&LandmarkName::ALL) {
+    for (st, &nm) in s.st.iter().zip(&LandmarkName::ALL) {
         println!(
             "{:<16} {:>5} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>6.1}% {:>6.1}% {:>6.1}% {:>7}",
-            s.landmark,
-            s.n,
-            s.mean_mm,
-            s.median_mm,
-            s.p95_mm,
-            s.max_mm,
-            100.0 * s.within_2_5mm,
-            100.0 * s.within_5mm,
-            100.0 * s.within_10mm,
-            silent_of(nm)
+            st.landmark,
+            st.n,
+            st.mean_mm,
+            st.median_mm,
+            st.p95_mm,
+            st.max_mm,
+            100.0 * st.within_2_5mm,
+            100.0 * st.within_5mm,
+            100.0 * st.within_10mm,
+            s.silent_of(nm)
         );
     }
     println!(
-        "not found: {} of {n} faces ({:.1} %); ground-truth landmarks not on the cleaned scan: {unseen}; scans that failed: {}",
-        not_found.len(),
-        100.0 * nf_rate,
+        "not found: {} of {n} faces ({:.1} %); ground-truth landmarks not on the cleaned scan: {}; scans that failed: {}",
+        s.not_found.len(),
+        100.0 * s.nf_rate,
+        s.unseen,
         scan_failures.len()
     );
-    for (name, e) in not_found.iter().take(20) {
+    for (name, e) in s.not_found.iter().take(20) {
         println!("  {name}: {e}");
     }
     println!(
-        "landmarks of found faces reported unseen: {unseen_right} whose truth is not on the cleaned scan, {unseen_missed} whose truth is (counted as not found above)"
+        "landmarks of found faces reported unseen: {} whose truth is not on the cleaned scan, {} whose truth is (counted as not found above)",
+        s.unseen_right, s.unseen_missed
     );
-    println!("silent wrong landmarks: {}", silent.len());
-    for (name, w) in silent.iter().take(20) {
+    println!("silent wrong landmarks: {}", s.silent.len());
+    for (name, w) in s.silent.iter().take(20) {
         println!("  {name}: {w}");
     }
     for e in scan_failures.iter().take(20) {
         println!("  scan failed: {e}");
     }
-    let by = |n: LandmarkName| &st[n as usize];
-    let corners = [
-        by(LandmarkName::OuterEyeRight),
-        by(LandmarkName::OuterEyeLeft),
-    ];
-    let targets = [
-        (
-            "outer eye corners median < 2 mm",
-            corners.iter().all(|s| s.median_mm < 2.0),
-        ),
-        (
-            "outer eye corners p95 < 4 mm",
-            corners.iter().all(|s| s.p95_mm < 4.0),
-        ),
-        (
-            "nose tip median < 2 mm",
-            by(LandmarkName::NoseTip).median_mm < 2.0,
-        ),
-        ("not found < 2 %", nf_rate < 0.02),
-        (
-            "no outer corner or nose tip > 10 mm off unreported",
-            [
-                LandmarkName::OuterEyeRight,
-                LandmarkName::OuterEyeLeft,
-                LandmarkName::NoseTip,
-            ]
-            .iter()
-            .all(|&n| silent_of(n) == 0),
-        ),
-    ];
-    for (what, ok) in &targets {
-        println!("target {what}: {}", if *ok { "met" } else { "NOT met" });
-    }
-    let secs = t0.elapsed().as_secs_f64();
-    println!("wall time {secs:.1} s");
-    let summary = serde_json::json!({
-        "faces": n,
-        "seed": args.seed,
-        "expressions": !args.neutral,
-        "scan": settings.label(),
-        "crop_radius_mm": args.scan.crop_radius,
-        "units_of_errors": "mm",
-        "median_valid_samples": med_valid,
-        "median_vertices_after_cleaning": med_vertices,
-        "median_detect_ms": med_detect,
-        "per_landmark": st,
-        "not_found": not_found.iter().map(|(f, e)| serde_json::json!({"face": f, "error": e})).collect::<Vec<_>>(),
-        "not_found_rate": nf_rate,
-        "silent_wrong": silent.iter().map(|(f, w)| serde_json::json!({"face": f, "what": w})).collect::<Vec<_>>(),
-        "truth_not_on_cleaned_scan": unseen,
-        "reported_unseen": {"truth_not_on_scan": unseen_right, "truth_on_scan": unseen_missed},
-        "scan_failures": scan_failures,
-        "targets": targets.iter().map(|(w, ok)| serde_json::json!({"target": w, "met": ok})).collect::<Vec<_>>(),
-        "seconds": secs,
-    });
-    std::fs::write(
-        out.join("summary.json"),
-        serde_json::to_string_pretty(&summary)? + "\n",
-    )?;
+}
+
+/// One row per scanned face: the errors (or why the truth is not on the scan, and why a
+/// landmark was reported unseen), the scan's size, the detection time and its error.
+fn write_csv(path: &Path, outcomes: &[ScanOutcome]) -> Result<()> {
+    let names: Vec<&str> = LandmarkName::ALL.iter().map(|n| n.key()).collect();
     let mut csv = format!(
         "face,{},valid_samples,vertices,detect_ms,error\n",
         names.join(",")
     );
-    for o in &outcomes {
+    for o in outcomes {
         let e: Vec<String> = o
             .errors
             .iter()
@@ -323,27 +434,6 @@ pub(super) fn run_scans(
             o.not_found.as_deref().unwrap_or("").replace(',', ";")
         );
     }
-    std::fs::write(out.join("per-face.csv"), csv)?;
-    let series: Vec<(String, Vec<f64>)> = LandmarkName::ALL
-        .iter()
-        .map(|&n| {
-            (
-                n.key().to_string(),
-                outcomes
-                    .iter()
-                    .filter_map(|o| o.errors[n as usize].as_ref().ok())
-                    .map(|x| x.min(15.0))
-                    .collect(),
-            )
-        })
-        .collect();
-    viz::histogram(
-        out.join("errors-histogram.svg"),
-        &format!("Landmark errors on range scans ({})", settings.label()),
-        "error (mm, clipped at 15)",
-        &series,
-        30,
-    )?;
-    println!("{}", out.display());
+    std::fs::write(path, csv)?;
     Ok(())
 }
