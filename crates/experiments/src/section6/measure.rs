@@ -30,6 +30,9 @@ pub(super) struct Set<'a> {
     pub ctx: &'a Ctx<'a>,
 }
 
+/// Cells of a measurement with the four distances of each.
+type Cells<C> = (Vec<C>, Vec<[f64; 4]>);
+
 /// The between-person comparisons: the four matrices, the median time per comparison (ms)
 /// of each representation, how many comparisons were timed, and the separations.
 pub(super) struct Between {
@@ -102,7 +105,7 @@ pub(super) fn between_persons(s: &Set<'_>) -> Result<Between> {
 /// The reference-point grid: per cell `(radius % of D, direction)`, the bipolar distance with
 /// the left outer eye corner moved and the other three with the nose tip moved (NaN where a
 /// walk was stopped by a hole).
-pub(super) fn reference_grid(s: &Set<'_>) -> Result<(Vec<(f64, f64)>, Vec<[f64; 4]>)> {
+pub(super) fn reference_grid(s: &Set<'_>) -> Result<Cells<(f64, f64)>> {
     let grid_cells = error_grid();
     let pb = bar(grid_cells.len(), "reference-point grid");
     let grid: Vec<[f64; 4]> = grid_cells
@@ -188,7 +191,7 @@ fn grid_cell(s: &Set<'_>, pct: f64, theta: f64) -> Result<[f64; 4]> {
 /// Depth noise on the test face: per cell `(sigma mm, draw)`, the four distances between the
 /// clean and the noisy face (everything recomputed on the noisy mesh). `mm` is millimetres
 /// per mesh unit.
-pub(super) fn depth_noise(s: &Set<'_>, mm: f64) -> Result<(Vec<(f64, usize)>, Vec<[f64; 4]>)> {
+pub(super) fn depth_noise(s: &Set<'_>, mm: f64) -> Result<Cells<(f64, usize)>> {
     let (tf, ctx) = (&s.faces[s.test], s.ctx);
     let args = ctx.args;
     let noise_cells: Vec<(f64, usize)> = args

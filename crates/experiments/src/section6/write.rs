@@ -114,8 +114,6 @@ fn cell_rows<C>(cells: &[C], d: &[[f64; 4]], lead: impl Fn(&C) -> [String; 2]) -
         .collect()
 }
 
-#[allow(clippy::too_many_arguments)]
-
 /// Everything the report is written from.
 pub(super) struct Results<'a> {
     /// The task's arguments.
