@@ -509,19 +509,17 @@ impl<'a> Solve<'a> {
         if self.prune && ws.len() > 1 {
             sort_by_start(&mut ws);
             let mut cur = 0;
-            let mut cur_s = ws[0].scale();
             for j in 1..ws.len() {
                 let (lo, hi) = ws.split_at_mut(j);
-                let s2 = hi[0].scale();
-                match pair_trim(&mut lo[cur], cur_s, &mut hi[0], s2, &mut self.bound_stats) {
+                match pair_trim(&mut lo[cur], &mut hi[0], &mut self.bound_stats) {
                     Trim::FirstDead => {
-                        (cur, cur_s) = (j, s2);
+                        cur = j;
                         alive -= 1;
                     }
                     Trim::SecondDead => alive -= 1,
                     Trim::Both => {
                         if hi[0].b1 > lo[cur].b1 {
-                            (cur, cur_s) = (j, s2);
+                            cur = j;
                         }
                     }
                 }

@@ -55,11 +55,19 @@ impl Window {
     }
 
     /// Size of the window's distance function (`|sigma| + |source|`), the reference of the
-    /// relative tolerances in [`pair_trim`]; depends only on `sigma` and the source, so callers
-    /// compute it once per window and pass it on.
+    /// relative tolerances in [`pair_trim`].
     #[inline]
     pub fn scale(&self) -> f64 {
         self.sigma.abs() + (self.sx * self.sx + self.sy * self.sy).sqrt()
+    }
+
+    /// An upper bound of [`Window::scale`] without a square root (`|source|` bounded by its L1
+    /// norm, times `1 + 1e-15` to cover rounding): a tolerance test against the scale that
+    /// fails with this bound fails with the scale too, so the scale is only computed when a
+    /// test could pass.
+    #[inline]
+    fn scale_bound(&self) -> f64 {
+        (self.sigma.abs() + self.sx.abs() + self.sy.abs()) * (1.0 + 1e-15)
     }
 }
 
@@ -94,13 +102,17 @@ pub(crate) enum Trim {
 }
 
 /// Real roots of `D1(x) = D2(x)` (a superset: squaring may add spurious ones), written into
-/// `out`; returns how many.
-fn equal_distance_roots(w1: &Window, w2: &Window, scale: f64, out: &mut [f64; 2]) -> usize {
+/// `out`; returns how many. The sigmas count as equal (perpendicular bisector) when they
+/// differ by at most `1e-14` times the larger [`Window::scale`].
+fn equal_distance_roots(w1: &Window, w2: &Window, out: &mut [f64; 2]) -> usize {
     let delta = w2.sigma - w1.sigma;
     let u = w1.sx - w2.sx;
     // |S1|^2 - |S2|^2 written to avoid cancellation.
     let k = u * (w1.sx + w2.sx) + (w1.sy - w2.sy) * (w1.sy + w2.sy);
-    if delta.abs() <= 1e-14 * scale {
+    let ad = delta.abs();
+    if ad <= 1e-14 * w1.scale_bound().max(w2.scale_bound())
+        && ad <= 1e-14 * w1.scale().max(w2.scale())
+    {
         // Perpendicular bisector of the two sources.
         if u != 0.0 {
             out[0] = k / (2.0 * u);
@@ -148,25 +160,23 @@ fn equal_distance_roots(w1: &Window, w2: &Window, scale: f64, out: &mut [f64; 2]
 ///
 /// A part of a window is removed only when the other window is strictly shorter there (by more
 /// than [`TAU`] relative); windows are never split in the middle. Identical distance functions
-/// whose intervals overlap or touch are merged into `w1`. `s1` and `s2` are the windows'
-/// [`Window::scale`] (computed once per window by the caller: trimming does not change them);
-/// `bs` steers the bounding shortcut (speed only).
-pub(crate) fn pair_trim(
-    w1: &mut Window,
-    s1: f64,
-    w2: &mut Window,
-    s2: f64,
-    bs: &mut BoundStats,
-) -> Trim {
+/// whose intervals overlap or touch (functions within `1e-12` times `w1`'s [`Window::scale`])
+/// are merged into `w1`. `bs` steers the bounding shortcut (speed only).
+pub(crate) fn pair_trim(w1: &mut Window, w2: &mut Window, bs: &mut BoundStats) -> Trim {
     let l = w1.b0.max(w2.b0);
     let r = w1.b1.min(w2.b1);
     if r < l {
         return Trim::Both;
     }
-    let s = 1e-12 * s1;
-    if (w1.sigma - w2.sigma).abs() <= s
-        && (w1.sx - w2.sx).abs() <= s
-        && (w1.sy - w2.sy).abs() <= s
+    let ds = (w1.sigma - w2.sigma).abs();
+    let ub = 1e-12 * w1.scale_bound();
+    if ds <= ub
+        && (w1.sx - w2.sx).abs() <= ub
+        && (w1.sy - w2.sy).abs() <= ub
+        && {
+            let s = 1e-12 * w1.scale();
+            ds <= s && (w1.sx - w2.sx).abs() <= s && (w1.sy - w2.sy).abs() <= s
+        }
         && w2.b0 <= w1.b1
         && w1.b0 <= w2.b1
         && w1.id == u32::MAX
@@ -189,15 +199,14 @@ pub(crate) fn pair_trim(
             return out;
         }
     }
-    exact_trim(w1, w2, s1.max(s2), l, r)
+    exact_trim(w1, w2, l, r)
 }
 
 /// The exact path of [`pair_trim`] on the overlap `[l, r]` (`l < r`): equal-distance roots,
-/// a midpoint test per segment, then the ends are moved past the lost segments. `scale` is the
-/// larger of the two windows' [`Window::scale`].
-fn exact_trim(w1: &mut Window, w2: &mut Window, scale: f64, l: f64, r: f64) -> Trim {
+/// a midpoint test per segment, then the ends are moved past the lost segments.
+fn exact_trim(w1: &mut Window, w2: &mut Window, l: f64, r: f64) -> Trim {
     let mut roots = [0.0; 2];
-    let nr = equal_distance_roots(w1, w2, scale, &mut roots);
+    let nr = equal_distance_roots(w1, w2, &mut roots);
     // Breakpoints l < p1 < p2 < r.
     let mut pts = [l, 0.0, 0.0, r];
     let mut np = 1;
@@ -390,21 +399,14 @@ mod tests {
     }
 
     fn trim(a: &mut Window, b: &mut Window) -> Trim {
-        let (sa, sb) = (a.scale(), b.scale());
-        pair_trim(a, sa, b, sb, &mut BoundStats::default())
+        pair_trim(a, b, &mut BoundStats::default())
     }
 
     /// After a trim, every point of the original union is still served (within tolerance) by
     /// a surviving window at no more than the original lower envelope.
     fn check_sound(a: Window, b: Window, rng: &mut ChaCha8Rng) {
         let (mut x, mut y) = (a, b);
-        let out = pair_trim(
-            &mut x,
-            a.scale(),
-            &mut y,
-            b.scale(),
-            &mut BoundStats::default(),
-        );
+        let out = pair_trim(&mut x, &mut y, &mut BoundStats::default());
         match out {
             Trim::FirstDead => assert!(x.is_dead()),
             Trim::SecondDead => assert!(y.is_dead()),
@@ -492,7 +494,7 @@ mod tests {
             };
             decided += 1;
             let (mut x2, mut y2) = (a, b);
-            let slow = exact_trim(&mut x2, &mut y2, a.scale().max(b.scale()), l, r);
+            let slow = exact_trim(&mut x2, &mut y2, l, r);
             assert_eq!(fast, slow, "{a:?} {b:?}");
             for (p, q) in [(x1, x2), (y1, y2)] {
                 assert_eq!(p.is_dead(), q.is_dead(), "{a:?} {b:?}");
