@@ -10,7 +10,7 @@
 use anyhow::Result;
 use facemodel::FaceModel;
 use indicatif::ProgressBar;
-use landmarks::{DetectOptions, GenericModel, LandmarkName, Unseen, VisibleLandmarks};
+use landmarks::{DetectOptions, GenericModel, LandmarkName, VisibleLandmarks};
 use meshcore::{DVec3, TriMesh};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -199,16 +199,6 @@ impl ScannedFace {
             self.truth_vertex(nose)?,
         ])
     }
-
-    /// The distance (mm) of detected landmark `n` from its ground truth, or why the detector
-    /// left it unseen; `None` when detection failed.
-    pub fn detection_error(&self, n: LandmarkName) -> Option<Result<f64, Unseen>> {
-        let d = self.detected.as_ref().ok()?;
-        Some(
-            d.get(n)
-                .map(|l| (l.position - self.truth[n as usize].position).length()),
-        )
-    }
 }
 
 /// The landmarks the descriptors take their poles from: the outer eye corners and the nose tip.
@@ -314,13 +304,20 @@ pub fn scan_faces(
         .collect()
 }
 
-/// [`scan_faces`] for one face.
+/// [`scan_faces`] for one face: [`scan_raw`], then [`clean_scan`].
 pub fn scan_face(
     model: &FaceModel,
     generic: &GenericModel,
     spec: &FaceSpec,
     options: &ScanSetOptions,
 ) -> Result<ScannedFace> {
+    let (scan, t_scan) = scan_raw(model, spec)?;
+    clean_scan(&scan, t_scan, generic, options)
+}
+
+/// Samples the face of `spec` and scans it (the raw grid with the projected ground-truth
+/// landmarks, in [`LandmarkName::ALL`] order), with the time it took.
+pub fn scan_raw(model: &FaceModel, spec: &FaceSpec) -> Result<(rangescan::Scan, Duration)> {
     let t0 = Instant::now();
     let face = model.sample(&spec.identity_weights, &spec.expression_weights)?;
     let truth_cm = model.landmark_positions(&face)?;
@@ -350,6 +347,17 @@ pub fn scan_face(
             ..ScanOptions::default()
         },
     )?;
+    Ok((scan, t0.elapsed()))
+}
+
+/// Cleans a raw scan ([`scan_raw`]; its crop around the *true* nose tip), snaps its ground truth
+/// to the cleaned scan and detects the landmarks on it; `t_scan` is the scan's own time.
+pub fn clean_scan(
+    scan: &rangescan::Scan,
+    t_scan: Duration,
+    generic: &GenericModel,
+    options: &ScanSetOptions,
+) -> Result<ScannedFace> {
     let t1 = Instant::now();
     let nose = scan.landmarks[LandmarkName::NoseTip as usize].position;
     let cleaned = scanprep::clean(
@@ -414,7 +422,7 @@ pub fn scan_face(
         truth,
         detected,
         times: StepTimes {
-            scan: t1 - t0,
+            scan: t_scan,
             clean: t2 - t1,
             detect: t3 - t2,
         },

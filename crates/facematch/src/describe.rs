@@ -50,7 +50,7 @@ impl FaceFields {
 }
 
 /// The fields of the landmarks `poles` on `mesh` by `solver` (of `mesh`), cut off at `cutoff`
-/// times the corners' straight distance.
+/// times the corners' straight distance, solved in parallel.
 pub fn face_fields(
     mesh: &TriMesh,
     solver: &dyn GeodesicSolver,
@@ -78,9 +78,17 @@ pub fn face_fields(
             .map_err(|e| format!("geodesic field: {e}"))
     };
     let lost_right = poles.lost.map(|l| l.right);
-    let (ur, tr) = field(poles.r, lost_right == Some(true))?;
-    let (uq, tq) = field(poles.q, lost_right == Some(false))?;
-    let (un, tn) = field(poles.nose, false)?;
+    // The three solves are independent: on two threads when rayon has them.
+    let ((r, q), n) = rayon::join(
+        || {
+            rayon::join(
+                || field(poles.r, lost_right == Some(true)),
+                || field(poles.q, lost_right == Some(false)),
+            )
+        },
+        || field(poles.nose, false),
+    );
+    let ((ur, tr), (uq, tq), (un, tn)) = (r?, q?, n?);
     let d = match poles.lost {
         Some(_) => f64::NAN,
         None => 0.5 * (ur[poles.q as usize] + uq[poles.r as usize]),

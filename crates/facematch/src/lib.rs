@@ -44,7 +44,7 @@ pub use options::{
 };
 pub use poles::{Lost, Pair, Poles};
 pub use prepare::{prepare, prepare_with, PreparedScan, ScanInput, StepTimes};
-pub use template::{enroll, Template, TemplateView, FORMAT_VERSION};
+pub use template::{enroll, views_of, Template, TemplateView, FORMAT_VERSION};
 pub use view::{
     cut_to_view, describe_view, nearest_vertex, probe_direction, seen_within, view_directions,
     ViewCut,

@@ -308,4 +308,58 @@ mod tests {
             Pair::RightNose
         );
     }
+
+    /// A 40 x 40 mm sheet (2 mm grid) and detected landmarks at grid vertices, the right outer
+    /// corner unseen and predicted at `predicted`.
+    fn sheet(predicted: DVec3) -> (TriMesh, VisibleLandmarks) {
+        use landmarks::{Landmark, Unseen};
+        let mesh =
+            meshcore::shapes::grid(20, 20, meshcore::shapes::Diagonals::Alternating, |i, j| {
+                DVec3::new(2.0 * i as f64, 2.0 * j as f64, 0.0)
+            })
+            .unwrap();
+        let at = |i: u32, j: u32| j * 21 + i;
+        // In `LandmarkName::ALL` order: outer right, inner right, inner left, outer left, nose.
+        let vertices = [at(2, 15), at(6, 15), at(14, 15), at(18, 15), at(10, 5)];
+        let landmark = |v: u32| Landmark {
+            vertex: v,
+            position: mesh.position(v),
+            confidence: 1.0,
+        };
+        let mut landmarks = vertices.map(|v| Ok(landmark(v)));
+        landmarks[LandmarkName::OuterEyeRight as usize] =
+            Err(Unseen::Unobserved { agreement: 0.8 });
+        let mut at_pred = vertices.map(|v| mesh.position(v));
+        at_pred[LandmarkName::OuterEyeRight as usize] = predicted;
+        let found = VisibleLandmarks {
+            landmarks,
+            predicted: at_pred,
+            confidence: 1.0,
+            fit_rms: 0.0,
+            inlier_fraction: 1.0,
+            symmetry: 1.0,
+            model_to_mesh: meshcore::DAffine3::IDENTITY,
+        };
+        (mesh, found)
+    }
+
+    #[test]
+    fn an_unseen_corner_is_lost_or_placed_at_its_prediction() {
+        // Predicted 1.02 mm from the sheet's vertex (3, 15), its nearest.
+        let (mesh, d) = sheet(DVec3::new(6.2, 30.0, 1.0));
+        let poles = |lost, predicted| Poles::from_detected(&mesh, &d, lost, predicted, 3.0);
+        let lost = poles(true, false).unwrap();
+        assert_eq!(lost.lost.map(|l| l.right), Some(true));
+        let placed = poles(true, true).unwrap();
+        assert_eq!(placed.lost, None);
+        assert_eq!(placed.r, 15 * 21 + 3);
+        assert_eq!(placed.q, 15 * 21 + 18);
+        // Without lost corners allowed, the unseen corner is an error unless placed.
+        assert!(poles(false, false).unwrap_err().contains("outer_eye_right"));
+        assert_eq!(poles(false, true).unwrap(), placed);
+        // A prediction farther than the snap distance from the sheet stays lost.
+        let (mesh, d) = sheet(DVec3::new(6.0, 30.0, 3.5));
+        let far = Poles::from_detected(&mesh, &d, true, true, 3.0).unwrap();
+        assert!(far.lost.is_some());
+    }
 }

@@ -65,8 +65,10 @@ pub fn prepare(input: ScanInput<'_>, options: &MatchOptions) -> Result<PreparedS
 
 /// Prepares a scan: cleans it (`options.prepare.clean`, no crop), detects the landmarks seen
 /// from the scanner, cleans the input again with a crop of `options.prepare.crop_radius_mm`
-/// around the detected nose tip and detects again on the cropped scan. Errors: the cleaning's,
-/// and [`MatchError::NoFace`] with the detector's reason when no face is found.
+/// around the detected nose tip and detects again on the cropped scan. When no face is found
+/// on the uncropped scan, the first detection is repeated on a crop around the point nearest
+/// the scanner, and the notes say so. Errors: the cleaning's, and [`MatchError::NoFace`] with
+/// the detector's reasons when no face is found.
 pub fn prepare_with(
     input: ScanInput<'_>,
     generic: &GenericModel,
@@ -109,11 +111,51 @@ pub fn prepare_with(
     let first = scanprep::clean(scan_input, &clean_opts)?;
     let used = first.report.units.used;
     let t1 = Instant::now();
-    let found = detect(&first.mesh, generic, scanner, p)?;
+    let first_found = detect(&first.mesh, generic, scanner, p);
+    let (found, found_on) = match (first_found, p.crop_radius_mm) {
+        (Ok(f), _) => (f, first.mesh),
+        (Err(MatchError::NoFace(why)), Some(radius_mm)) => {
+            // A wide scan (shoulders, hair, a second head) can hide the face from the
+            // detector: crop around the point nearest the scanner (on a face seen from the
+            // front, at or near the nose) and look again. Said in the notes.
+            let near = first
+                .mesh
+                .positions()
+                .iter()
+                .copied()
+                .max_by(|a, b| a.dot(scanner).total_cmp(&b.dot(scanner)))
+                .ok_or_else(|| MatchError::NoFace("the cleaned scan is empty".into()))?;
+            let around = scanprep::clean(
+                scan_input,
+                &CleanOptions {
+                    units: Some(used),
+                    crop: Some(Crop {
+                        centre: near / used.mm_per_unit(),
+                        radius_mm,
+                    }),
+                    ..clean_opts.clone()
+                },
+            )?;
+            let f = detect(&around.mesh, generic, scanner, p).map_err(|e| {
+                MatchError::NoFace(format!(
+                    "{why}; cropped around the point nearest the scanner: {}",
+                    match e {
+                        MatchError::NoFace(w) => w,
+                        e => e.to_string(),
+                    }
+                ))
+            })?;
+            notes.push(format!(
+                "no face found on the uncropped scan ({why}): found after a crop of {radius_mm} mm around the point nearest the scanner"
+            ));
+            (f, around.mesh)
+        }
+        (Err(e), _) => return Err(e),
+    };
     let t2 = Instant::now();
     let Some(radius_mm) = p.crop_radius_mm else {
         return Ok(PreparedScan {
-            mesh: first.mesh,
+            mesh: found_on,
             scanner,
             units: used,
             detected: found,
@@ -126,7 +168,7 @@ pub fn prepare_with(
         });
     };
     // The crop's centre in the input's units and frame.
-    let nose_mm = first.mesh.position(
+    let nose_mm = found_on.position(
         found
             .get(LandmarkName::NoseTip)
             .map_err(|u| MatchError::NoFace(format!("the nose tip is {u}")))?

@@ -6,8 +6,10 @@
 //! the count (u32) and each template's bytes with their length (u64).
 
 use crate::view::{describe_view, view_directions};
-use crate::{Description, KeyedSet, Lost, MatchError, MatchOptions, Pair, PreparedScan};
-use meshcore::DVec3;
+use crate::{
+    Description, KeyedSet, Lost, MatchError, MatchOptions, Pair, Poles, PreparedScan, ViewOptions,
+};
+use meshcore::{DVec3, TriMesh};
 use rayon::prelude::*;
 use std::path::Path;
 
@@ -62,17 +64,7 @@ impl Template {
         let poles = scan.poles(options)?;
         let description = crate::describe(&scan.mesh, poles, scan.scanner, options, search)?;
         let views = match &options.view {
-            Some(v) => {
-                let [r, q, _] = description.landmarks;
-                view_directions(scan.scanner, r, q, &v.yaws_deg)
-                    .into_par_iter()
-                    .map(|(yaw_deg, toward)| TemplateView {
-                        yaw_deg,
-                        toward,
-                        sets: describe_view(&scan.mesh, poles, scan.scanner, toward, options, v),
-                    })
-                    .collect()
-            }
+            Some(v) => views_of(&scan.mesh, poles, scan.scanner, options, v),
             None => Vec::new(),
         };
         Ok(Self {
@@ -438,6 +430,27 @@ impl<'a> Reader<'a> {
             _ => Err(self.bad("a descriptor flag")),
         }
     }
+}
+
+/// A template's views of the face `mesh` (landmarks `poles`, own scanner `scanner`): one per
+/// turn of `view.yaws_deg` to either side of the scanner ([`view_directions`]), each described
+/// by [`describe_view`] (in parallel, in order).
+pub fn views_of(
+    mesh: &TriMesh,
+    poles: Poles,
+    scanner: DVec3,
+    options: &MatchOptions,
+    view: &ViewOptions,
+) -> Vec<TemplateView> {
+    let [r, q, _] = poles.positions(mesh);
+    view_directions(scanner, r, q, &view.yaws_deg)
+        .into_par_iter()
+        .map(|(yaw_deg, toward)| TemplateView {
+            yaw_deg,
+            toward,
+            sets: describe_view(mesh, poles, scanner, toward, options, view),
+        })
+        .collect()
 }
 
 /// Prepares a scan ([`crate::prepare`]) and makes its gallery template (no search).

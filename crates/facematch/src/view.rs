@@ -125,6 +125,7 @@ pub fn describe_view(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Pair;
 
     #[test]
     fn views_turn_about_the_vertical_axis_to_both_sides() {
@@ -151,5 +152,48 @@ mod tests {
         let moved = lm.map(|p| rot * p + DVec3::new(3.0, 1.0, 0.0));
         let t = probe_direction(&moved, DVec3::Z, &lm).unwrap();
         assert!((t - rot.inverse() * DVec3::Z).length() < 1e-9);
+    }
+
+    #[test]
+    fn a_view_keeps_a_face_with_a_lost_corner() {
+        // A 100 x 60 mm sheet (2 mm squares), seen turned 30 degrees about the vertical.
+        let m = meshcore::shapes::grid(50, 30, meshcore::shapes::Diagonals::Alternating, |i, j| {
+            DVec3::new(2.0 * i as f64, 2.0 * j as f64, 0.0)
+        })
+        .unwrap();
+        let at = |i: u32, j: u32| j * 51 + i;
+        let poles = Poles::new(at(5, 20), at(45, 20), at(25, 5));
+        let o = MatchOptions {
+            levels: 8,
+            boundary_margin_mm: None,
+            max_incidence_deg: None,
+            search: None,
+            view: None,
+            ..MatchOptions::default()
+        };
+        let v = ViewOptions::default();
+        let toward = DQuat::from_rotation_y(-30f64.to_radians()) * DVec3::Z;
+        let whole = describe_view(&m, poles, DVec3::Z, toward, &o, &v).unwrap();
+        assert!(whole.iter().all(Result::is_ok), "{whole:?}");
+        // The left corner lost at its true place: the cut is the same and so is the right side
+        // pair's descriptor (its frame from the lost corner's place); no other pair.
+        let [_, q, _] = poles.positions(&m);
+        let lost = Poles {
+            q: poles.nose,
+            lost: Some(crate::Lost {
+                right: false,
+                position: q,
+            }),
+            ..poles
+        };
+        let cut = describe_view(&m, lost, DVec3::Z, toward, &o, &v).unwrap();
+        let (corners, left, right) = (
+            Pair::Corners as usize,
+            Pair::LeftNose as usize,
+            Pair::RightNose as usize,
+        );
+        assert!(cut[corners].is_err() && cut[left].is_err());
+        assert_eq!(cut[right], whole[right]);
+        assert!(!cut[right].as_ref().unwrap().points.is_empty());
     }
 }

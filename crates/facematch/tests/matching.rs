@@ -126,3 +126,54 @@ fn a_probe_scores_alike_after_a_rigid_motion_and_in_other_units() {
         "{s0} vs {s1} after a rigid motion and a renumbering, in cm"
     );
 }
+
+#[test]
+fn a_face_beside_another_head_is_found_after_a_crop_and_the_notes_say_so() {
+    let Some([a]) = testsupport::paper_meshes(["id3_neutral.obj"]) else {
+        return;
+    };
+    // A second head 24 cm to the side and 4 cm farther from the scanner (cm): the uncropped
+    // scan is two faces wide.
+    let n = a.n_vertices() as u32;
+    let positions: Vec<DVec3> = a
+        .positions()
+        .iter()
+        .copied()
+        .chain(
+            a.positions()
+                .iter()
+                .map(|p| *p + DVec3::new(24.0, 0.0, -4.0)),
+        )
+        .collect();
+    let triangles: Vec<[u32; 3]> = a
+        .triangles()
+        .iter()
+        .copied()
+        .chain(a.triangles().iter().map(|t| t.map(|v| v + n)))
+        .collect();
+    let two = TriMesh::new(positions, triangles).unwrap();
+    let o = MatchOptions::default();
+    let sc = rangescan::scan(
+        &two,
+        &ScanOptions {
+            input_mm_per_unit: 10.0,
+            seed: 21,
+            ..ScanOptions::default()
+        },
+    )
+    .unwrap();
+    let s = prepare(ScanInput::Grid(&sc.grid), &o).unwrap();
+    // The face found is the front one: the nose tip (the ICT model's vertex 4857) within 5 mm.
+    let truth = sc.scan_from_input.transform_point3(a.position(4857));
+    let nose = s
+        .detected
+        .get(landmarks::LandmarkName::NoseTip)
+        .unwrap()
+        .position;
+    assert!(
+        (nose - truth).length() < 5.0,
+        "nose tip at {nose:?}, the front head's at {truth:?}; notes {:?}",
+        s.notes
+    );
+    eprintln!("notes: {:?}", s.notes);
+}

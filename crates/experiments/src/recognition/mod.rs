@@ -265,8 +265,9 @@ struct Described {
     /// The iso-curvature network's points prepared for ICP (the network itself is not kept).
     iso: Result<PreparedSet, String>,
     lm_pos: [DVec3; 3],
-    /// A gallery face's mesh for view matching (`None` for probes and when off).
-    view: Option<Box<ViewSource>>,
+    /// A gallery face's views and their settings, as its template stores them
+    /// ([`facematch::views_of`]; `None` for probes and when view matching is off).
+    views: Option<(Vec<facematch::TemplateView>, facematch::ViewOptions)>,
     /// Wall time of each description (bipolar, single pole, facial curves, iso-curvature): the
     /// geodesic fields it needs (both corners; the nose tip) and its own build.
     secs: [f64; 4],
@@ -428,7 +429,7 @@ fn describe_face(
         facial,
         iso,
         lm_pos: [r, q, nose],
-        view: None,
+        views: None,
         secs: [
             t_corners + t_bip,
             t_nose + t_pol,
@@ -441,58 +442,6 @@ fn describe_face(
 /// Directions of the reference-point search around each pole (the recognition benchmarks and
 /// scan-study).
 pub(crate) const SEARCH_DIRECTIONS: usize = 6;
-
-/// What a gallery face needs to be described again as a probe's scanner would see it.
-#[derive(Debug)]
-struct ViewSource {
-    mesh: TriMesh,
-    lm: Lm,
-    /// The gallery's own description settings.
-    matching: facematch::MatchOptions,
-    /// Below this angle (degrees) between the two scanner directions the face's own
-    /// description is used.
-    min_angle_deg: f64,
-}
-
-impl ViewSource {
-    /// The view-matching settings: the benchmark describes each view from the probe's exact
-    /// direction (no stored turns).
-    fn view_options(&self) -> facematch::ViewOptions {
-        facematch::ViewOptions {
-            min_angle_deg: self.min_angle_deg,
-            yaws_deg: Vec::new(),
-            ..facematch::ViewOptions::default()
-        }
-    }
-
-    /// The gallery face described as a scanner would measure it from the probe's scanner
-    /// direction ([`crate::scans::SCANNER_SIDE`] in the probe's frame, carried into the
-    /// gallery's by the rigid fit of the probe's landmarks `probe_lm` onto the gallery's;
-    /// [`facematch::describe_view`]), as the template's one view. `None` when the directions
-    /// are within `min_angle_deg` or the fit fails; a view that cannot be described is the
-    /// view's error (the comparison then falls back on the face's own description, counted).
-    fn view_from(&self, probe_lm: &[DVec3; 3]) -> Option<facematch::TemplateView> {
-        let side = crate::scans::SCANNER_SIDE;
-        let own = self.lm.positions(&self.mesh);
-        let toward = facematch::probe_direction(probe_lm, side, &own)?;
-        if toward.angle_between(side).to_degrees() < self.min_angle_deg {
-            return None;
-        }
-        let sets = facematch::describe_view(
-            &self.mesh,
-            self.lm,
-            side,
-            toward,
-            &self.matching,
-            &self.view_options(),
-        );
-        Some(facematch::TemplateView {
-            yaw_deg: f64::NAN,
-            toward,
-            sets,
-        })
-    }
-}
 
 /// Iterations of the recognition ICP ([`crate::pipeline::trimmed_icp`]).
 const ICP_ITERATIONS: usize = 6;
@@ -515,29 +464,24 @@ fn icp_points(mesh: &TriMesh, n: usize) -> Vec<DVec3> {
     mesh.positions().iter().step_by(stride).copied().collect()
 }
 
-/// A probe `x` compared with a gallery face `y` by [`facematch::compare`] (with view matching
-/// against the gallery face as the probe's scanner would see it; per pair the least over the
-/// probe's own and moved descriptors), or `None` when a side has no descriptions.
+/// A probe `x` compared with a gallery face `y` by [`facematch::compare`], as with `y`'s
+/// template (view matching against its stored view nearest the probe's scanner direction; per
+/// pair the least over the probe's own and moved descriptors), or `None` when a side has no
+/// descriptions.
 fn bipolar_compare(x: &Described, y: &Described) -> Option<facematch::Comparison> {
     let (Ok(xd), Ok(yd)) = (&x.bip, &y.bip) else {
         return None;
     };
-    let views = y
-        .view
-        .as_ref()
-        .and_then(|v| v.view_from(&xd.landmarks))
-        .into_iter()
-        .collect();
     let template = facematch::Template {
         identity: String::new(),
         source: String::new(),
         settings: String::new(),
         description: yd.clone(),
-        views,
+        views: y.views.as_ref().map_or(Vec::new(), |v| v.0.clone()),
         notes: Vec::new(),
     };
     let o = facematch::MatchOptions {
-        view: y.view.as_ref().map(|v| v.view_options()),
+        view: y.views.as_ref().map(|v| v.1.clone()),
         ..x.matching.clone()
     };
     Some(facematch::compare(xd, &template, &o))
@@ -935,7 +879,6 @@ pub fn run(args: Args) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use meshcore::DQuat;
 
     #[test]
     fn detect_only_writes_one_row_per_scan_and_stops() {
@@ -1062,62 +1005,6 @@ mod tests {
         // integer sum).
         let p = mcnemar_exact(300, 200);
         assert!((p / 8.940066542253267e-6 - 1.0).abs() < 1e-9, "{p}");
-    }
-
-    /// A flat sheet of `nx` x `ny` squares of 2 mm and its landmarks at the grid points `at`
-    /// (r, q, nose tip).
-    fn plane_face(nx: usize, ny: usize, at: [(u32, u32); 3]) -> (TriMesh, Lm) {
-        let m = meshcore::shapes::grid(nx, ny, meshcore::shapes::Diagonals::Alternating, |i, j| {
-            DVec3::new(2.0 * i as f64, 2.0 * j as f64, 0.0)
-        })
-        .unwrap();
-        let [r, q, nose] = at.map(|(i, j)| j * (nx as u32 + 1) + i);
-        (m, Lm::new(r, q, nose))
-    }
-
-    #[test]
-    fn view_matching_keeps_a_face_with_a_lost_corner() {
-        // A 100 x 60 mm sheet, seen by a probe turned 30 degrees about the vertical.
-        let (m, lm) = plane_face(50, 30, [(5, 20), (45, 20), (25, 5)]);
-        let source = |lm: Lm| ViewSource {
-            mesh: m.clone(),
-            lm,
-            matching: facematch::MatchOptions {
-                levels: 8,
-                boundary_margin_mm: None,
-                max_incidence_deg: None,
-                search: None,
-                view: None,
-                ..facematch::MatchOptions::default()
-            },
-            min_angle_deg: 10.0,
-        };
-        let [r, q, nose] = lm.positions(&m);
-        let turn = DQuat::from_rotation_y(30f64.to_radians());
-        let probe = [r, q, nose].map(|p| turn * p);
-        let whole = source(lm).view_from(&probe).unwrap().sets.unwrap();
-        assert!(whole.iter().all(Result::is_ok), "{whole:?}");
-        // The left corner lost at its true place: the cut is the same and the right side
-        // pair's descriptor too (its frame from the lost corner's place); no other pair.
-        let lost = Lm {
-            q: lm.nose,
-            lost: Some(facematch::Lost {
-                right: false,
-                position: q,
-            }),
-            ..lm
-        };
-        let cut = source(lost).view_from(&probe).unwrap().sets.unwrap();
-        let (corners, left) = (
-            facematch::Pair::Corners as usize,
-            facematch::Pair::LeftNose as usize,
-        );
-        assert!(cut[corners].is_err() && cut[left].is_err());
-        let right = facematch::Pair::RightNose as usize;
-        assert_eq!(cut[right], whole[right]);
-        assert!(!cut[right].as_ref().unwrap().points.is_empty());
-        // Below the angle, no view.
-        assert!(source(lost).view_from(&[r, q, nose]).is_none());
     }
 
     #[test]

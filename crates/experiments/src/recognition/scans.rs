@@ -1,7 +1,8 @@
 //! `cargo xtask recognition --scans`: the benchmark on range scans. Faces sampled from the ICT
-//! model are scanned by `rangescan`, cleaned by `scanprep` (crop around the nose tip) and
-//! described on the cleaned scans with the ground-truth landmarks the scanner projected and with
-//! the landmarks `landmarks::detect_visible` places (seen from the scanner). Gallery: neutral
+//! model are scanned by `rangescan` and described twice: with the ground-truth landmarks the
+//! scanner projected, on the scan cleaned by `scanprep` with a crop around the true nose tip,
+//! and as a user's scan is, on the scan `facematch::prepare` makes (cleaned, cropped around the
+//! *detected* nose tip) with the landmarks it detects (seen from the scanner). Gallery: neutral
 //! frontal scans at the `--scan-*` settings; probes: the other expressions, each under a random
 //! yaw of 0-45 degrees (either side) and a random noise level. Every face is described by three
 //! pole pairs (the outer eye corners; each outer corner with the nose tip); a probe turned past
@@ -16,13 +17,13 @@ use super::{
     describe_face, elastic_options, icp_points, iso_levels_of, median, order_stat, paired_table,
     results_table, roc_figure, score_row, summarize, time_comparisons, time_descriptions,
     timed_pairs, write_summary, Args, DescribeOptions, Described, Lm, Metrics, PairDistances, Row,
-    ViewSource, SCORES, SEARCH_DIRECTIONS, TIMED_FACES,
+    SCORES, SEARCH_DIRECTIONS, TIMED_FACES,
 };
 use crate::pipeline::{bar, resolve_methods};
 use crate::report::{line_plot, Report, Series};
 use crate::scans::{
-    sample_weights, scan_face, scan_seed, FaceSpec, ScanSetOptions, ScanSettings, ScannedFace,
-    MAX_SNAP_MM, REFERENCE_LANDMARKS,
+    clean_scan, sample_weights, scan_face, scan_raw, scan_seed, FaceSpec, ScanSetOptions,
+    ScanSettings, ScannedFace, MAX_SNAP_MM, REFERENCE_LANDMARKS, SCANNER_SIDE,
 };
 use crate::walk::Walker;
 use anyhow::{bail, Context, Result};
@@ -80,12 +81,14 @@ fn sweeps() -> Vec<Sweep> {
 struct Face {
     name: String,
     identity: usize,
-    /// The cleaned scan, kept for gallery faces (ICP target).
-    mesh: Option<TriMesh>,
+    /// Per landmark set, the cleaned scan, kept for gallery faces (ICP target): for the ground
+    /// truth cropped around the true nose tip, for the detected landmarks the scan
+    /// `facematch::prepare` made (cropped around the detected nose tip).
+    mesh: [Option<TriMesh>; 2],
     /// Its ground-truth landmark vertices, when on the scan.
     gt_lm: Option<Lm>,
-    /// ICP probe points.
-    pts: Vec<DVec3>,
+    /// Per landmark set, the ICP probe points (of that set's scan).
+    pts: [Vec<DVec3>; 2],
     /// Per landmark set: the description or why there is none.
     desc: [Result<Described, String>; 2],
     /// Detected minus true position of the outer eye corners and the nose tip (mm), when
@@ -93,7 +96,8 @@ struct Face {
     det_err: Option<[f64; 3]>,
     valid_samples: usize,
     vertices: usize,
-    /// Wall seconds: scan, clean, detect, describe.
+    /// Wall seconds: scan, clean (ground truth's), prepare (the detected path's cleanings and
+    /// detections), describe.
     secs: [f64; 4],
 }
 
@@ -112,6 +116,7 @@ fn process(
     method: Method,
     dopt: &DescribeOptions,
     scan_opts: &ScanSetOptions,
+    prep: &facematch::MatchOptions,
     icp_n: usize,
     msg: &str,
 ) -> Vec<Face> {
@@ -120,7 +125,7 @@ fn process(
         .par_iter()
         .map(|spec| {
             let f = describe_spec(
-                model, generic, spec, keep_mesh, method, dopt, scan_opts, icp_n,
+                model, generic, spec, keep_mesh, method, dopt, scan_opts, prep, icp_n,
             );
             pb.inc(1);
             f
@@ -143,14 +148,20 @@ fn truth_lm(s: &ScannedFace, allow_lost: bool) -> Result<Lm, String> {
     )
 }
 
-/// The detected landmarks of a scan ([`Lm::from_detected`]: a corner the detector reported
-/// unseen may be lost, at the place the fitted face predicts, or with `predicted` placed at the
-/// vertex nearest that place when it is within [`MAX_SNAP_MM`] of the scan).
-fn detected_lm(s: &ScannedFace, allow_lost: bool, predicted: bool) -> Result<Lm, String> {
-    let d = s.detected.as_ref().map_err(|e| format!("detection: {e}"))?;
-    Lm::from_detected(&s.mesh, d, allow_lost, predicted, MAX_SNAP_MM)
+/// Distances (mm) of the detected outer eye corners and nose tip from their ground truth (an
+/// unseen one counts as infinitely far off), when the ground truth is on the scan.
+fn detection_errors(s: &ScannedFace, found: &landmarks::VisibleLandmarks) -> Option<[f64; 3]> {
+    s.truth_vertices().ok()?;
+    Some(REFERENCE_LANDMARKS.map(|n| {
+        found.get(n).map_or(f64::INFINITY, |l| {
+            (l.position - s.truth[n as usize].position).length()
+        })
+    }))
 }
 
+/// Scans the face of `spec`; cleans it for the ground-truth landmarks (crop around the true nose
+/// tip) and prepares it as a user would for the detected ones ([`facematch::prepare_with`]:
+/// crop around the detected nose tip, no ground truth); describes both.
 #[allow(clippy::too_many_arguments)]
 fn describe_spec(
     model: &FaceModel,
@@ -160,42 +171,49 @@ fn describe_spec(
     method: Method,
     dopt: &DescribeOptions,
     scan_opts: &ScanSetOptions,
+    prep: &facematch::MatchOptions,
     icp_n: usize,
 ) -> Face {
     let mut face = Face {
         name: spec.name.clone(),
         identity: spec.identity,
-        mesh: None,
+        mesh: [None, None],
         gt_lm: None,
-        pts: Vec::new(),
+        pts: [Vec::new(), Vec::new()],
         desc: [Err(String::new()), Err(String::new())],
         det_err: None,
         valid_samples: 0,
         vertices: 0,
         secs: [0.0; 4],
     };
-    let s = match scan_face(model, generic, spec, scan_opts) {
-        Ok(s) => s,
+    let gt_opts = ScanSetOptions {
+        detect: None,
+        ..scan_opts.clone()
+    };
+    let scanned = scan_raw(model, spec).and_then(|(raw, t_scan)| {
+        let s = clean_scan(&raw, t_scan, generic, &gt_opts)?;
+        Ok((raw, s))
+    });
+    let (raw, s) = match scanned {
+        Ok(x) => x,
         Err(e) => {
             let e = format!("scan or cleaning: {e:#}");
             face.desc = [Err(e.clone()), Err(e)];
             return face;
         }
     };
+    let t = Instant::now();
+    let prepared = facematch::prepare_with(facematch::ScanInput::Grid(&raw.grid), generic, prep)
+        .map_err(|e| format!("prepare: {e}"));
+    drop(raw);
+    face.secs[2] = t.elapsed().as_secs_f64();
     face.valid_samples = s.valid_samples;
     face.vertices = s.mesh.n_vertices();
     face.secs[0] = s.times.scan.as_secs_f64();
     face.secs[1] = s.times.clean.as_secs_f64();
-    face.secs[2] = s.times.detect.as_secs_f64();
-    face.pts = icp_points(&s.mesh, icp_n);
-    if s.detected.is_ok() && s.truth_vertices().is_ok() {
-        // An unseen landmark counts as infinitely far off.
-        face.det_err = Some(REFERENCE_LANDMARKS.map(|n| {
-            s.detection_error(n)
-                .map_or(f64::INFINITY, |e| e.unwrap_or(f64::INFINITY))
-        }));
+    if let Ok(p) = &prepared {
+        face.det_err = detection_errors(&s, &p.detected);
     }
-    let t = Instant::now();
     // The reference-point search is the probes' (the gallery keeps its one description).
     let gallery_opts;
     let dopt = if keep_mesh {
@@ -208,41 +226,49 @@ fn describe_spec(
         dopt
     };
     let allow_lost = dopt.side_pair_deg.is_some();
+    let t = Instant::now();
+    let meshes: [Result<TriMesh, String>; 2] =
+        [Ok(s.mesh.clone()), prepared.clone().map(|p| p.mesh)];
     let lms = [
         truth_lm(&s, allow_lost),
-        detected_lm(&s, allow_lost, dopt.predicted_corners),
+        prepared.as_ref().map_err(Clone::clone).and_then(|p| {
+            Lm::from_detected(
+                &p.mesh,
+                &p.detected,
+                allow_lost,
+                dopt.predicted_corners,
+                MAX_SNAP_MM,
+            )
+        }),
     ];
     face.gt_lm = lms[0].as_ref().ok().copied();
-    face.desc = match geodesic::new_solver(&s.mesh, method) {
-        Ok(solver) => {
-            let walker = Walker::new(&s.mesh);
-            lms.clone().map(|lm| {
-                lm.and_then(|lm| describe_face(&s.mesh, solver.as_ref(), &walker, lm, dopt))
-            })
-        }
-        Err(e) => [
-            Err(format!("geodesic solver: {e}")),
-            Err(format!("geodesic solver: {e}")),
-        ],
-    };
-    face.secs[3] = t.elapsed().as_secs_f64();
-    if let (true, Some(min_angle_deg)) = (keep_mesh, dopt.view_match) {
-        for (d, lm) in face.desc.iter_mut().zip(lms) {
-            if let (Ok(d), Ok(lm)) = (d, lm) {
-                d.view = Some(Box::new(ViewSource {
-                    mesh: s.mesh.clone(),
-                    lm,
-                    matching: facematch::MatchOptions {
-                        method,
-                        ..dopt.matching()
-                    },
-                    min_angle_deg,
-                }));
-            }
+    for k in 0..2 {
+        let (Ok(mesh), Ok(lm)) = (&meshes[k], &lms[k]) else {
+            face.desc[k] = Err(lms[k].clone().err().unwrap_or_default());
+            continue;
+        };
+        face.pts[k] = icp_points(mesh, icp_n);
+        face.desc[k] = geodesic::new_solver(mesh, method)
+            .map_err(|e| format!("geodesic solver: {e}"))
+            .and_then(|solver| describe_face(mesh, solver.as_ref(), &Walker::new(mesh), *lm, dopt));
+        if let (true, Some(min_angle_deg), Ok(d)) = (keep_mesh, dopt.view_match, &mut face.desc[k])
+        {
+            // The gallery face's template views (facematch's, computed once).
+            let view = facematch::ViewOptions {
+                min_angle_deg,
+                ..facematch::ViewOptions::default()
+            };
+            let matching = facematch::MatchOptions {
+                method,
+                ..dopt.matching()
+            };
+            let views = facematch::views_of(mesh, *lm, SCANNER_SIDE, &matching, &view);
+            d.views = Some((views, view));
         }
     }
+    face.secs[3] = t.elapsed().as_secs_f64();
     if keep_mesh {
-        face.mesh = Some(s.mesh);
+        face.mesh = meshes.map(Result::ok);
     }
     face
 }
@@ -251,7 +277,7 @@ fn describe_spec(
 /// per comparison (timed on pairs of this group) and per description (`ms_desc`).
 fn score_group(
     gallery: &[Face],
-    locators: &[Option<FaceLocator<'_>>],
+    locators: &[[Option<FaceLocator<'_>>; 2]],
     probes: &[Face],
     elastic: &ElasticOptions,
     ms_desc: &[f64; 4],
@@ -266,15 +292,15 @@ fn score_group(
         let gal: Vec<Option<(&Described, &FaceLocator<'_>)>> = gallery
             .iter()
             .zip(locators)
-            .map(|(g, l)| g.desc[k].as_ref().ok().zip(l.as_ref()))
+            .map(|(g, l)| g.desc[k].as_ref().ok().zip(l[k].as_ref()))
             .collect();
         let (rows, pairs): (Vec<Row>, Vec<Vec<PairDistances>>) = probes
             .par_iter()
-            .map(|p| score_row(p.desc[k].as_ref().ok(), &p.pts, &gal, elastic))
+            .map(|p| score_row(p.desc[k].as_ref().ok(), &p.pts[k], &gal, elastic))
             .unzip();
         let pr: Vec<(Option<&Described>, &[DVec3])> = probes
             .iter()
-            .map(|p| (p.desc[k].as_ref().ok(), p.pts.as_slice()))
+            .map(|p| (p.desc[k].as_ref().ok(), p.pts[k].as_slice()))
             .collect();
         let ms_cmp = time_comparisons(&timed_pairs(&pr, &gal), elastic)?;
         all.extend(summarize(&rows, &ms_cmp, ms_desc, &pid, &gid, set));
@@ -425,7 +451,7 @@ fn detect_only(
     model: &FaceModel,
     generic: &GenericModel,
     specs: &[&FaceSpec],
-    scan_opts: &ScanSetOptions,
+    prep: &facematch::MatchOptions,
     out: &std::path::Path,
 ) -> Result<()> {
     /// One scan: its outcome, each landmark's error (`None`: not placed) and the reasons.
@@ -435,11 +461,18 @@ fn detect_only(
         confidence: Option<f64>,
         why: String,
     }
-    let pb = bar(specs.len(), "scan, clean, detect");
+    let pb = bar(specs.len(), "scan, prepare (clean, detect, crop, detect)");
     let outcomes: Vec<Outcome> = specs
         .par_iter()
         .map(|spec| {
-            let r = scan_face(model, generic, spec, scan_opts);
+            let r = scan_raw(model, spec).map(|(raw, _)| {
+                let p = facematch::prepare_with(
+                    facematch::ScanInput::Grid(&raw.grid),
+                    generic,
+                    prep,
+                );
+                (raw, p)
+            });
             pb.inc(1);
             let failed = |status, why| Outcome {
                 status,
@@ -448,34 +481,35 @@ fn detect_only(
                 why,
             };
             match r {
-                Err(e) => failed("scan or cleaning failed", format!("{e:#}")),
-                Ok(s) => match &s.detected {
-                    Err(e) => failed("not found", e.clone()),
-                    Ok(d) => {
-                        let mut why = Vec::new();
-                        let err = REFERENCE_LANDMARKS.map(|n| match s.detection_error(n) {
-                            Some(Ok(e)) => Some(e),
-                            None => None,
-                            Some(Err(u)) => {
+                Err(e) => failed("scan failed", format!("{e:#}")),
+                Ok((_, Err(e))) => failed("not found", e.to_string()),
+                Ok((raw, Ok(p))) => {
+                    let d = &p.detected;
+                    let mut why = Vec::new();
+                    let err = REFERENCE_LANDMARKS.map(|n| {
+                        let k = n as usize;
+                        let truth = raw.landmarks[k].position;
+                        match d.get(n) {
+                            Ok(l) => Some((l.position - truth).length()),
+                            Err(u) => {
                                 // Where the fitted face puts it: how far the pole would be
                                 // if it were used anyway.
-                                let k = n as usize;
-                                let off = (d.predicted[k] - s.truth[k].position).length();
+                                let off = (d.predicted[k] - truth).length();
                                 why.push(format!(
                                     "{}: {u}; the fitted face predicts it {off:.2} mm from its ground truth",
                                     n.key()
                                 ));
                                 None
                             }
-                        });
-                        Outcome {
-                            status: "found",
-                            err,
-                            confidence: Some(d.confidence),
-                            why: why.join("; "),
                         }
+                    });
+                    Outcome {
+                        status: "found",
+                        err,
+                        confidence: Some(d.confidence),
+                        why: why.join("; "),
                     }
-                },
+                }
             }
         })
         .collect();
@@ -503,7 +537,7 @@ fn detect_only(
         .collect();
     let mut rep = Report::new(out, "Landmark detection on the recognition's scans")?;
     rep.para(&format!(
-        "`--detect-only`: landmarks found on {found} of {} scans (gallery, probes and sweeps of the run; `landmarks::detect_visible`, seen from the scanner). Errors are distances from the ground truth carried through the scanner (mm); a landmark not placed (not found, or unseen) has none.",
+        "`--detect-only`: landmarks found on {found} of {} scans (gallery, probes and sweeps of the run; `facematch::prepare`: cleaned, `landmarks::detect_visible` seen from the scanner, cropped around the detected nose tip, detected again). Errors are distances from the ground truth carried through the scanner (mm); a landmark not placed (not found, or unseen) has none.",
         outcomes.len()
     ));
     rep.csv(
@@ -667,6 +701,20 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         predicted_corners: args.predicted_corners,
         search_all_pairs: !args.own_pair_search,
     };
+    // The detected landmarks' path is a user's: `facematch::prepare` with the same cleaning,
+    // its crop around the detected nose tip.
+    let prep = facematch::MatchOptions {
+        prepare: facematch::PrepareOptions {
+            clean: CleanOptions {
+                crop: None,
+                ..scan_opts.clean.clone()
+            },
+            crop_radius_mm: Some(args.scan.crop_radius),
+            detect_smoothing: args.detect_smooth,
+            detect: scan_opts.detect.unwrap_or_default(),
+        },
+        ..dopt.matching()
+    };
     let elastic = elastic_options(args.curve_samples);
     // Specs: gallery, main probes, sweeps (each face its own scan seed).
     let weights = sample_weights(model, identities, expressions, args.seed);
@@ -756,7 +804,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
             .chain(&probe_specs)
             .chain(sweep_specs.iter().flatten().flatten())
             .collect();
-        return detect_only(model, &generic, &specs, &scan_opts, &out);
+        return detect_only(model, &generic, &specs, &prep, &out);
     }
     let methods = resolve_methods(&args.method, &meshcore::shapes::icosphere(1))?;
     let method = methods[0].used;
@@ -808,21 +856,22 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
             method,
             &dopt,
             &scan_opts,
+            &prep,
             args.icp_points,
             msg,
         )
     };
     let gallery = run(&gallery_specs, true, "gallery scans");
-    let locators: Vec<Option<FaceLocator<'_>>> = gallery
+    let locators: Vec<[Option<FaceLocator<'_>>; 2]> = gallery
         .iter()
-        .map(|g| g.mesh.as_ref().map(FaceLocator::new))
+        .map(|g| [0, 1].map(|k| g.mesh[k].as_ref().map(FaceLocator::new)))
         .collect();
     let probes = run(&probe_specs, false, "probe scans");
     // Description times: the first gallery scans again, one at a time on one thread.
     let first: Vec<(&TriMesh, Lm)> = gallery
         .iter()
         .filter_map(|g| {
-            let m = g.mesh.as_ref()?;
+            let m = g.mesh[0].as_ref()?;
             g.gt_lm.map(|lm| (m, lm))
         })
         .take(TIMED_FACES)
@@ -857,7 +906,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         "Recognition benchmark on range scans of sampled ICT faces",
     )?;
     rep.para(&format!(
-        "{identities} identities x {expressions} faces (seed {}). Gallery: {} neutral frontal scans ({}). Probes: {} scans of the other expressions, each under a random yaw of 0-45 degrees to either side and a noise of {} mm (other settings as the gallery). Scans by `rangescan` (orthographic), cleaned by `scanprep` (spikes, holes up to 10 mm, small components, crop of {} mm around the true nose tip{}). Geodesics: {}. Bipolar descriptor: static area, N = {} levels between the outer eye corners, {}; single pole: {} sectors around the nose tip; ICP: about {} probe vertices onto the gallery surface from the 3-landmark alignment, 10 % trimmed, score = RMS closest-point distance (mm); facial curves: N level curves of the nose-tip field up to D, elastic distance ({} segments per curve, one start-point candidate, one alternation), root sum of squares; iso-curvature: {} levels per principal field (quantiles of the first gallery scan) in the geodesic disc of radius D around the nose tip, normalised RMS closest-point distance after an ICP started from the 3-landmark alignment. Times, single thread (one-thread pool after the parallel work): per comparison the mean over up to 24 probe x gallery pairs per group and landmark set; per description the median over the first 6 gallery scans (ground truth) of the fields a representation needs plus its build. Ground-truth landmarks: the model's landmark vertices carried through the scanner, at the nearest vertex of the cleaned scan (a landmark the scanner does not see is a failure); detected: `landmarks::detect_visible` on the cleaned scan, seen from the scanner (+z).",
+        "{identities} identities x {expressions} faces (seed {}). Gallery: {} neutral frontal scans ({}). Probes: {} scans of the other expressions, each under a random yaw of 0-45 degrees to either side and a noise of {} mm (other settings as the gallery). Scans by `rangescan` (orthographic), cleaned by `scanprep` (spikes, holes up to 10 mm, small components, crop of {} mm around the nose tip{}): for the ground-truth landmarks around the true nose tip; for the detected landmarks by `facematch::prepare`, as a user's scans are (cleaned, landmarks detected, cleaned again with the crop around the *detected* nose tip, detected again: no ground truth on that path, and ICP's detected rows use these scans too). Geodesics: {}. Bipolar descriptor: static area, N = {} levels between the outer eye corners, {}; single pole: {} sectors around the nose tip; ICP: about {} probe vertices onto the gallery surface from the 3-landmark alignment, 10 % trimmed, score = RMS closest-point distance (mm); facial curves: N level curves of the nose-tip field up to D, elastic distance ({} segments per curve, one start-point candidate, one alternation), root sum of squares; iso-curvature: {} levels per principal field (quantiles of the first gallery scan) in the geodesic disc of radius D around the nose tip, normalised RMS closest-point distance after an ICP started from the 3-landmark alignment. Times, single thread (one-thread pool after the parallel work): per comparison the mean over up to 24 probe x gallery pairs per group and landmark set; per description the median over the first 6 gallery scans (ground truth) of the fields a representation needs plus its build. Ground-truth landmarks: the model's landmark vertices carried through the scanner, at the nearest vertex of the cleaned scan (a landmark the scanner does not see is a failure); detected: `landmarks::detect_visible` on the scan `facematch::prepare` made, seen from the scanner (+z).",
         args.seed,
         gallery.len(),
         base.label(),
@@ -998,7 +1047,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
     rep.para("Per scan: the distance of each detected landmark from its ground truth (`landmarks.csv`; empty where detection failed or the ground truth is not on the scan).");
     let time_row = |k: usize| median(everyone.iter().map(|f| f.secs[k]).collect());
     rep.para(&format!(
-        "Per scan (median wall time, {} valid samples, {} vertices after cleaning): scan {:.2} s, clean {:.2} s, detect {:.2} s, the four representations with both landmark sets {:.2} s (faces in parallel on every core, so these are upper bounds of the single-scan times).",
+        "Per scan (median wall time, {} valid samples, {} vertices after cleaning): scan {:.2} s, clean (ground truth's) {:.2} s, `facematch::prepare` (the detected landmarks' cleanings and detections) {:.2} s, the four representations with both landmark sets {:.2} s (faces in parallel on every core, so these are upper bounds of the single-scan times).",
         median(everyone.iter().map(|f| f.valid_samples as f64).collect()),
         median(everyone.iter().map(|f| f.vertices as f64).collect()),
         time_row(0), time_row(1), time_row(2), time_row(3)
@@ -1130,74 +1179,4 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
     eprintln!("{} failures; {secs:.1} s wall", fails.len());
     println!("{}", out.display());
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::scans::{StepTimes, Truth};
-    use landmarks::{Landmark, LandmarkName as L, Unseen, VisibleLandmarks};
-    use meshcore::DAffine3;
-
-    /// A 40 x 40 mm sheet (2 mm grid) with landmarks at grid vertices; the right outer corner
-    /// unseen, predicted at `predicted`.
-    fn sheet(predicted: DVec3) -> ScannedFace {
-        let mesh =
-            meshcore::shapes::grid(20, 20, meshcore::shapes::Diagonals::Alternating, |i, j| {
-                DVec3::new(2.0 * i as f64, 2.0 * j as f64, 0.0)
-            })
-            .unwrap();
-        let at = |i: u32, j: u32| j * 21 + i;
-        // In `LandmarkName::ALL` order: outer right, inner right, inner left, outer left, nose.
-        let vertices = [at(2, 15), at(6, 15), at(14, 15), at(18, 15), at(10, 5)];
-        let landmark = |v: u32| Landmark {
-            vertex: v,
-            position: mesh.position(v),
-            confidence: 1.0,
-        };
-        let mut landmarks = vertices.map(|v| Ok(landmark(v)));
-        landmarks[L::OuterEyeRight as usize] = Err(Unseen::Unobserved { agreement: 0.8 });
-        let mut at_pred = vertices.map(|v| mesh.position(v));
-        at_pred[L::OuterEyeRight as usize] = predicted;
-        let truth = vertices.map(|v| Truth {
-            position: mesh.position(v),
-            scanner: rangescan::Visibility::Visible,
-            vertex: Ok((v, 0.0)),
-        });
-        ScannedFace {
-            valid_samples: 0,
-            detected: Ok(VisibleLandmarks {
-                landmarks,
-                predicted: at_pred,
-                confidence: 1.0,
-                fit_rms: 0.0,
-                inlier_fraction: 1.0,
-                symmetry: 1.0,
-                model_to_mesh: DAffine3::IDENTITY,
-            }),
-            mesh,
-            truth,
-            times: StepTimes::default(),
-        }
-    }
-
-    #[test]
-    fn an_unseen_corner_is_lost_or_placed_at_its_prediction() {
-        // Predicted 1.02 mm from the sheet's vertex (3, 15), its nearest.
-        let s = sheet(DVec3::new(6.2, 30.0, 1.0));
-        let lost = detected_lm(&s, true, false).unwrap();
-        assert_eq!(lost.lost.map(|l| l.right), Some(true));
-        let placed = detected_lm(&s, true, true).unwrap();
-        assert_eq!(placed.lost, None);
-        assert_eq!(placed.r, 15 * 21 + 3);
-        assert_eq!(placed.q, 15 * 21 + 18);
-        // Without lost corners allowed, the unseen corner is an error unless placed.
-        assert!(detected_lm(&s, false, false)
-            .unwrap_err()
-            .contains("outer_eye_right"));
-        assert_eq!(detected_lm(&s, false, true).unwrap(), placed);
-        // A prediction farther than MAX_SNAP_MM from the scan stays lost.
-        let far = sheet(DVec3::new(6.0, 30.0, MAX_SNAP_MM + 0.5));
-        assert!(detected_lm(&far, true, true).unwrap().lost.is_some());
-    }
 }
