@@ -121,3 +121,107 @@ fn enrolling_a_non_face_says_no_face_was_found() {
         "{e}"
     );
 }
+
+#[test]
+fn identify_ranks_the_benchmarks_own_scans_as_the_benchmark() {
+    let model = testsupport::require_shared!(testsupport::MODEL);
+    let dir = tempfile::tempdir().unwrap();
+    let (scans, out) = (dir.path().join("scans"), dir.path().join("bench"));
+    // The scan benchmark on 3 identities (a neutral frontal gallery scan each, one turned probe
+    // each), writing its raw scans.
+    #[derive(clap::Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: experiments::recognition::Args,
+    }
+    let s = |p: &std::path::Path| p.to_str().unwrap().to_string();
+    let (model, scans_s, out_s) = (s(&model), s(&scans), s(&out));
+    let args = <Cli as clap::Parser>::parse_from([
+        "recognition",
+        "--scans",
+        "--identities",
+        "3",
+        "--expressions",
+        "2",
+        "--no-sweeps",
+        "--model",
+        &model,
+        "--out",
+        &out_s,
+        "--save-scans",
+        &scans_s,
+    ])
+    .args;
+    experiments::recognition::run(args).unwrap();
+    // Its bipolar distances with the detected landmarks (the path a user's scan takes): per
+    // probe and gallery identity, the three pairs' distances; the score is their least.
+    let text = std::fs::read_to_string(out.join("bipolar-pairs.csv")).unwrap();
+    let mut bench: std::collections::BTreeMap<String, Vec<(String, f64)>> = Default::default();
+    for line in text.lines().skip(1) {
+        let c: Vec<&str> = line.split(',').collect();
+        if c[2] != "detected" {
+            continue;
+        }
+        let d: Vec<f64> = c[5..8].iter().map(|x| x.parse().unwrap()).collect();
+        let score = d.iter().copied().fold(f64::INFINITY, f64::min);
+        let gallery = format!("id{:02}", c[4].parse::<usize>().unwrap());
+        bench
+            .entry(c[0].to_string())
+            .or_default()
+            .push((gallery, score));
+    }
+    assert_eq!(bench.len(), 3, "{text}");
+    // The same scans through the CLI.
+    let gallery = s(&dir.path().join("gallery"));
+    let mut enroll: Vec<String> = (0..3)
+        .map(|i| s(&scans.join(format!("id{i:02}-e0.bnt"))))
+        .collect();
+    enroll.extend([
+        "--out".into(),
+        gallery.clone(),
+        "--identity-from".into(),
+        r"^(id\d+)-".into(),
+    ]);
+    let r = bipolar_cmd(
+        "enroll",
+        &enroll.iter().map(String::as_str).collect::<Vec<_>>(),
+    )
+    .success();
+    assert!(r.stdout.contains("enrolled 3 of 3 scans"), "{}", r.stdout);
+    for (probe, mut scores) in bench {
+        let r = bipolar_cmd(
+            "identify",
+            &[
+                &s(&scans.join(format!("{probe}.bnt"))),
+                "--gallery",
+                &gallery,
+                "--json",
+            ],
+        )
+        .success();
+        let j: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+        let ranking = j["ranking"].as_array().unwrap();
+        scores.sort_by(|a, b| a.1.total_cmp(&b.1));
+        let cli: Vec<(String, f64)> = ranking
+            .iter()
+            .map(|x| {
+                (
+                    x["identity"].as_str().unwrap().to_string(),
+                    x["score"].as_f64().unwrap(),
+                )
+            })
+            .collect();
+        assert_eq!(
+            cli.iter().map(|x| &x.0).collect::<Vec<_>>(),
+            scores.iter().map(|x| &x.0).collect::<Vec<_>>(),
+            "{probe}: identify {cli:?}, the benchmark {scores:?}"
+        );
+        // The benchmark writes 6 decimals.
+        for ((_, a), (_, b)) in cli.iter().zip(&scores) {
+            assert!(
+                (a - b).abs() < 1e-6,
+                "{probe}: identify {cli:?}, the benchmark {scores:?}"
+            );
+        }
+    }
+}

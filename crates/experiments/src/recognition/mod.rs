@@ -115,15 +115,21 @@ pub struct Args {
     pub ref_search: f64,
     /// View matching of the bipolar score (`--scans`; degrees): when a probe's scanner
     /// direction, carried into a gallery face's frame by the landmark alignment, is more than
-    /// this angle from the gallery scan's own, the gallery face is described again on the part
-    /// of it a scanner would see from the probe's direction (`rangescan::visible_faces`,
-    /// incidence up to 75 degrees), so that both sides miss the same surface.
+    /// this angle from the gallery scan's own, the probe is compared with the gallery face's
+    /// template view nearest that direction (`facematch::views_of`: the face described on the
+    /// part of it a scanner turned by 15, 25, 35 or 45 degrees to either side would see,
+    /// `rangescan::visible_faces`, incidence up to 75 degrees), so that both sides miss the
+    /// same surface.
     #[arg(long, default_value_t = SCAN_VIEW_MATCH_DEG)]
     pub view_match: f64,
     /// No view matching (`--scans`): every probe is compared with the gallery face's one
     /// description.
     #[arg(long)]
     pub no_view_match: bool,
+    /// Write every raw scan of the run (gallery, probes, sweeps) to this folder as `NAME.bnt`
+    /// (`--scans`), for `bipolar enroll` / `identify` on the benchmark's own scans.
+    #[arg(long)]
+    pub save_scans: Option<std::path::PathBuf>,
     /// Side pairs of the bipolar score (`--scans`; degrees): a probe whose eye line is turned
     /// from its scanner by more than this is compared by the bipolar descriptor of its outer
     /// eye corner nearer the scanner and its nose tip (the gallery faces are described by

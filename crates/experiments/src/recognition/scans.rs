@@ -118,6 +118,7 @@ fn process(
     scan_opts: &ScanSetOptions,
     prep: &facematch::MatchOptions,
     icp_n: usize,
+    save: Option<&std::path::Path>,
     msg: &str,
 ) -> Vec<Face> {
     let pb = bar(specs.len(), msg);
@@ -125,7 +126,7 @@ fn process(
         .par_iter()
         .map(|spec| {
             let f = describe_spec(
-                model, generic, spec, keep_mesh, method, dopt, scan_opts, prep, icp_n,
+                model, generic, spec, keep_mesh, method, dopt, scan_opts, prep, icp_n, save,
             );
             pb.inc(1);
             f
@@ -173,6 +174,7 @@ fn describe_spec(
     scan_opts: &ScanSetOptions,
     prep: &facematch::MatchOptions,
     icp_n: usize,
+    save: Option<&std::path::Path>,
 ) -> Face {
     let mut face = Face {
         name: spec.name.clone(),
@@ -194,10 +196,15 @@ fn describe_spec(
         let s = clean_scan(&raw, t_scan, generic, &gt_opts)?;
         Ok((raw, s))
     });
-    let (raw, s) = match scanned {
+    let saved = |raw: &rangescan::Scan| match save {
+        Some(dir) => mesh_io::write_bnt(dir.join(format!("{}.bnt", spec.name)), &raw.grid)
+            .map_err(anyhow::Error::from),
+        None => Ok(()),
+    };
+    let (raw, s) = match scanned.and_then(|(raw, s)| saved(&raw).map(|()| (raw, s))) {
         Ok(x) => x,
         Err(e) => {
-            let e = format!("scan or cleaning: {e:#}");
+            let e = format!("scan, cleaning or saving: {e:#}");
             face.desc = [Err(e.clone()), Err(e)];
             return face;
         }
@@ -806,6 +813,10 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
             .collect();
         return detect_only(model, &generic, &specs, &prep, &out);
     }
+    if let Some(dir) = &args.save_scans {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("creating --save-scans {}", dir.display()))?;
+    }
     let methods = resolve_methods(&args.method, &meshcore::shapes::icosphere(1))?;
     let method = methods[0].used;
     // Iso-curvature levels: from the first gallery scan (ground-truth landmarks), scanned once
@@ -858,6 +869,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
             &scan_opts,
             &prep,
             args.icp_points,
+            args.save_scans.as_deref(),
             msg,
         )
     };
