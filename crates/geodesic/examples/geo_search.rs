@@ -8,7 +8,9 @@
 //! cargo run --release -p geodesic --example geo_search -- MESH CUT RADIUS POLE [POLE ...]
 //! ```
 
-use geodesic::{distances_many, ExactGeodesic, GeodesicSolver, SolveOptions, Source};
+use geodesic::{
+    distances_many, ExactGeodesic, ExactWorkspace, GeodesicSolver, SolveOptions, Source,
+};
 use std::time::Instant;
 
 fn main() {
@@ -63,6 +65,28 @@ fn main() {
         v[1]
     };
     let moved = &all[own.len()..];
+    // The moved fields one after another on this thread, each solve allocating its buffers
+    // or reusing one workspace; alternated 3 times, medians.
+    let (mut fresh, mut reused) = (Vec::new(), Vec::new());
+    let mut ws = ExactWorkspace::new();
+    for _ in 0..3 {
+        let t = Instant::now();
+        for s in moved {
+            solver.distances(s, &opts).expect("solve");
+        }
+        fresh.push(t.elapsed().as_secs_f64());
+        let t = Instant::now();
+        for s in moved {
+            solver.distances_with(&mut ws, s, &opts).expect("solve");
+        }
+        reused.push(t.elapsed().as_secs_f64());
+    }
+    fresh.sort_by(f64::total_cmp);
+    reused.sort_by(f64::total_cmp);
+    println!(
+        "moved fields one after another: {:.3} s allocating per solve, {:.3} s with a reused workspace",
+        fresh[1], reused[1]
+    );
     let (t_own, t_own_seq, t_moved, t_all) = (time(&own), time_seq(&own), time(moved), time(&all));
     println!(
         "setup {setup:.3} s; own fields ({}) {t_own:.3} s in parallel, {t_own_seq:.3} s one after another; \
