@@ -190,7 +190,10 @@ impl Study<'_> {
          the scanner's projected ground-truth landmarks, snapped to the cleaned surface (at most \
          {} mm away, else the scan is listed as unusable). Exact geodesics; static area at N = {} \
          (levels <= N, `facemodel::static_mask`); single pole with {} sectors; ICP of {} \
-         static-area points, symmetric mean of the two directions, RMS in mm.\n",
+         static-area points, symmetric mean of the two directions, RMS in mm. The three pole \
+         pairs (and their view matching and search) are `facematch`'s: its poles at the vertices \
+         nearest the snapped landmarks, each scan of a pair the probe once, per pair the lesser \
+         of the two distances.\n",
         faces.len(),
         args.set
             .faces
