@@ -2,7 +2,10 @@
 //! score matrix (rank-1, EER, ROC), the paired comparison of two scores (McNemar), and their
 //! tables, summary and figures.
 
-use super::*;
+use super::compare::Row;
+use super::Args;
+use crate::report::{f4, line_plot, Report, Series};
+use anyhow::Result;
 
 /// Identification/verification figures of one score matrix.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -14,7 +17,8 @@ pub(super) struct Metrics {
     pub(super) genuine_mean: f64,
     pub(super) impostor_mean: f64,
     pub(super) failures: usize,
-    /// Mean single-thread wall time of one comparison (ms), over [`TIMED_PAIRS`] pairs.
+    /// Mean single-thread wall time of one comparison (ms), over
+    /// [`TIMED_PAIRS`](super::compare::TIMED_PAIRS) pairs.
     pub(super) ms_per_comparison: f64,
     /// Median single-thread wall time of one description (ms): its geodesic fields and its
     /// build; NaN for ICP, which compares the meshes themselves.
@@ -183,7 +187,7 @@ pub(super) fn eer_roc(gen: &[f64], imp: &[f64]) -> (f64, Vec<(f64, f64)>) {
     (eer, roc)
 }
 
-/// Names of the five scores of [`score_row`].
+/// Names of the five scores of [`score_row`](super::compare::score_row).
 pub(super) const SCORES: [&str; 5] = [
     "bipolar",
     "single_pole",
@@ -192,7 +196,8 @@ pub(super) const SCORES: [&str; 5] = [
     "iso_curvature",
 ];
 
-/// Index in [`Described::secs`] of each score's description (ICP has none).
+/// Index in [`Described::secs`](super::describe::Described::secs) of each score's description (ICP
+/// has none).
 pub(super) const DESCRIPTION_OF: [Option<usize>; 5] = [Some(0), Some(1), None, Some(2), Some(3)];
 
 /// The element at `pick(len)` of the sorted finite values (NaN when there is none).
@@ -211,9 +216,10 @@ pub(super) fn median(v: Vec<f64>) -> f64 {
     order_stat(v, |n| n / 2)
 }
 
-/// The figures of the five score matrices of one landmark set (rows from [`score_row`]), with
-/// the times per comparison ([`time_comparisons`]) and per description
-/// ([`time_descriptions`]; ICP has none).
+/// The figures of the five score matrices of one landmark set (rows from
+/// [`score_row`](super::compare::score_row)), with the times per comparison
+/// ([`time_comparisons`](super::compare::time_comparisons)) and per description
+/// ([`time_descriptions`](super::compare::time_descriptions); ICP has none).
 pub(super) fn summarize(
     rows: &[Row],
     ms_comparison: &[f64; 5],

@@ -7,7 +7,8 @@
 //! interval; the paired comparison adds up each seed's probes that only one of two scores
 //! identifies (the probes of one seed are the same for every score).
 
-use super::{discordant, mcnemar_exact, paired_table, Args, Metrics};
+use super::metrics::{discordant, mcnemar_exact, paired_table, Metrics};
+use super::Args;
 use crate::report::{line_plot, Report, Series};
 use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};

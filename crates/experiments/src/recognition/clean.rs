@@ -1,0 +1,320 @@
+//! The benchmark on clean meshes: faces sampled from the ICT model under random rigid motions,
+//! described with the model's landmarks and with detected ones.
+
+use super::compare::{
+    icp_points, score_row, time_comparisons, time_descriptions, timed_pairs, Row, TIMED_FACES,
+    TIMED_PAIRS,
+};
+use super::describe::{
+    describe_face, elastic_options, iso_levels_of, DescribeOptions, Described, ISO_POINTS,
+    SEARCH_DIRECTIONS,
+};
+use super::metrics::{paired_table, results_table, roc_figure, summarize, write_summary, Metrics};
+use super::{Args, Lm};
+use crate::pipeline::{bar, resolve_methods};
+use crate::report::Report;
+use crate::walk::Walker;
+use anyhow::{bail, Result};
+use facemodel::{random_rigid_motion, FaceModel};
+use meshcore::{DVec3, FaceLocator, TriMesh};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// One sampled face.
+#[derive(Debug)]
+struct Sample {
+    identity: usize,
+    index: usize,
+    mesh: TriMesh,
+}
+
+/// The descriptions of one face with the ground-truth and the detected landmarks (`None` where
+/// the landmarks or the description failed).
+type Both = [Option<Described>; 2];
+
+/// The run's samples and settings, as the report states them.
+struct Setup<'a> {
+    identities: usize,
+    expressions: usize,
+    samples: &'a [Sample],
+    /// Indices of the gallery faces (expression 0) and of the probes in `samples`.
+    gallery: Vec<usize>,
+    probes: Vec<usize>,
+    method: geodesic::Method,
+    method_note: Option<String>,
+    probe_opts: &'a DescribeOptions,
+    detected: &'a [Option<Lm>],
+}
+
+/// Runs the benchmark on clean meshes; prints the output folder on the last line.
+pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
+    let identities = args.identities.unwrap_or(50);
+    let expressions = args.expressions.unwrap_or(6);
+    if identities < 2 || expressions < 2 {
+        bail!("need at least 2 identities and 2 expressions (one neutral gallery face + probes)");
+    }
+    let out = args.io.out.out_dir("recognition");
+    let gt = Lm {
+        lost: None,
+        r: model.landmark_id("right_eye_outer")?,
+        q: model.landmark_id("left_eye_outer")?,
+        nose: model.landmark_id("nose_tip")?,
+    };
+    let samples = sample_faces(model, identities, expressions, args.seed)?;
+    let methods = resolve_methods(&args.method, &samples[0].mesh)?;
+    let method = methods[0].used;
+    let method_note = methods[0].note.clone();
+    eprintln!(
+        "{} faces sampled ({} identities x {}); geodesics: {}",
+        samples.len(),
+        identities,
+        expressions,
+        method.name()
+    );
+    // Iso-curvature levels: from the first gallery face (ground-truth landmarks).
+    let iso_levels = {
+        let s = &samples[0];
+        let solver = geodesic::new_solver(&s.mesh, method)?;
+        iso_levels_of(&s.mesh, solver.as_ref(), gt, args.iso_levels)?
+    };
+    let desc_opts = DescribeOptions {
+        levels: args.res.levels,
+        sectors: args.res.sectors,
+        iso_levels: Some(iso_levels),
+        boundary_margin: None,
+        max_incidence_deg: None,
+        ref_search: None,
+        view_match: None,
+        side_pair_deg: None,
+        least_pair: false,
+        search_all_pairs: false,
+        second_weight: 0.0,
+        predicted_corners: false,
+    };
+    // The reference-point search is the probes' (the gallery keeps its one description); its
+    // radius is given in mm, the model is in cm.
+    let probe_opts = DescribeOptions {
+        ref_search: (args.ref_search > 0.0)
+            .then(|| args.ref_search / meshcore::units::Units::Centimetre.mm_per_unit()),
+        ..desc_opts.clone()
+    };
+    // Landmark detection.
+    let generic = landmarks::GenericModel::default_model()
+        .map_err(|e| anyhow::anyhow!("landmark model: {e}"))?;
+    let detected = detect_all(&samples, &generic);
+    // Descriptors for both landmark sets.
+    let described = describe_all(&samples, &detected, gt, method, &desc_opts, &probe_opts)?;
+    let setup = Setup {
+        identities,
+        expressions,
+        samples: &samples,
+        gallery: (0..samples.len())
+            .filter(|&i| samples[i].index == 0)
+            .collect(),
+        probes: (0..samples.len())
+            .filter(|&i| samples[i].index != 0)
+            .collect(),
+        method,
+        method_note,
+        probe_opts: &probe_opts,
+        detected: &detected,
+    };
+    let all = score_all(args, &setup, &described, gt)?;
+    write_report(args, &setup, gt, &all, &out, t0)
+}
+
+/// Samples `identities` x `expressions` faces (expression 0 neutral), each under a random rigid
+/// motion (sequential: deterministic).
+fn sample_faces(
+    model: &FaceModel,
+    identities: usize,
+    expressions: usize,
+    seed: u64,
+) -> Result<Vec<Sample>> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut samples = Vec::new();
+    for id in 0..identities {
+        let w = model.random_identity(&mut rng);
+        for e in 0..expressions {
+            let ew = if e == 0 {
+                vec![0.0; model.n_expressions()]
+            } else {
+                model.random_expression(&mut rng)
+            };
+            let mesh = model.sample(&w, &ew)?;
+            let motion = random_rigid_motion(&mut rng, 5.0);
+            let (pos, tri) = mesh.into_parts();
+            let pos = pos
+                .into_iter()
+                .map(|p| motion.transform_point3(p))
+                .collect();
+            samples.push(Sample {
+                identity: id,
+                index: e,
+                mesh: TriMesh::new(pos, tri)?,
+            });
+        }
+    }
+    Ok(samples)
+}
+
+/// The detected landmarks of every face (`None` where detection failed).
+fn detect_all(samples: &[Sample], generic: &landmarks::GenericModel) -> Vec<Option<Lm>> {
+    let pb = bar(samples.len(), "detecting landmarks");
+    let detected: Vec<Option<Lm>> = samples
+        .par_iter()
+        .map(|s| {
+            let r = landmarks::detect(&s.mesh, generic).ok().map(|l| {
+                Lm::new(
+                    l.outer_eye_right.vertex,
+                    l.outer_eye_left.vertex,
+                    l.nose_tip.vertex,
+                )
+            });
+            pb.inc(1);
+            r
+        })
+        .collect();
+    pb.finish();
+    detected
+}
+
+/// Every face described with the ground-truth landmarks `gt` and with its detected ones: the
+/// gallery faces with `desc_opts`, the probes with `probe_opts`.
+fn describe_all(
+    samples: &[Sample],
+    detected: &[Option<Lm>],
+    gt: Lm,
+    method: geodesic::Method,
+    desc_opts: &DescribeOptions,
+    probe_opts: &DescribeOptions,
+) -> Result<Vec<Both>> {
+    let pb = bar(samples.len(), &format!("descriptors ({})", method.name()));
+    let described: Vec<Both> = samples
+        .par_iter()
+        .zip(detected)
+        .map(|(s, det)| -> Result<_> {
+            let solver = geodesic::new_solver(&s.mesh, method)?;
+            let walker = Walker::new(&s.mesh);
+            let o = if s.index == 0 { desc_opts } else { probe_opts };
+            let out = [Some(gt), *det].map(|lm| {
+                lm.and_then(|lm| describe_face(&s.mesh, solver.as_ref(), &walker, lm, o).ok())
+            });
+            pb.inc(1);
+            Ok(out)
+        })
+        .collect::<Result<_>>()?;
+    pb.finish();
+    Ok(described)
+}
+
+/// The figures of every score with both landmark sets: the probes scored against the gallery
+/// in parallel, then the comparisons and descriptions timed on one thread.
+fn score_all(args: &Args, s: &Setup<'_>, described: &[Both], gt: Lm) -> Result<Vec<Metrics>> {
+    let (samples, gallery, probes) = (s.samples, &s.gallery, &s.probes);
+    let elastic = elastic_options(args.curve_samples);
+    let gid: Vec<usize> = gallery.iter().map(|&g| samples[g].identity).collect();
+    let pid: Vec<usize> = probes.iter().map(|&p| samples[p].identity).collect();
+    let locators: Vec<FaceLocator<'_>> = gallery
+        .iter()
+        .map(|&g| FaceLocator::new(&samples[g].mesh))
+        .collect();
+    let mut all = Vec::new();
+    let pb = bar(2 * probes.len(), "scoring");
+    let probe_pts: Vec<Vec<DVec3>> = probes
+        .iter()
+        .map(|&p| icp_points(&samples[p].mesh, args.icp_points))
+        .collect();
+    let mut timed = Vec::new();
+    for k in [0, 1] {
+        let gal: Vec<Option<(&Described, &FaceLocator<'_>)>> = gallery
+            .iter()
+            .zip(&locators)
+            .map(|(&g, l)| described[g][k].as_ref().map(|d| (d, l)))
+            .collect();
+        let rows: Vec<Row> = probes
+            .par_iter()
+            .zip(&probe_pts)
+            .map(|(&p, pts)| {
+                let (r, _) = score_row(described[p][k].as_ref(), pts, &gal, &elastic);
+                pb.inc(1);
+                r
+            })
+            .collect();
+        let pr: Vec<(Option<&Described>, &[DVec3])> = probes
+            .iter()
+            .zip(&probe_pts)
+            .map(|(&p, pts)| (described[p][k].as_ref(), pts.as_slice()))
+            .collect();
+        timed.push((rows, time_comparisons(&timed_pairs(&pr, &gal), &elastic)?));
+    }
+    pb.finish();
+    // Description times: the first gallery faces again, one at a time on one thread.
+    let first: Vec<(&TriMesh, Lm)> = gallery
+        .iter()
+        .take(TIMED_FACES)
+        .map(|&g| (&samples[g].mesh, gt))
+        .collect();
+    let ms_desc = time_descriptions(&first, s.method, s.probe_opts)?;
+    for ((rows, ms_cmp), lname) in timed.iter().zip(["ground_truth", "detected"]) {
+        all.extend(summarize(rows, ms_cmp, &ms_desc, &pid, &gid, lname));
+    }
+    Ok(all)
+}
+
+/// Writes `report.md` (settings, landmark detection, results, the paired comparison, ROC) and
+/// `summary.json`; prints the output folder.
+fn write_report(
+    args: &Args,
+    s: &Setup<'_>,
+    gt: Lm,
+    all: &[Metrics],
+    out: &std::path::Path,
+    t0: Instant,
+) -> Result<()> {
+    let (samples, detected) = (s.samples, s.detected);
+    let det_err: Vec<[f64; 3]> = samples
+        .iter()
+        .zip(detected)
+        .filter_map(|(s, d)| {
+            d.map(|d| {
+                [(gt.r, d.r), (gt.q, d.q), (gt.nose, d.nose)]
+                    .map(|(a, b)| (s.mesh.position(a) - s.mesh.position(b)).length())
+            })
+        })
+        .collect();
+    let mut rep = Report::new(out, "Recognition benchmark on sampled ICT faces")?;
+    rep.para(&format!(
+        "{} identities x {} faces (seed {}): {} gallery faces (neutral), {} probes (random expressions: with probability 1/2 a recipe at strength 0.3-1, plus random blendshapes), every face under a random rigid motion. Geodesics: {}{}. Bipolar descriptor: static area, N = {} levels between the outer eye corners (grid reading, keyed distance){}; single pole: {} sectors x {} radius levels around the nose tip; ICP: {} probe vertices onto the gallery surface, started from the 3-landmark alignment, 10 % trimmed, score = RMS closest-point distance (cm); facial curves: N = {} level curves of the nose-tip field up to D, elastic distance ({} segments per curve, one start-point candidate, one rotation / reparametrisation alternation), root sum of squares; iso-curvature: {} levels per principal field (quantiles of the first gallery face) in the geodesic disc of radius D around the nose tip, ICP of the networks' points (thinned to at most {ISO_POINTS}, every k-th point) started from the 3-landmark alignment (10 iterations on a 500-point subsample, at most 10 on all points), score = normalised RMS closest-point distance. Times, single thread (a one-thread pool, after the parallel scoring; the machine is shared, so compare them as ratios): ms per comparison is the mean over {TIMED_PAIRS} probe x gallery pairs per landmark set; ms per description the median over the first {TIMED_FACES} gallery faces (ground-truth landmarks), described as probes, of the fields a representation needs (both corners; the nose tip; the search's moved corners) plus its build.",
+        s.identities, s.expressions, args.seed, s.gallery.len(), s.probes.len(), s.method.name(),
+        s.method_note.as_ref().map(|n| format!(" (exact requested: {n})")).unwrap_or_default(),
+        args.res.levels,
+        s.probe_opts.ref_search.map(|r| format!(", each probe also described from its outer eye corners moved by {r} cm in {SEARCH_DIRECTIONS} directions of their tangent planes (`bipolar::SearchedPole`), its score the least distance over these 49 descriptors")).unwrap_or_default(),
+        args.res.sectors, args.res.levels, icp_points(&s.samples[0].mesh, args.icp_points).len(),
+        args.res.levels, args.curve_samples, args.iso_levels
+    ));
+    let n_det = detected.iter().filter(|d| d.is_some()).count();
+    let mean_err =
+        |k: usize| det_err.iter().map(|e| e[k]).sum::<f64>() / det_err.len().max(1) as f64;
+    rep.para(&format!("Landmark detection: {n_det} of {} faces detected; mean error right corner {:.3} cm, left corner {:.3} cm, nose tip {:.3} cm.", samples.len(), mean_err(0), mean_err(1), mean_err(2)));
+    results_table(&mut rep, all, "results.csv")?;
+    paired_table(&mut rep, all);
+    roc_figure(&mut rep, all, "roc.svg", "ROC (verification)")?;
+    rep.png_twins()?;
+    let secs = t0.elapsed().as_secs_f64();
+    rep.para(&format!("Run time: {secs:.1} s."));
+    rep.finish()?;
+    let fields = serde_json::json!({
+        "geodesic_note": s.method_note,
+        "landmark_detection": { "detected": n_det, "faces": samples.len(), "mean_error_cm": { "right_eye_outer": mean_err(0), "left_eye_outer": mean_err(1), "nose_tip": mean_err(2) } },
+        "roc_plot": "roc.svg",
+        "seconds": secs,
+    });
+    let sampled = [s.identities, s.expressions, s.gallery.len(), s.probes.len()];
+    write_summary(out, args, sampled, s.method, fields, all)?;
+    eprintln!("{secs:.1} s wall");
+    println!("{}", out.display());
+    Ok(())
+}

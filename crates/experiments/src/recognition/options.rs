@@ -1,0 +1,183 @@
+//! The command line of `cargo xtask recognition` and the defaults of its flags.
+
+use crate::paths::{ModelArgs, ResolutionArgs};
+use crate::scans::ScanArgs;
+
+/// Arguments of `cargo xtask recognition`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct Args {
+    /// Number of sampled identities (default 50; with `--scans` 16).
+    #[arg(long)]
+    pub identities: Option<usize>,
+    /// Faces per identity, the first neutral for the gallery (default 6; with `--scans` 3).
+    #[arg(long)]
+    pub expressions: Option<usize>,
+    /// Seed of the sampling.
+    #[arg(long, default_value_t = 7)]
+    pub seed: u64,
+    /// Geodesic method (exact falls back to fmm, then heat, if unavailable).
+    #[arg(long, default_value = "exact")]
+    pub method: String,
+    /// Descriptor resolution.
+    #[command(flatten)]
+    pub res: ResolutionArgs,
+    /// Levels per principal field of the iso-curvature network (between the 5 % and 95 %
+    /// quantiles of the first gallery face's curvatures, the same levels for every face).
+    #[arg(long = "iso-levels", default_value_t = 6)]
+    pub iso_levels: usize,
+    /// Segments each facial curve is resampled into for the elastic distance.
+    #[arg(long = "curve-samples", default_value_t = CURVE_SAMPLES)]
+    pub curve_samples: usize,
+    /// Probe vertices used by ICP (evenly strided).
+    #[arg(long, default_value_t = 100)]
+    pub icp_points: usize,
+    /// ICT model folder and output folder (default `target/recognition`; with `--scans`
+    /// `target/recognition-scans`).
+    #[command(flatten)]
+    pub io: ModelArgs,
+    /// Recognition on range scans (`rangescan`, cleaned by `scanprep`): neutral frontal scans
+    /// (the `--scan-*` settings) as the gallery, expressions under yaw and noise as probes, and
+    /// sweeps of noise, pitch and yaw.
+    #[arg(long)]
+    pub scans: bool,
+    /// Scanner settings of the gallery (and the reference of the sweeps) with `--scans`.
+    #[command(flatten)]
+    pub scan: ScanArgs,
+    /// Target edge length (mm) the cleaned scans are decimated to before detection and
+    /// description (`--scans`; 0 keeps the scan's sampling).
+    #[arg(long, default_value_t = SCAN_EDGE_MM)]
+    pub scan_edge: f64,
+    /// Taubin smoothing iterations of the cleaned scans, before the decimation (`--scans`; 0:
+    /// none).
+    #[arg(long, default_value_t = 0)]
+    pub scan_smooth: usize,
+    /// Taubin smoothing iterations of a copy of each cleaned scan that landmark detection runs
+    /// on (`--scans`; the landmarks keep their vertices; 0: detection on the scan itself).
+    #[arg(long, default_value_t = 0)]
+    pub detect_smooth: usize,
+    /// Identities whose probes are rescanned at every sweep setting (`--scans`).
+    #[arg(long, default_value_t = 4)]
+    pub sweep_identities: usize,
+    /// Skip the sweeps (`--scans`).
+    #[arg(long)]
+    pub no_sweeps: bool,
+    /// Band (mm) along the holes and the border of each cleaned scan that the bipolar
+    /// descriptor leaves out (`--scans`; 0 keeps everything).
+    #[arg(long, default_value_t = SCAN_BOUNDARY_MARGIN_MM)]
+    pub boundary_margin: f64,
+    /// Parts of each scan seen at more than this incidence (degrees) left out of the bipolar
+    /// descriptor (`--scans`; 0 keeps everything).
+    #[arg(long, default_value_t = SCAN_MAX_INCIDENCE_DEG)]
+    pub max_incidence: f64,
+    /// Reference-point search of the bipolar score (mm, 0: off; on the clean meshes the outer
+    /// eye corners' pair alone, as their only pair): each probe is also
+    /// described by each pole pair (the outer eye corners; each corner with the nose tip) from
+    /// its two poles moved by this distance in 6 directions of their tangent planes (48 more
+    /// descriptors per pair; only the probe's own pair with `--own-pair-search`), and its
+    /// distance by a pair is the least over the pair's 49 descriptors.
+    #[arg(long, default_value_t = SCAN_REF_SEARCH_MM)]
+    pub ref_search: f64,
+    /// View matching of the bipolar score (`--scans`; degrees): when a probe's scanner
+    /// direction, carried into a gallery face's frame by the landmark alignment, is more than
+    /// this angle from the gallery scan's own, the probe is compared with the gallery face's
+    /// template view nearest that direction (`facematch::views_of`: the face described on the
+    /// part of it a scanner turned by 15, 25, 35 or 45 degrees to either side would see,
+    /// `rangescan::visible_faces`, incidence up to 75 degrees), so that both sides miss the
+    /// same surface.
+    #[arg(long, default_value_t = SCAN_VIEW_MATCH_DEG)]
+    pub view_match: f64,
+    /// No view matching (`--scans`): every probe is compared with the gallery face's one
+    /// description.
+    #[arg(long)]
+    pub no_view_match: bool,
+    /// Write every raw scan of the run (gallery, probes, sweeps) to this folder as `NAME.bnt`
+    /// (`--scans`), for `bipolar enroll` / `identify` on the benchmark's own scans.
+    #[arg(long)]
+    pub save_scans: Option<std::path::PathBuf>,
+    /// Side pairs of the bipolar score (`--scans`; degrees): a probe whose eye line is turned
+    /// from its scanner by more than this is compared by the bipolar descriptor of its outer
+    /// eye corner nearer the scanner and its nose tip (the gallery faces are described by
+    /// both side pairs), not by its two corners, whose far one its scanner barely saw.
+    #[arg(long, default_value_t = SCAN_SIDE_PAIR_DEG)]
+    pub side_pair: f64,
+    /// No side pairs (`--scans`): every probe is compared by its outer eye corners.
+    #[arg(long)]
+    pub no_side_pair: bool,
+    /// The bipolar score of a probe is its distance by its own pole pair alone (the corners,
+    /// or its side pair past `--side-pair`), not the least distance over the three pairs
+    /// (`--scans`).
+    #[arg(long)]
+    pub own_pair_only: bool,
+    /// The reference-point search (`--ref-search`) moves only the poles of the probe's own
+    /// pair (`--scans`; the former default): 12 moved fields and 48 more descriptors per probe.
+    /// By default, with the least over the three pairs, it moves the poles of all three: 18
+    /// moved fields and 144 more descriptors.
+    #[arg(long)]
+    pub own_pair_search: bool,
+    /// Weight of the second least pair distance in the bipolar score with the least over the
+    /// three pairs (`--scans`; 0, the default: the least alone; 0.25 gives 0.75 x least + 0.25 x
+    /// second least, which asks two pairs to agree).
+    #[arg(long, default_value_t = 0.0)]
+    pub pair_second: f64,
+    /// Scan, clean and detect the landmarks of the gallery, probe and sweep scans, write
+    /// `detection.csv` (per scan: the detected landmarks' errors or why detection failed) and
+    /// a report of the errors and landmarks placed against the yaw, and stop, without
+    /// describing or comparing (`--scans`).
+    #[arg(long)]
+    pub detect_only: bool,
+    /// An outer eye corner the detector reports unseen is placed at the vertex nearest where
+    /// the fitted face predicts it (within 3 mm of the cleaned scan) instead of being lost, so
+    /// that the corners' pair and its side pair still describe the face (`--scans`; the
+    /// landmark stays unseen in `detection.csv` and `landmarks.csv`).
+    #[arg(long)]
+    pub predicted_corners: bool,
+    /// Keep only the probes (and sweep scans) whose name starts with one of these
+    /// (comma-separated, e.g. `id01-e2,id27`; `--scans`), against the whole gallery: their
+    /// ranks are those of the whole run.
+    #[arg(long, value_delimiter = ',')]
+    pub only_probes: Vec<String>,
+    /// Run the benchmark once per seed (comma-separated; `--seed` is then ignored), each into
+    /// `OUT/seed-S/`, and pool the runs probe by probe into `OUT/report.md` and `pooled.csv`:
+    /// rank-1 over all the seeds' probes with its 95 % interval, the mean EER, the paired
+    /// comparison with McNemar's test.
+    #[arg(long, value_delimiter = ',')]
+    pub seeds: Vec<u64>,
+    /// With `--seeds`: pool the runs already in `OUT/seed-S/` without running them.
+    #[arg(long, requires = "seeds")]
+    pub pool_only: bool,
+    /// Keep only these identities (comma-separated numbers, `--scans`): their gallery scans,
+    /// probes and sweep scans, with the scan seeds, yaws and noises of the whole run, so that a
+    /// run's misses can be rerun and looked at in a minute (ranks are then among these
+    /// identities only).
+    #[arg(long, value_delimiter = ',')]
+    pub only_identities: Vec<usize>,
+}
+
+/// Default of `--scan-edge`, mm.
+const SCAN_EDGE_MM: f64 = 1.5;
+
+/// Default of `--boundary-margin`: the band next to the holes where the fields of two scans
+/// disagree most (docs/scans.md, "Yaw").
+const SCAN_BOUNDARY_MARGIN_MM: f64 = 6.0;
+
+/// The default of `--max-incidence`, chosen on scan-study (60 degrees raised every same-face
+/// figure and kept the other-person minimum; 45 degrees left too few shared keys on the face
+/// mesh; docs/scans.md, "Grazing incidence").
+const SCAN_MAX_INCIDENCE_DEG: f64 = 60.0;
+
+/// The default of `--ref-search`: 2 mm raised bipolar with detected landmarks from 0.656 to
+/// 0.750 (16 identities) and from 0.550 to 0.690 (50) and kept or raised it with ground truth;
+/// 1.2 and 3 mm differ from it by one probe on 16 identities (docs/scans.md, "Reference-point
+/// search").
+const SCAN_REF_SEARCH_MM: f64 = 2.0;
+
+/// The default of `--view-match` (degrees). Not tuned: below it a probe is near frontal, its
+/// scanner saw what the gallery's did, and the gallery's own description is used.
+pub(crate) const SCAN_VIEW_MATCH_DEG: f64 = 10.0;
+
+/// The default of `--side-pair` (degrees), chosen on 16 identities: 25 moved one probe from
+/// rank 1 to 3 and gained nothing else (docs/scans.md, "Side pairs and lost corners").
+const SCAN_SIDE_PAIR_DEG: f64 = 30.0;
+
+/// Default of `--curve-samples`.
+const CURVE_SAMPLES: usize = 50;

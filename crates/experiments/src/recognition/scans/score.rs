@@ -1,0 +1,181 @@
+//! The scores of a probe group against the gallery: its figures, each probe's rank and every
+//! failure.
+
+use super::super::compare::{score_row, time_comparisons, timed_pairs, PairDistances, Row};
+use super::super::describe::Described;
+use super::super::metrics::{summarize, Metrics, SCORES};
+use super::face::Face;
+use super::SETS;
+use anyhow::Result;
+use facecurves::ElasticOptions;
+use meshcore::{DVec3, FaceLocator};
+use rayon::prelude::*;
+
+/// Figures of a probe group against the gallery, per landmark set and score, with the times
+/// per comparison (timed on pairs of this group) and per description (`ms_desc`).
+pub(super) fn score_group(
+    gallery: &[Face],
+    locators: &[[Option<FaceLocator<'_>>; 2]],
+    probes: &[Face],
+    elastic: &ElasticOptions,
+    ms_desc: &[f64; 4],
+) -> Result<Scored> {
+    let gid: Vec<usize> = gallery.iter().map(|g| g.identity).collect();
+    let pid: Vec<usize> = probes.iter().map(|p| p.identity).collect();
+    let mut all = Vec::new();
+    let mut per_probe = Vec::new();
+    let mut by_pair = Vec::new();
+    let mut fallbacks = Vec::new();
+    for (k, set) in SETS.iter().enumerate() {
+        let gal: Vec<Option<(&Described, &FaceLocator<'_>)>> = gallery
+            .iter()
+            .zip(locators)
+            .map(|(g, l)| g.desc[k].as_ref().ok().zip(l[k].as_ref()))
+            .collect();
+        let (rows, pairs): (Vec<Row>, Vec<Vec<PairDistances>>) = probes
+            .par_iter()
+            .map(|p| score_row(p.desc[k].as_ref().ok(), &p.pts[k], &gal, elastic))
+            .unzip();
+        let pr: Vec<(Option<&Described>, &[DVec3])> = probes
+            .iter()
+            .map(|p| (p.desc[k].as_ref().ok(), p.pts[k].as_slice()))
+            .collect();
+        let ms_cmp = time_comparisons(&timed_pairs(&pr, &gal), elastic)?;
+        all.extend(summarize(&rows, &ms_cmp, ms_desc, &pid, &gid, set));
+        for (p, row) in probes.iter().zip(&rows) {
+            for (j, score) in SCORES.iter().enumerate() {
+                per_probe.push(probe_rank(&p.name, p.identity, set, score, &row[j], &gid));
+            }
+        }
+        let mut kinds = std::collections::BTreeMap::<String, usize>::new();
+        let (mut with, mut total) = (0, 0);
+        for (p, ds) in probes.iter().zip(&pairs) {
+            let Ok(x) = &p.desc[k] else { continue };
+            for (g, (d, fb)) in gallery.iter().zip(ds) {
+                total += 1;
+                with += usize::from(!fb.is_empty());
+                for f in fb {
+                    *kinds.entry(f.clone()).or_default() += 1;
+                }
+                by_pair.push(
+                    [
+                        p.name.clone(),
+                        p.identity.to_string(),
+                        set.to_string(),
+                        x.bip
+                            .as_ref()
+                            .map_or(String::new(), |b| format!("{:?}", b.pair)),
+                        g.identity.to_string(),
+                    ]
+                    .into_iter()
+                    .chain(d.iter().map(|v| format!("{v:.6}")))
+                    .chain([fb.join("; ")])
+                    .collect(),
+                );
+            }
+        }
+        let kinds: Vec<String> = kinds.iter().map(|(k, n)| format!("{k}: {n}")).collect();
+        fallbacks.push(format!(
+            "{set}: {with} of {total} bipolar comparisons took a fallback{}{}",
+            if kinds.is_empty() { "" } else { " (" },
+            if kinds.is_empty() {
+                String::new()
+            } else {
+                kinds.join("; ") + ")"
+            }
+        ));
+    }
+    Ok(Scored {
+        metrics: all,
+        per_probe,
+        by_pair,
+        fallbacks,
+    })
+}
+
+/// What [`score_group`] gives: the figures, the lines of `probes.csv` and those of
+/// `bipolar-pairs.csv`, and per landmark set the count of bipolar comparisons that took a
+/// fallback ([`facematch::Comparison::fallbacks`]), by kind.
+pub(super) struct Scored {
+    pub(super) metrics: Vec<Metrics>,
+    pub(super) per_probe: Vec<Vec<String>>,
+    pub(super) by_pair: Vec<Vec<String>>,
+    pub(super) fallbacks: Vec<String>,
+}
+
+/// One line of `probes.csv`: where the probe's own identity ranks among the gallery for one
+/// score (1 = identified; empty when its genuine score failed), its genuine score, and the
+/// best impostor with its score.
+fn probe_rank(
+    name: &str,
+    identity: usize,
+    set: &str,
+    score: &str,
+    row: &[f64],
+    gallery_id: &[usize],
+) -> Vec<String> {
+    let genuine = row
+        .iter()
+        .zip(gallery_id)
+        .filter(|(_, &g)| g == identity)
+        .map(|(v, _)| *v)
+        .fold(f64::NAN, f64::min);
+    let impostor = row
+        .iter()
+        .zip(gallery_id)
+        .filter(|(v, &g)| g != identity && v.is_finite())
+        .min_by(|a, b| a.0.total_cmp(b.0).then(a.1.cmp(b.1)));
+    let rank = genuine.is_finite().then(|| {
+        1 + row
+            .iter()
+            .zip(gallery_id)
+            .filter(|(v, &g)| g != identity && v.is_finite() && **v < genuine)
+            .count()
+    });
+    let num = |v: f64| {
+        if v.is_finite() {
+            format!("{v:.6}")
+        } else {
+            String::new()
+        }
+    };
+    vec![
+        name.to_string(),
+        identity.to_string(),
+        set.to_string(),
+        score.to_string(),
+        rank.map(|r| r.to_string()).unwrap_or_default(),
+        num(genuine),
+        impostor.map(|(_, g)| g.to_string()).unwrap_or_default(),
+        impostor.map(|(v, _)| num(*v)).unwrap_or_default(),
+    ]
+}
+
+/// Every failure of a group: (face, landmark set, what failed).
+pub(super) fn failures(faces: &[Face], group: &str) -> Vec<[String; 4]> {
+    let mut out = Vec::new();
+    for f in faces {
+        for (k, set) in SETS.iter().enumerate() {
+            let what: Vec<String> = match &f.desc[k] {
+                Err(e) => vec![e.clone()],
+                Ok(d) => [
+                    match &d.bip {
+                        Ok(b) => b.sets[b.pair as usize].as_ref().err().cloned(),
+                        Err(e) => Some(e.clone()),
+                    }
+                    .as_ref(),
+                    d.facial.as_ref().err(),
+                    d.iso.as_ref().err(),
+                ]
+                .into_iter()
+                .flatten()
+                .cloned()
+                .collect(),
+            };
+            for w in what {
+                out.push([group.to_string(), f.name.clone(), set.to_string(), w]);
+            }
+        }
+    }
+    out
+}
