@@ -128,33 +128,24 @@ fn a_probe_scores_alike_after_a_rigid_motion_and_in_other_units() {
 }
 
 #[test]
-fn a_face_beside_another_head_is_found_after_a_crop_and_the_notes_say_so() {
+fn a_face_before_a_wall_is_found() {
     let Some([a]) = testsupport::paper_meshes(["id3_neutral.obj"]) else {
         return;
     };
-    // A second head 24 cm to the side and 4 cm farther from the scanner (cm): the uncropped
-    // scan is two faces wide.
+    // A 25 x 25 cm wall 25 cm behind the nose tip (cm), wider than the head: the uncropped
+    // scan is mostly wall.
+    let nose = a.position(4857);
     let n = a.n_vertices() as u32;
-    let positions: Vec<DVec3> = a
-        .positions()
-        .iter()
-        .copied()
-        .chain(
-            a.positions()
-                .iter()
-                .map(|p| *p + DVec3::new(24.0, 0.0, -4.0)),
-        )
-        .collect();
-    let triangles: Vec<[u32; 3]> = a
-        .triangles()
-        .iter()
-        .copied()
-        .chain(a.triangles().iter().map(|t| t.map(|v| v + n)))
-        .collect();
-    let two = TriMesh::new(positions, triangles).unwrap();
+    let c = nose - DVec3::new(0.0, 0.0, 25.0);
+    let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+        .map(|(x, y)| c + DVec3::new(12.5 * x, 12.5 * y, 0.0));
+    let positions: Vec<DVec3> = a.positions().iter().copied().chain(corners).collect();
+    let mut triangles = a.triangles().to_vec();
+    triangles.extend([[n, n + 1, n + 2], [n, n + 2, n + 3]]);
+    let scene = TriMesh::new(positions, triangles).unwrap();
     let o = MatchOptions::default();
     let sc = rangescan::scan(
-        &two,
+        &scene,
         &ScanOptions {
             input_mm_per_unit: 10.0,
             seed: 21,
@@ -163,17 +154,31 @@ fn a_face_beside_another_head_is_found_after_a_crop_and_the_notes_say_so() {
     )
     .unwrap();
     let s = prepare(ScanInput::Grid(&sc.grid), &o).unwrap();
-    // The face found is the front one: the nose tip (the ICT model's vertex 4857) within 5 mm.
-    let truth = sc.scan_from_input.transform_point3(a.position(4857));
-    let nose = s
+    // The face is found, its nose tip (the ICT model's vertex 4857) within 5 mm; the crop
+    // leaves the wall out.
+    let truth = sc.scan_from_input.transform_point3(nose);
+    let found = s
         .detected
         .get(landmarks::LandmarkName::NoseTip)
         .unwrap()
         .position;
     assert!(
-        (nose - truth).length() < 5.0,
-        "nose tip at {nose:?}, the front head's at {truth:?}; notes {:?}",
+        (found - truth).length() < 5.0,
+        "nose tip at {found:?}, truth {truth:?}; notes {:?}",
         s.notes
     );
-    eprintln!("notes: {:?}", s.notes);
+    // The crop: 100 mm around the found nose tip, within 5 mm of the truth; the wall is 250 mm
+    // behind.
+    assert!(
+        s.mesh
+            .positions()
+            .iter()
+            .all(|p| (*p - truth).length() < 105.0),
+        "the prepared scan reaches beyond the crop: {:?}",
+        s.mesh
+            .positions()
+            .iter()
+            .map(|p| (*p - truth).length())
+            .fold(0.0, f64::max)
+    );
 }
