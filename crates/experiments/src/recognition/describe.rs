@@ -215,6 +215,5 @@ pub(super) fn describe_face(
     })
 }
 
-/// Directions of the reference-point search around each pole (the recognition benchmarks and
-/// scan-study).
-pub(crate) const SEARCH_DIRECTIONS: usize = 6;
+/// Directions of the reference-point search around each pole (both recognition benchmarks).
+pub(super) const SEARCH_DIRECTIONS: usize = 6;

@@ -173,7 +173,7 @@ const SCAN_REF_SEARCH_MM: f64 = 2.0;
 
 /// The default of `--view-match` (degrees). Not tuned: below it a probe is near frontal, its
 /// scanner saw what the gallery's did, and the gallery's own description is used.
-pub(crate) const SCAN_VIEW_MATCH_DEG: f64 = 10.0;
+const SCAN_VIEW_MATCH_DEG: f64 = 10.0;
 
 /// The default of `--side-pair` (degrees), chosen on 16 identities: 25 moved one probe from
 /// rank 1 to 3 and gained nothing else (docs/scans.md, "Side pairs and lost corners").
