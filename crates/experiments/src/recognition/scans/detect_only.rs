@@ -49,7 +49,7 @@ pub(super) fn detect_only(
             "outer eye left (mm)",
             "nose tip (mm)",
             "confidence",
-            "why not found or unseen",
+            "why not found or unseen; what prepare substituted",
         ],
         &rows,
     )?;
@@ -127,7 +127,7 @@ fn detect_all(
                         status: "found",
                         err,
                         confidence: Some(d.confidence),
-                        why: why.join("; "),
+                        why: why.into_iter().chain(p.notes.clone()).collect::<Vec<_>>().join("; "),
                     }
                 }
             }

@@ -34,6 +34,9 @@ pub(super) struct Face {
     /// Detected minus true position of the outer eye corners and the nose tip (mm), when
     /// detected and on the scan.
     pub(super) det_err: Option<[f64; 3]>,
+    /// What `facematch::prepare` assumed or substituted on the way to the detected landmarks
+    /// (a crop around the point nearest the scanner where no face was found uncropped).
+    pub(super) prepare_notes: Vec<String>,
     pub(super) valid_samples: usize,
     pub(super) vertices: usize,
     /// Wall seconds: scan, clean (ground truth's), prepare (the detected path's cleanings and
@@ -96,6 +99,7 @@ impl Pipeline<'_> {
             pts: [Vec::new(), Vec::new()],
             desc: [Err(String::new()), Err(String::new())],
             det_err: None,
+            prepare_notes: Vec::new(),
             valid_samples: 0,
             vertices: 0,
             secs: [0.0; 4],
@@ -133,6 +137,7 @@ impl Pipeline<'_> {
         face.secs[1] = s.times.clean.as_secs_f64();
         if let Ok(p) = &prepared {
             face.det_err = detection_errors(&s, &p.detected);
+            face.prepare_notes = p.notes.clone();
         }
         // The reference-point search is the probes' (the gallery keeps its one description).
         let gallery_opts;

@@ -247,6 +247,22 @@ fn landmark_section(rep: &mut Report, everyone: &[&Face]) -> Result<()> {
         &lm_rows,
     )?;
     rep.para("Per scan: the distance of each detected landmark from its ground truth (`landmarks.csv`; empty where detection failed or the ground truth is not on the scan).");
+    let noted: Vec<String> = everyone
+        .iter()
+        .filter(|f| !f.prepare_notes.is_empty())
+        .map(|f| format!("{}: {}", f.name, f.prepare_notes.join("; ")))
+        .collect();
+    rep.para(&format!(
+        "`facematch::prepare` took a substitution on {} of {} scans (each listed; the detected landmarks of these scans were found after it):",
+        noted.len(),
+        everyone.len()
+    ));
+    rep.list(&noted);
+    println!(
+        "prepare notes on {} of {} scans",
+        noted.len(),
+        everyone.len()
+    );
     let time_row = |k: usize| median(everyone.iter().map(|f| f.secs[k]).collect());
     rep.para(&format!(
         "Per scan (median wall time, {} valid samples, {} vertices after cleaning): scan {:.2} s, clean (ground truth's) {:.2} s, `facematch::prepare` (the detected landmarks' cleanings and detections) {:.2} s, the four representations with both landmark sets {:.2} s (faces in parallel on every core, so these are upper bounds of the single-scan times).",
