@@ -110,8 +110,10 @@ fn equal_distance_roots(w1: &Window, w2: &Window, out: &mut [f64; 2]) -> usize {
     // |S1|^2 - |S2|^2 written to avoid cancellation.
     let k = u * (w1.sx + w2.sx) + (w1.sy - w2.sy) * (w1.sy + w2.sy);
     let ad = delta.abs();
-    if ad <= 1e-14 * w1.scale_bound().max(w2.scale_bound())
-        && ad <= 1e-14 * w1.scale().max(w2.scale())
+    // Equal sigmas (every window of one source without pseudo-sources) need no scale.
+    if ad == 0.0
+        || (ad <= 1e-14 * w1.scale_bound().max(w2.scale_bound())
+            && ad <= 1e-14 * w1.scale().max(w2.scale()))
     {
         // Perpendicular bisector of the two sources.
         if u != 0.0 {
