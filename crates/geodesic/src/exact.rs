@@ -91,7 +91,8 @@ impl HeGeom {
 /// Reusable per-solve buffers of [`ExactGeodesic`] (vertex states, window-list headers and
 /// flags, queues, a pool of window lists) for [`ExactGeodesic::distances_with`]: a caller
 /// solving many fields on one mesh keeps one per thread instead of allocating them per solve.
-/// Holds about `10 n + 25 h` bytes for a mesh of `n` vertices and `h` half-edges after a solve.
+/// After a solve it holds `10 n + 25 h` bytes for a mesh of `n` vertices and `h` half-edges,
+/// plus the queues and up to 4096 emptied window lists kept for reuse.
 #[derive(Debug, Default)]
 pub struct ExactWorkspace {
     buf: solve::Buffers,
