@@ -27,9 +27,9 @@ pub struct SearchedPole {
 impl SearchedPole {
     /// The candidates of the reference vertex `v` (as [`reference_candidates`] with `toward`,
     /// `radius` and `directions`) with their fields: `given`, the field from `v`, is taken as
-    /// it is, each moved candidate's is solved by `solver` with `opts` (a cut-off keeps the
-    /// solves short). Errors are those of [`reference_candidates`]; a failed solve leaves that
-    /// candidate's field `None`.
+    /// it is, the moved candidates' are solved by `solver` with `opts` (a cut-off keeps the
+    /// solves short), in parallel. Errors are those of [`reference_candidates`]; a failed solve
+    /// leaves that candidate's field `None`.
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         mesh: &TriMesh,
@@ -42,13 +42,28 @@ impl SearchedPole {
         opts: &SolveOptions,
     ) -> Result<Self, BipolarError> {
         let vertices = reference_candidates(mesh, v, toward, radius, directions)?;
+        // The moved candidates' fields in one parallel batch; should any fail, each is solved
+        // on its own, so that only the failed ones are `None`.
+        let sets: Vec<Vec<Source>> = vertices
+            .iter()
+            .filter(|&&w| w != v)
+            .map(|&w| vec![Source::Vertex(w)])
+            .collect();
+        let mut solved = match solver.distances_many(&sets, opts) {
+            Ok(f) => f.into_iter().map(Some).collect::<Vec<_>>(),
+            Err(_) => sets
+                .iter()
+                .map(|set| solver.distances(set, opts).ok())
+                .collect(),
+        }
+        .into_iter();
         let fields = vertices
             .iter()
             .map(|&w| {
                 if w == v {
                     Some(given.to_vec())
                 } else {
-                    solver.distances(&[Source::Vertex(w)], opts).ok()
+                    solved.next().flatten()
                 }
             })
             .collect();
