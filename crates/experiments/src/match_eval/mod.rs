@@ -229,6 +229,24 @@ fn unusable_section(rep: &mut Report, sets: &[Set], processed: &[(Vec<BntGrid>, 
         } else {
             rep.list(&failed);
         }
+        // What preparation substituted on the scans that were used (the notes of their
+        // templates and probes).
+        let noted: Vec<String> = g
+            .iter()
+            .zip(&pr.templates)
+            .filter_map(|(s, t)| Some((s, &t.as_ref().ok()?.notes)))
+            .chain(p.iter().zip(&pr.probe_notes))
+            .filter(|(_, n)| !n.is_empty())
+            .map(|(s, n)| format!("{}: {}", s.name, n.join("; ")))
+            .collect();
+        rep.heading(3, &format!("{name}: what preparation substituted"));
+        rep.para(&format!(
+            "{} of {} scans (the template's or the probe's notes):",
+            noted.len(),
+            g.len() + p.len()
+        ));
+        rep.list(&noted);
+        println!("{name}: preparation substituted on {} scans", noted.len());
     }
 }
 

@@ -175,6 +175,8 @@ pub(super) fn scan_all(
 pub(super) struct Processed {
     pub templates: Vec<Result<Template, String>>,
     pub probes: Vec<Result<Description, String>>,
+    /// What `facematch::prepare` assumed or substituted for each probe.
+    pub probe_notes: Vec<Vec<String>>,
 }
 
 /// Enrols the gallery scans and describes the probes (with the search), in parallel.
@@ -203,17 +205,24 @@ pub(super) fn process(
         .collect();
     pb.finish();
     let pb = bar(probes.len(), "probes");
-    let probes = probes
+    let (probes, probe_notes) = probes
         .par_iter()
         .zip(grids_p)
         .map(|(_, g)| {
             let d = prepare(ScanInput::Grid(g), o)
-                .and_then(|s| s.describe(o, true))
+                .and_then(|s| Ok((s.describe(o, true)?, s.notes)))
                 .map_err(|e| e.to_string());
             pb.inc(1);
-            d
+            match d {
+                Ok((d, notes)) => (Ok(d), notes),
+                Err(e) => (Err(e), Vec::new()),
+            }
         })
-        .collect();
+        .unzip();
     pb.finish();
-    Processed { templates, probes }
+    Processed {
+        templates,
+        probes,
+        probe_notes,
+    }
 }

@@ -15,8 +15,8 @@
 //! descriptor points with ambiguous keys per setting and the fallbacks of the `facematch`
 //! comparisons.
 //!
-//! Files: [`acquisition`] (settings, scanning, landmarks), [`variants`] (the bipolar variants),
-//! [`description`] (a scan's descriptions), [`distances`] (a pair's distances), [`outputs`]
+//! Files: `acquisition` (settings, scanning, landmarks), `variants` (the bipolar variants),
+//! `description` (a scan's descriptions), `distances` (a pair's distances), `outputs`
 //! (tables, report, histograms). Only composes the libraries; deterministic (the scanner's
 //! seeds, rayon results collected in input order).
 
