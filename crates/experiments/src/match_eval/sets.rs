@@ -226,3 +226,48 @@ pub(super) fn process(
         probe_notes,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_held_out_scan_not_found_uncropped_is_found_after_the_fallback_crop_and_said() {
+        let dir = testsupport::require_shared!(testsupport::MODEL);
+        #[derive(clap::Parser)]
+        struct Cli {
+            #[command(flatten)]
+            args: Args,
+        }
+        let a = <Cli as clap::Parser>::parse_from(["match-eval", "--model", dir.to_str().unwrap()])
+            .args;
+        let model = FaceModel::load(&dir).unwrap();
+        // p08-s0, the held-out gallery scan whose uncropped scan gives no face (docs/matching.md).
+        let (gallery, _) = held_out_specs(&model, &a);
+        let s = &gallery[8];
+        assert_eq!(s.name, "p08-s0");
+        let face = model
+            .sample(&s.identity_weights, &s.expression_weights)
+            .unwrap();
+        let grid = rangescan::scan(&face, &s.scan).unwrap().grid;
+        let p = prepare(ScanInput::Grid(&grid), &MatchOptions::default()).unwrap();
+        assert!(
+            p.notes
+                .iter()
+                .any(|n| n.contains("no face found on the uncropped scan")
+                    && n.contains("around the point nearest the scanner")),
+            "{:?}",
+            p.notes
+        );
+        // Without the crop (detection on the uncropped scan only) no face is found.
+        let uncropped = MatchOptions {
+            prepare: facematch::PrepareOptions {
+                crop_radius_mm: None,
+                ..MatchOptions::default().prepare
+            },
+            ..MatchOptions::default()
+        };
+        let e = prepare(ScanInput::Grid(&grid), &uncropped).unwrap_err();
+        assert!(e.to_string().contains("mirror-symmetric"), "{e}");
+    }
+}
