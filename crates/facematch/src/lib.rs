@@ -5,8 +5,10 @@
 //!
 //! 1. [`prepare`]: clean the scan ([`scanprep::clean`], units recognised, output in mm), detect
 //!    the landmarks seen from the scanner ([`landmarks::detect_visible`]), clean it again with a
-//!    crop around the *detected* nose tip and detect again. A scan in which no face is found is
-//!    an error with the detector's reason; an outer eye corner the detector reports unseen is a
+//!    crop around the *detected* nose tip and detect again (when the uncropped scan gives no
+//!    face, the first detection is repeated on a crop around the point nearest the scanner,
+//!    and the scan's notes say so). A scan in which no face is found is an error with the
+//!    detector's reasons; an outer eye corner the detector reports unseen is a
 //!    [`Lost`] corner (explicit), not a stand-in.
 //! 2. [`describe`]: the geodesic fields of the outer eye corners and the nose tip (cut off at
 //!    1.4 times the corners' distance), the bipolar descriptor of each of the three pole pairs
