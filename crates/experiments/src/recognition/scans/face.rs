@@ -152,8 +152,6 @@ impl Pipeline<'_> {
         };
         let allow_lost = dopt.side_pair_deg.is_some();
         let t = Instant::now();
-        let meshes: [Result<TriMesh, String>; 2] =
-            [Ok(s.mesh.clone()), prepared.clone().map(|p| p.mesh)];
         let lms = [
             truth_lm(&s, allow_lost),
             prepared.as_ref().map_err(Clone::clone).and_then(|p| {
@@ -167,6 +165,7 @@ impl Pipeline<'_> {
             }),
         ];
         face.gt_lm = lms[0].as_ref().ok().copied();
+        let meshes: [Result<TriMesh, String>; 2] = [Ok(s.mesh), prepared.map(|p| p.mesh)];
         for k in 0..2 {
             let (Ok(mesh), Ok(lm)) = (&meshes[k], &lms[k]) else {
                 face.desc[k] = Err(lms[k].clone().err().unwrap_or_default());
