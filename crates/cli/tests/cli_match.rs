@@ -129,14 +129,9 @@ fn identify_ranks_the_benchmarks_own_scans_as_the_benchmark() {
     let (scans, out) = (dir.path().join("scans"), dir.path().join("bench"));
     // The scan benchmark on 2 identities (a neutral frontal gallery scan each, one turned probe
     // each), writing its raw scans.
-    #[derive(clap::Parser)]
-    struct Cli {
-        #[command(flatten)]
-        args: experiments::recognition::Args,
-    }
     let s = |p: &std::path::Path| p.to_str().unwrap().to_string();
     let (model, scans_s, out_s) = (s(&model), s(&scans), s(&out));
-    let args = <Cli as clap::Parser>::parse_from([
+    let args: experiments::recognition::Args = experiments::parse_args(&[
         "recognition",
         "--scans",
         "--identities",
@@ -150,8 +145,7 @@ fn identify_ranks_the_benchmarks_own_scans_as_the_benchmark() {
         &out_s,
         "--save-scans",
         &scans_s,
-    ])
-    .args;
+    ]);
     experiments::recognition::run(args).unwrap();
     // Its bipolar distances with the detected landmarks (the path a user's scan takes): per
     // probe and gallery identity, the three pairs' distances; the score is their least.

@@ -16,6 +16,18 @@ pub mod scan_study;
 pub mod section6;
 pub mod sphere_validate;
 
+/// A task's options parsed from `argv` (the task's name first, then its flags) as `cargo xtask
+/// <task>` parses them; for tests and programs that run a task in-process. Bad arguments end
+/// the process with clap's message.
+pub fn parse_args<A: clap::Args>(argv: &[&str]) -> A {
+    #[derive(clap::Parser)]
+    struct Cli<A: clap::Args> {
+        #[command(flatten)]
+        args: A,
+    }
+    <Cli<A> as clap::Parser>::parse_from(argv).args
+}
+
 mod curves;
 mod paths;
 mod pipeline;

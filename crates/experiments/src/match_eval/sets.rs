@@ -234,13 +234,7 @@ mod tests {
     #[test]
     fn the_held_out_scan_not_found_uncropped_is_found_after_the_fallback_crop_and_said() {
         let dir = testsupport::require_shared!(testsupport::MODEL);
-        #[derive(clap::Parser)]
-        struct Cli {
-            #[command(flatten)]
-            args: Args,
-        }
-        let a = <Cli as clap::Parser>::parse_from(["match-eval", "--model", dir.to_str().unwrap()])
-            .args;
+        let a: Args = crate::parse_args(&["match-eval", "--model", dir.to_str().unwrap()]);
         let model = FaceModel::load(&dir).unwrap();
         // p08-s0, the held-out gallery scan whose uncropped scan gives no face (docs/matching.md).
         let (gallery, _) = held_out_specs(&model, &a);

@@ -8,11 +8,6 @@ fn detect_only_writes_one_row_per_scan_and_stops() {
     let model = testsupport::require_shared!(testsupport::MODEL);
     let out = std::env::temp_dir().join(format!("bipolar-detect-only-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
-    #[derive(clap::Parser)]
-    struct Cli {
-        #[command(flatten)]
-        args: Args,
-    }
     let (model, dir) = (model.display().to_string(), out.display().to_string());
     let args = |extra: &[&str]| {
         let base = [
@@ -29,7 +24,7 @@ fn detect_only_writes_one_row_per_scan_and_stops() {
             "--out",
             &dir,
         ];
-        <Cli as clap::Parser>::parse_from(base.iter().chain(extra)).args
+        crate::parse_args::<Args>(&[&base[..], extra].concat())
     };
     run(args(&[])).unwrap();
     let text = std::fs::read_to_string(out.join("detection.csv")).unwrap();

@@ -36,12 +36,7 @@ fn the_view_matched_variant_is_the_least_of_the_three_pairs() {
 }
 
 fn study_args(ref_search_mm: f64) -> Args {
-    #[derive(clap::Parser)]
-    struct Cli {
-        #[command(flatten)]
-        args: Args,
-    }
-    let mut args = <Cli as clap::Parser>::parse_from(["scan-study"]).args;
+    let mut args: Args = crate::parse_args(&["scan-study"]);
     args.ref_search_mm = ref_search_mm;
     args
 }
