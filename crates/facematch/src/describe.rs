@@ -436,13 +436,13 @@ fn moved_descriptors(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use geodesic::GeodesicSolver;
 
     /// A flat sheet of `nx` x `ny` squares of 2 mm, its landmarks at the grid points `at` (r, q,
     /// nose tip), its exact solver and the landmarks' fields.
-    fn plane_face(
+    pub(crate) fn plane_face(
         nx: usize,
         ny: usize,
         at: [(u32, u32); 3],
@@ -456,6 +456,20 @@ mod tests {
         let solver = geodesic::new_solver(&m, geodesic::Method::Exact).unwrap();
         let f = face_fields(&m, solver.as_ref(), poles, 1.4).unwrap();
         (m, poles, solver, f)
+    }
+
+    /// `poles` with the left outer corner lost at its place on `m` (its vertex replaced by the
+    /// nose tip's).
+    pub(crate) fn left_lost(poles: Poles, m: &TriMesh) -> Poles {
+        let [_, q, _] = poles.positions(m);
+        Poles {
+            q: poles.nose,
+            lost: Some(crate::Lost {
+                right: false,
+                position: q,
+            }),
+            ..poles
+        }
     }
 
     /// A solver that counts the fields it solves.
@@ -547,14 +561,7 @@ mod tests {
             assert_eq!(side.frame, frame);
         }
         // The left corner lost: its true place still sets the frame; only the right pair.
-        let lost = Poles {
-            q: poles.nose,
-            lost: Some(crate::Lost {
-                right: false,
-                position: q,
-            }),
-            ..poles
-        };
+        let lost = left_lost(poles, &m);
         assert_eq!(lost.positions(&m), [r, q, nose]);
         let f = face_fields(&m, solver.as_ref(), lost, 1.4).unwrap();
         assert!(f.uq.is_empty() && f.scale(lost).is_err());

@@ -125,6 +125,7 @@ pub fn describe_view(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::describe::tests::{left_lost, plane_face};
     use crate::Pair;
 
     #[test]
@@ -157,12 +158,7 @@ mod tests {
     #[test]
     fn a_view_keeps_a_face_with_a_lost_corner() {
         // A 100 x 60 mm sheet (2 mm squares), seen turned 30 degrees about the vertical.
-        let m = meshcore::shapes::grid(50, 30, meshcore::shapes::Diagonals::Alternating, |i, j| {
-            DVec3::new(2.0 * i as f64, 2.0 * j as f64, 0.0)
-        })
-        .unwrap();
-        let at = |i: u32, j: u32| j * 51 + i;
-        let poles = Poles::new(at(5, 20), at(45, 20), at(25, 5));
+        let (m, poles, _, _) = plane_face(50, 30, [(5, 20), (45, 20), (25, 5)]);
         let o = MatchOptions {
             levels: 8,
             boundary_margin_mm: None,
@@ -177,16 +173,7 @@ mod tests {
         assert!(whole.iter().all(Result::is_ok), "{whole:?}");
         // The left corner lost at its true place: the cut is the same and so is the right side
         // pair's descriptor (its frame from the lost corner's place); no other pair.
-        let [_, q, _] = poles.positions(&m);
-        let lost = Poles {
-            q: poles.nose,
-            lost: Some(crate::Lost {
-                right: false,
-                position: q,
-            }),
-            ..poles
-        };
-        let cut = describe_view(&m, lost, DVec3::Z, toward, &o, &v).unwrap();
+        let cut = describe_view(&m, left_lost(poles, &m), DVec3::Z, toward, &o, &v).unwrap();
         let (corners, left, right) = (
             Pair::Corners as usize,
             Pair::LeftNose as usize,
