@@ -73,18 +73,8 @@ pub(crate) struct Solve<'a> {
     g: &'a ExactGeodesic,
     cut: f64,
     pub(crate) d: Vec<f64>,
-    state: Vec<u8>,
-    emitted: Vec<f64>,
-    emit_flag: Vec<bool>,
-    lists: Vec<Vec<Window>>,
-    /// Per half-edge: [`QUEUED`] (in `fifo`) and [`FILLED`] (its list is not empty), one byte
-    /// so that the queue checks do not load the list headers.
-    flags: Vec<u8>,
-    fifo: VecDeque<u32>,
-    heap: BinaryHeap<Item>,
-    pool: Vec<Vec<Window>>,
-    pending_emit: Vec<u32>,
-    tc_buf: Vec<f64>,
+    /// The per-solve arrays, reusable by the next solve ([`Solve::finish_into`]).
+    b: Buffers,
     bound_stats: BoundStats,
     draining: bool,
     /// Pairwise trim and apex split enabled (off only in the differential tests' oracle mode,
@@ -108,6 +98,8 @@ pub(crate) struct Buffers {
     emitted: Vec<f64>,
     emit_flag: Vec<bool>,
     lists: Vec<Vec<Window>>,
+    /// Per half-edge: [`QUEUED`] (in `fifo`) and [`FILLED`] (its list is not empty), one byte
+    /// so that the queue checks do not load the list headers.
     flags: Vec<u8>,
     fifo: VecDeque<u32>,
     heap: BinaryHeap<Item>,
@@ -174,16 +166,7 @@ impl<'a> Solve<'a> {
             g,
             cut,
             d: vec![f64::INFINITY; n],
-            state: buf.state,
-            emitted: buf.emitted,
-            emit_flag: buf.emit_flag,
-            lists: buf.lists,
-            flags: buf.flags,
-            fifo: buf.fifo,
-            heap: buf.heap,
-            pool: buf.pool,
-            pending_emit: buf.pending_emit,
-            tc_buf: buf.tc_buf,
+            b: buf,
             bound_stats: BoundStats::default(),
             draining: false,
             prune: true,
@@ -226,7 +209,7 @@ impl<'a> Solve<'a> {
         for s in seeds {
             match s {
                 Seed::Vertex(v) => {
-                    self.emit_flag[v as usize] = true;
+                    self.b.emit_flag[v as usize] = true;
                     self.relax(v, 0.0, Pred::Source);
                 }
                 Seed::Face { face, bary, skip } => self.seed_face_point(face, bary, skip),
@@ -235,7 +218,7 @@ impl<'a> Solve<'a> {
                     self.points.push((face, [f64::NAN; 3], pos));
                     for &v in &self.g.tris[face as usize] {
                         let dv = (self.g.positions[v as usize] - pos).length();
-                        self.emit_flag[v as usize] = true;
+                        self.b.emit_flag[v as usize] = true;
                         self.relax(v, dv, Pred::Point(i));
                     }
                 }
@@ -323,23 +306,23 @@ impl<'a> Solve<'a> {
             w.id = rec.len() as u32;
             rec.push(Record { h, w, origin });
         }
-        let list = &mut self.lists[h as usize];
+        let list = &mut self.b.lists[h as usize];
         if list.capacity() == 0 {
-            if let Some(v) = self.pool.pop() {
+            if let Some(v) = self.b.pool.pop() {
                 *list = v;
             }
         }
         list.push(w);
-        let f = &mut self.flags[h as usize];
+        let f = &mut self.b.flags[h as usize];
         *f |= FILLED;
         if *f & QUEUED == 0 {
             let g = self.g;
             if self.draining
-                || self.state[g.tail(h) as usize] == INSIDE
-                || self.state[g.head(h) as usize] == INSIDE
+                || self.b.state[g.tail(h) as usize] == INSIDE
+                || self.b.state[g.head(h) as usize] == INSIDE
             {
-                self.flags[h as usize] |= QUEUED;
-                self.fifo.push_back(h);
+                self.b.flags[h as usize] |= QUEUED;
+                self.b.fifo.push_back(h);
             }
         }
     }
@@ -352,11 +335,11 @@ impl<'a> Solve<'a> {
             if !self.pred.is_empty() {
                 self.pred[vi] = pred;
             }
-            if self.state[vi] != INSIDE {
-                self.state[vi] = FRONT;
-                self.heap.push(Item(dist, v));
-            } else if self.emit_flag[vi] {
-                self.pending_emit.push(v);
+            if self.b.state[vi] != INSIDE {
+                self.b.state[vi] = FRONT;
+                self.b.heap.push(Item(dist, v));
+            } else if self.b.emit_flag[vi] {
+                self.b.pending_emit.push(v);
             }
         }
     }
@@ -364,10 +347,10 @@ impl<'a> Solve<'a> {
     /// Emits the pseudo-source windows of `v` (and relaxes its neighbours along edges).
     fn emit_from_vertex(&mut self, v: u32) {
         let dv = self.d[v as usize];
-        if self.emitted[v as usize] == dv || dv > self.cut {
+        if self.b.emitted[v as usize] == dv || dv > self.cut {
             return;
         }
-        self.emitted[v as usize] = dv;
+        self.b.emitted[v as usize] = dv;
         let g = self.g;
         self.cur_origin = Origin::Vertex(v);
         for &gh in g.opp(v) {
@@ -379,16 +362,16 @@ impl<'a> Solve<'a> {
     }
 
     fn push_list(&mut self, h: u32) {
-        if self.flags[h as usize] == FILLED {
-            self.flags[h as usize] = FILLED | QUEUED;
-            self.fifo.push_back(h);
+        if self.b.flags[h as usize] == FILLED {
+            self.b.flags[h as usize] = FILLED | QUEUED;
+            self.b.fifo.push_back(h);
         }
     }
 
     fn pop_vertex(&mut self, v: u32) {
         let g = self.g;
-        self.state[v as usize] = INSIDE;
-        if self.emit_flag[v as usize] {
+        self.b.state[v as usize] = INSIDE;
+        if self.b.emit_flag[v as usize] {
             self.emit_from_vertex(v);
         }
         for &gh in g.opp(v) {
@@ -400,12 +383,12 @@ impl<'a> Solve<'a> {
                 }
             }
             for u in [g.tail(gh), g.head(gh)] {
-                if self.state[u as usize] == OUTSIDE {
-                    self.state[u as usize] = FRONT;
+                if self.b.state[u as usize] == OUTSIDE {
+                    self.b.state[u as usize] = FRONT;
                 }
             }
             let t = g.twin[gh as usize];
-            let ok = t == NONE || self.state[g.apex(t & IDX) as usize] != OUTSIDE;
+            let ok = t == NONE || self.b.state[g.apex(t & IDX) as usize] != OUTSIDE;
             if ok {
                 self.push_list(gh);
                 if t != NONE {
@@ -417,25 +400,25 @@ impl<'a> Solve<'a> {
 
     pub(crate) fn run(&mut self) {
         loop {
-            if let Some(v) = self.pending_emit.pop() {
+            if let Some(v) = self.b.pending_emit.pop() {
                 self.emit_from_vertex(v);
                 continue;
             }
-            if let Some(h) = self.fifo.pop_front() {
-                self.flags[h as usize] &= !QUEUED;
+            if let Some(h) = self.b.fifo.pop_front() {
+                self.b.flags[h as usize] &= !QUEUED;
                 self.process(h);
                 continue;
             }
             let mut popped = false;
-            while let Some(&Item(dv, v)) = self.heap.peek() {
-                if dv != self.d[v as usize] || self.state[v as usize] == INSIDE {
-                    self.heap.pop();
+            while let Some(&Item(dv, v)) = self.b.heap.peek() {
+                if dv != self.d[v as usize] || self.b.state[v as usize] == INSIDE {
+                    self.b.heap.pop();
                     continue;
                 }
                 if dv > self.cut {
                     break;
                 }
-                self.heap.pop();
+                self.b.heap.pop();
                 self.pop_vertex(v);
                 popped = true;
                 break;
@@ -446,10 +429,10 @@ impl<'a> Solve<'a> {
             // Heap exhausted (or beyond the cut-off): drain every list still holding windows.
             self.draining = true;
             let mut any = false;
-            for (h, f) in self.flags.iter_mut().enumerate() {
+            for (h, f) in self.b.flags.iter_mut().enumerate() {
                 if *f == FILLED {
                     *f = FILLED | QUEUED;
-                    self.fifo.push_back(h as u32);
+                    self.b.fifo.push_back(h as u32);
                     any = true;
                 }
             }
@@ -473,25 +456,13 @@ impl<'a> Solve<'a> {
                 }
             }
         }
-        let buf = Buffers {
-            state: self.state,
-            emitted: self.emitted,
-            emit_flag: self.emit_flag,
-            lists: self.lists,
-            flags: self.flags,
-            fifo: self.fifo,
-            heap: self.heap,
-            pool: self.pool,
-            pending_emit: self.pending_emit,
-            tc_buf: self.tc_buf,
-        };
-        (self.d, buf)
+        (self.d, self.b)
     }
 
     /// The triangle step: filters the list of `h` and pushes its windows across face(h).
     fn process(&mut self, h: u32) {
-        let mut ws = std::mem::take(&mut self.lists[h as usize]);
-        self.flags[h as usize] &= !FILLED;
+        let mut ws = std::mem::take(&mut self.b.lists[h as usize]);
+        self.b.flags[h as usize] &= !FILLED;
         if ws.is_empty() {
             return;
         }
@@ -532,7 +503,7 @@ impl<'a> Solve<'a> {
         // P2: best window for the apex and the split point.
         let geo = geo.frame();
         let (cx, cy) = (geo.cx, geo.cy);
-        let mut tcs = std::mem::take(&mut self.tc_buf);
+        let mut tcs = std::mem::take(&mut self.b.tc_buf);
         tcs.clear();
         let mut best = f64::INFINITY;
         let mut p_star = 0.0;
@@ -585,14 +556,14 @@ impl<'a> Solve<'a> {
                 }
             }
         }
-        self.tc_buf = tcs;
+        self.b.tc_buf = tcs;
         self.recycle(ws);
     }
 
     fn recycle(&mut self, mut ws: Vec<Window>) {
         ws.clear();
-        if ws.capacity() > 0 && self.pool.len() < POOL_MAX {
-            self.pool.push(ws);
+        if ws.capacity() > 0 && self.b.pool.len() < POOL_MAX {
+            self.b.pool.push(ws);
         }
     }
 
