@@ -1,10 +1,10 @@
 //! The experiments of the bipolar workspace, run as `cargo xtask <task>`: one module per task
 //! (`sphere_validate`, `robustness`, `recognition`, `landmarks_eval`, `scan_study`, `scan_path`,
 //! `section6`), each with its clap `Args` and a `run` function. They compose the libraries'
-//! public APIs; the pieces several tasks share are the curve representations of section 6
-//! (`curves`), the pipeline glue around `bipolar` and `shapedist` (`pipeline`), the range-scan
-//! sets (`scans`), report writing (`report`) and the default paths (`paths`). Straightest
-//! geodesics are `geodesic::straightest`, the single-pole descriptor is `bipolar::polar`;
+//! public APIs; the pieces several tasks share are the pipeline glue around `bipolar` and
+//! `shapedist` (`pipeline`), the range-scan sets (`scans`), report writing (`report`) and the
+//! default paths (`paths`). The curve representations of section 6 are `facecurves::nose`,
+//! straightest geodesics `geodesic::straightest`, the single-pole descriptor `bipolar::polar`;
 //! face-set loading, the face frame and the static-area mask are in the `facemodel` crate.
 
 pub mod landmarks_eval;
@@ -28,7 +28,6 @@ pub fn parse_args<A: clap::Args>(argv: &[&str]) -> A {
     <Cli<A> as clap::Parser>::parse_from(argv).args
 }
 
-mod curves;
 mod paths;
 mod pipeline;
 mod report;

@@ -1,6 +1,6 @@
 //! Report folder writing: `report.md` (text, tables, embedded figures), CSV tables, PNG twins
-//! of the SVG figures, and the line-plot call shared by the reports (figures are drawn by
-//! `viz`).
+//! of the SVG figures, the line-plot call shared by the reports (figures are drawn by `viz`),
+//! and the list of the errors a run met ([`Failures`]).
 
 use anyhow::{Context, Result};
 use std::fmt::Write as _;
@@ -50,8 +50,12 @@ impl Report {
     }
 
     /// Appends a Markdown table.
-    pub fn table(&mut self, header: &[&str], rows: &[Vec<String>]) {
-        let _ = writeln!(self.md, "| {} |", header.join(" | "));
+    pub fn table(&mut self, header: &[impl AsRef<str>], rows: &[Vec<String>]) {
+        let _ = writeln!(
+            self.md,
+            "| {} |",
+            joined(header, " | ", |h| h.as_ref().into())
+        );
         let _ = writeln!(self.md, "|{}|", vec!["---"; header.len()].join("|"));
         for r in rows {
             let _ = writeln!(self.md, "| {} |", r.join(" | "));
@@ -60,8 +64,37 @@ impl Report {
     }
 
     /// Writes a CSV file into the folder.
-    pub fn csv(&self, name: &str, header: &[&str], rows: &[Vec<String>]) -> Result<()> {
+    pub fn csv(&self, name: &str, header: &[impl AsRef<str>], rows: &[Vec<String>]) -> Result<()> {
         write_csv(&self.path(name), header, rows)
+    }
+
+    /// Appends a Markdown table and writes the same cells as the CSV file `name`.
+    pub fn table_csv(
+        &mut self,
+        name: &str,
+        header: &[impl AsRef<str>],
+        rows: &[Vec<String>],
+    ) -> Result<()> {
+        self.table(header, rows);
+        self.csv(name, header, rows)
+    }
+
+    /// Draws a line plot into `file` ([`line_plot`]) and appends it as a figure with `caption`.
+    pub fn plot(
+        &mut self,
+        file: &str,
+        (title, x_label, y_label): (&str, &str, &str),
+        series: &[Series],
+        caption: &str,
+    ) -> Result<()> {
+        line_plot(&self.path(file), title, x_label, y_label, series)?;
+        self.figure(file, caption);
+        Ok(())
+    }
+
+    /// The Markdown written so far.
+    pub fn markdown(&self) -> &str {
+        &self.md
     }
 
     /// Writes a PNG twin of every SVG of the folder (rasterised by `viz::svg_to_png`, in
@@ -94,7 +127,7 @@ impl Report {
 }
 
 /// Writes a CSV file (fields containing `,` or `"` are quoted).
-pub fn write_csv(path: &Path, header: &[&str], rows: &[Vec<String>]) -> Result<()> {
+pub fn write_csv(path: &Path, header: &[impl AsRef<str>], rows: &[Vec<String>]) -> Result<()> {
     let esc = |s: &str| {
         if s.contains([',', '"', '\n']) {
             format!("\"{}\"", s.replace('"', "\"\""))
@@ -102,7 +135,7 @@ pub fn write_csv(path: &Path, header: &[&str], rows: &[Vec<String>]) -> Result<(
             s.to_string()
         }
     };
-    let mut out = header.iter().map(|h| esc(h)).collect::<Vec<_>>().join(",");
+    let mut out = joined(header, ",", |h| esc(h.as_ref()));
     out.push('\n');
     for r in rows {
         out.push_str(&r.iter().map(|f| esc(f)).collect::<Vec<_>>().join(","));
@@ -115,6 +148,62 @@ pub fn write_csv(path: &Path, header: &[&str], rows: &[Vec<String>]) -> Result<(
 pub fn write_json(path: &Path, value: &serde_json::Value) -> Result<()> {
     let text = serde_json::to_string_pretty(value)? + "\n";
     std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))
+}
+
+/// Rows of a labelled matrix: each label, then its row's values with 6 decimals.
+pub fn labelled_rows(labels: &[impl AsRef<str>], m: &[Vec<f64>]) -> Vec<Vec<String>> {
+    let row = |(l, r): (&_, &Vec<f64>)| {
+        let values = r.iter().map(|v| format!("{v:.6}"));
+        std::iter::once(AsRef::<str>::as_ref(l).to_string())
+            .chain(values)
+            .collect()
+    };
+    labels.iter().zip(m).map(row).collect()
+}
+
+/// The errors a run met, listed from parallel work (their cells are NaN), and a count of
+/// pairs left out for too few shared keys.
+#[derive(Debug, Default)]
+pub struct Failures {
+    listed: std::sync::Mutex<Vec<String>>,
+    too_few: std::sync::atomic::AtomicUsize,
+}
+
+impl Failures {
+    /// Lists an error.
+    pub fn list(&self, msg: String) {
+        let mut v = self
+            .listed
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        v.push(msg);
+    }
+
+    /// Counts a pair with too few shared keys.
+    pub fn too_few(&self) {
+        self.too_few
+            .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    /// `r`'s value, or `None` with its error listed (described by `what`).
+    pub fn ok<T, E: std::fmt::Display>(
+        &self,
+        r: Result<T, E>,
+        what: impl FnOnce() -> String,
+    ) -> Option<T> {
+        r.map_err(|e| self.list(format!("{}: {e}", what()))).ok()
+    }
+
+    /// The listed errors, sorted (the run is parallel), and the too-few-keys count.
+    pub fn summary(&self) -> (Vec<String>, usize) {
+        let mut v = self
+            .listed
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .clone();
+        v.sort();
+        (v, self.too_few.load(std::sync::atomic::Ordering::Relaxed))
+    }
 }
 
 /// Formats a number with 4 significant decimals.

@@ -18,6 +18,9 @@
 //!   optionally, scale.
 //!
 //! * [`io`]: JSON files of either representation.
+//! * [`nose`]: both representations of a face around its nose tip from the nose's geodesic
+//!   field (facial curves at `D / N` steps, the iso-curvature network in the disc `U_n <= D` at
+//!   levels shared by a face set) and their distances, as the experiments use them.
 //!
 //! `docs/section6.md` describes what was implemented from the cited papers and where it
 //! departs from them. Nothing here panics on user input: errors are [`FaceCurvesError`].
@@ -27,6 +30,7 @@ mod error;
 pub mod facial;
 pub mod io;
 pub mod iso;
+pub mod nose;
 
 pub use elastic::{elastic_distance, ElasticMatch, ElasticOptions, Resampling};
 pub use error::FaceCurvesError;

@@ -24,7 +24,8 @@
 //! * [`compare()`]: one comparison in a chosen [`Mode`] (keyed, ICP mean or Hausdorff) from flat
 //!   settings ([`CompareOptions`]), with its details as JSON: what the command line and the
 //!   Python bindings call.
-//! * [`pairwise_matrix`] and [`write_matrix_csv`]: parallel symmetric distance matrices.
+//! * [`pairwise_matrix`] and [`write_matrix_csv`]: parallel symmetric distance matrices;
+//!   [`Separation`]: how such a matrix separates groups.
 //!
 //! The normalisations and their proofs of lying in [0, 1] are in `docs/shape-distance.md`.
 //! Nothing panics on user input: errors are [`ShapeDistError`].
@@ -52,7 +53,7 @@ pub use keyed::{
     align_pairs, keyed_distance, pair_by_keys, Alignment, KeyedDistance, KeyedOptions, Pairing,
     RobustLoss, RotationMethod,
 };
-pub use matrix::{pairwise_matrix, write_matrix_csv, PairError};
+pub use matrix::{pairwise_matrix, write_matrix_csv, PairError, Separation};
 pub use target::{
     icp_to_target, Convergence, Damping, IcpLoopOptions, IcpTarget, Match, PointTarget,
     TrimRounding,

@@ -1,4 +1,5 @@
-//! Pairwise distance matrices (parallel, symmetric, zero diagonal) and their CSV form.
+//! Pairwise distance matrices (parallel, symmetric, zero diagonal), their CSV form, and how
+//! a matrix separates groups ([`Separation`]).
 
 use std::io::Write;
 
@@ -79,9 +80,86 @@ pub fn write_matrix_csv<W: Write>(
     Ok(())
 }
 
+/// How a symmetric distance matrix separates groups (e.g. the faces of one person): the
+/// largest distance within a group, the smallest between groups, and the same restricted to
+/// the pairs of one `focus` item. NaN distances are ignored; an empty set leaves its
+/// value at `0` (largest) or `+inf` (smallest).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Separation {
+    /// Largest distance between two items of one group.
+    pub max_same: f64,
+    /// Smallest distance between items of different groups.
+    pub min_diff: f64,
+    /// Largest distance between the focus item and another of its group.
+    pub row_max_same: f64,
+    /// Smallest distance between the focus item and an item of another group.
+    pub row_min_diff: f64,
+}
+
+impl Separation {
+    /// The separation of the square matrix `m` by `groups` (one per row; items beyond the
+    /// shorter of the two are ignored), with the pairs of item `focus` also on their own.
+    pub fn of<G: PartialEq>(m: &[Vec<f64>], groups: &[G], focus: usize) -> Self {
+        let mut s = Separation {
+            max_same: 0.0,
+            min_diff: f64::INFINITY,
+            row_max_same: 0.0,
+            row_min_diff: f64::INFINITY,
+        };
+        let n = groups.len().min(m.len());
+        for i in 0..n {
+            for j in i + 1..n.min(m[i].len()) {
+                let (v, row) = (m[i][j], i == focus || j == focus);
+                if groups[i] == groups[j] {
+                    s.max_same = s.max_same.max(v);
+                    if row {
+                        s.row_max_same = s.row_max_same.max(v);
+                    }
+                } else {
+                    s.min_diff = s.min_diff.min(v);
+                    if row {
+                        s.row_min_diff = s.row_min_diff.min(v);
+                    }
+                }
+            }
+        }
+        s
+    }
+
+    /// `min_diff / max_same`: above 1 when every pair within a group is closer than every
+    /// pair across groups.
+    pub fn ratio(&self) -> f64 {
+        self.min_diff / self.max_same
+    }
+
+    /// `row_min_diff / row_max_same`: [`Separation::ratio`] of the focus item's pairs.
+    pub fn row_ratio(&self) -> f64 {
+        self.row_min_diff / self.row_max_same
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn separation_of_groups_and_of_the_focus_row() {
+        let groups = ["a", "a", "b", "c"];
+        let m = vec![
+            vec![0.0, 0.1, 0.3, 0.2],
+            vec![0.1, 0.0, 0.05, 0.4],
+            vec![0.3, 0.05, 0.0, 0.5],
+            vec![0.2, 0.4, 0.5, 0.0],
+        ];
+        let s = Separation::of(&m, &groups, 0);
+        assert_eq!((s.max_same, s.min_diff), (0.1, 0.05));
+        assert_eq!((s.row_max_same, s.row_min_diff), (0.1, 0.2));
+        assert!((s.row_ratio() - 2.0).abs() < 1e-12 && s.ratio() < 1.0);
+        // NaN cells are ignored.
+        let mut m2 = m.clone();
+        (m2[1][2], m2[2][1]) = (f64::NAN, f64::NAN);
+        assert_eq!(Separation::of(&m2, &groups, 0).min_diff, 0.2);
+    }
 
     #[test]
     fn matrix_is_symmetric_with_zero_diagonal_and_reports_failures() {

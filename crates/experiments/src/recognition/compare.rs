@@ -3,10 +3,10 @@
 use super::describe::{describe_face, DescribeOptions, Described};
 use super::metrics::median;
 use super::Lm;
-use crate::curves::{facial_distance, iso_distance_from};
 use crate::pipeline::{dist, single_thread};
 use crate::walk::Walker;
 use anyhow::Result;
+use facecurves::nose::{facial_distance, iso_distance_from};
 use facecurves::ElasticOptions;
 use meshcore::linalg::fit_rigid;
 use meshcore::{DVec3, FaceLocator, TriMesh};

@@ -2,11 +2,11 @@
 //! their settings.
 
 use super::Lm;
-use crate::curves::{facial_curves, iso_curves, iso_point_set, reference_iso_levels};
 use crate::polar::{self, polar_descriptor, PolarOptions, Pole};
 use crate::walk::Walker;
 use anyhow::{Context, Result};
 use bipolar::PolarDescriptor;
+use facecurves::nose::{facial_curves, iso_curves, iso_point_set, reference_iso_levels};
 use facecurves::{ElasticOptions, FacialCurvesDescriptor, IsoLevels};
 use meshcore::{DVec3, Surface, TriMesh};
 use shapedist::{PreparedSet, Which};

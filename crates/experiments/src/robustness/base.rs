@@ -2,7 +2,7 @@
 //! face; the distance against resolution; the 12 x 12 matrices at the default resolution (and
 //! the single-pole matrix).
 
-use super::{eye_mid, n_keys, Ctx, Desc, MethodResults, Prepared, RESOLUTIONS};
+use super::{eye_mid, n_keys, Ctx, Desc, FacePrep, MethodResults, RESOLUTIONS};
 use crate::pipeline::{bar, Region};
 use crate::polar::{polar_descriptor, Pole};
 use crate::report::{markers, polylines, render_face as render};
@@ -61,10 +61,10 @@ fn curves(
 
 /// Figures 4 and 5 on the test face: level curves at 5, 10 and 30 levels between the corners
 /// with the whole-face descriptor, and the static area with its descriptor.
-pub(super) fn renders(ctx: &Ctx<'_>, prep: &Prepared, out: &Path) -> Result<()> {
+pub(super) fn renders(ctx: &Ctx<'_>, prep: &[FacePrep], out: &Path) -> Result<()> {
     let (mname, n) = (ctx.mname(), ctx.args.set.res.levels);
     let f = &ctx.faces[ctx.test];
-    let rf = &prep.refs[ctx.test];
+    let rf = &prep[ctx.test].refs;
     let topo = Topology::new(&f.mesh);
     for &nl in &[5u32, 10, 30] {
         let step = rf.d / f64::from(nl);
@@ -124,15 +124,15 @@ pub(super) fn renders(ctx: &Ctx<'_>, prep: &Prepared, out: &Path) -> Result<()> 
 
 /// Figures 6 and 7: the distance from the test face against resolution, the static and whole
 /// matrices at the default resolution, and the single-pole matrix.
-pub(super) fn run(ctx: &Ctx<'_>, prep: &Prepared, res: &mut MethodResults) -> Result<Base> {
+pub(super) fn run(ctx: &Ctx<'_>, prep: &[FacePrep], res: &mut MethodResults) -> Result<Base> {
     let (faces, test, n) = (ctx.faces, ctx.test, ctx.args.set.res.levels);
     let nf = faces.len();
     let describe_all = |nl: u32, region: Region, label: &'static str| -> Vec<Desc> {
         faces
             .par_iter()
-            .zip(&prep.refs)
-            .map(|(f, r)| {
-                ctx.describe(&f.mesh, r, nl, region, || {
+            .zip(prep)
+            .map(|(f, p)| {
+                ctx.describe(&f.mesh, &p.refs, nl, region, || {
                     format!("{} ({label}, N = {nl})", f.name)
                 })
             })
@@ -182,10 +182,10 @@ pub(super) fn run(ctx: &Ctx<'_>, prep: &Prepared, res: &mut MethodResults) -> Re
         .map(|i| {
             polar_descriptor(
                 &ctx.walkers[i],
-                &prep.nose_fields[i],
+                &prep[i].un,
                 Pole::Vertex(faces[i].landmarks.nose_tip),
-                eye_mid(&prep.refs[i]),
-                &ctx.polar_opts(&prep.refs[i]),
+                eye_mid(&prep[i].refs),
+                &ctx.polar_opts(&prep[i].refs),
             )
         })
         .collect::<Result<_>>()?;

@@ -4,12 +4,11 @@
 
 use super::base::Base;
 use super::stats::{max, mean, min};
-use super::{eye_mid, Ctx, MethodResults, Prepared, RESOLUTIONS};
-use crate::pipeline::{bar, error_grid, field, field_at, perturb, Refs, Region};
+use super::{eye_mid, Ctx, FacePrep, MethodResults, RESOLUTIONS};
+use crate::pipeline::{bar, error_grid, field, perturb, Refs, Region};
 use crate::polar::{polar_descriptor, Pole};
 use anyhow::Result;
 use bipolar::PolarDescriptor;
-use facemodel::face_frame;
 use geodesic::Source;
 use rayon::prelude::*;
 
@@ -23,11 +22,11 @@ struct Cell {
 }
 
 /// Moves q and the nose tip of the test face for every (radius, direction) cell.
-fn perturbed(ctx: &Ctx<'_>, prep: &Prepared, cells: &[(f64, f64)]) -> Result<Vec<Cell>> {
+fn perturbed(ctx: &Ctx<'_>, prep: &[FacePrep], cells: &[(f64, f64)]) -> Result<Vec<Cell>> {
     let test = ctx.test;
     let tf = &ctx.faces[test];
-    let tr = &prep.refs[test];
-    let tsolver = prep.solvers[test].as_ref();
+    let tr = &prep[test].refs;
+    let tsolver = prep[test].solver.as_ref();
     let pb = bar(cells.len(), &format!("{}: perturbation grid", ctx.mname()));
     let grid = cells
         .par_iter()
@@ -36,19 +35,7 @@ fn perturbed(ctx: &Ctx<'_>, prep: &Prepared, cells: &[(f64, f64)]) -> Result<Vec
             let lm = tf.landmarks;
             let w = &ctx.walkers[test];
             let (sp, cut_q) = perturb(w, lm.left_eye_outer, tr.r, radius, theta)?;
-            let uq = field(tsolver, Source::Point(sp))?;
-            let q = tf.mesh.point_position(&sp)?;
-            let d = 0.5 * (uq[lm.right_eye_outer as usize] + field_at(&tf.mesh, &tr.ur, &sp));
-            let frame = face_frame(&tf.mesh, tr.r, q, tr.nose);
-            let refs = Refs {
-                ur: tr.ur.clone(),
-                uq,
-                d,
-                r: tr.r,
-                q,
-                nose: tr.nose,
-                frame,
-            };
+            let refs = prep[test].with_q_moved(tf, sp)?;
             let (spn, cut_nose) = perturb(w, lm.nose_tip, eye_mid(tr), radius, theta)?;
             let un = field(tsolver, Source::Point(spn))?;
             let polar =
@@ -69,7 +56,7 @@ fn perturbed(ctx: &Ctx<'_>, prep: &Prepared, cells: &[(f64, f64)]) -> Result<Vec
 /// Fills the perturbation grid (figures 9, 10, 17) and the three cases (figure 11).
 pub(super) fn run(
     ctx: &Ctx<'_>,
-    prep: &Prepared,
+    prep: &[FacePrep],
     base: &Base,
     res: &mut MethodResults,
 ) -> Result<()> {

@@ -17,18 +17,22 @@ mod report;
 pub(crate) mod stats;
 
 use crate::paths::FaceSetArgs;
-use crate::pipeline::{bipolar, dist, resolve_methods, DescriptorRule, Refs, Region};
+use crate::pipeline::{
+    bipolar, dist, field, field_at, resolve_methods, DescriptorRule, Refs, Region,
+};
 use crate::polar::PolarOptions;
+use crate::report::Failures;
 use crate::walk::Walker;
 use anyhow::{bail, Result};
 use bipolar::PolarDescriptor;
+use facemodel::face_frame;
 use facemodel::Face;
+use geodesic::Source;
 use geodesic::{GeodesicSolver, Method};
-use meshcore::{DVec3, TriMesh};
+use meshcore::{DVec3, SurfacePoint, TriMesh};
 use rayon::prelude::*;
 use shapedist::ShapeDistError;
 use std::path::Path;
-use std::sync::Mutex;
 use std::time::Instant;
 
 /// Arguments of `cargo xtask robustness`.
@@ -76,39 +80,6 @@ struct MethodResults {
     seconds: f64,
 }
 
-/// Crate errors met during the run: every refused descriptor and every distance error other
-/// than "fewer than 3 shared keys" is listed (with the faces' names); the pairs with too few
-/// shared keys are counted. Their cells are NaN.
-#[derive(Debug, Default)]
-struct Failures {
-    listed: Mutex<Vec<String>>,
-    too_few_pairs: Mutex<usize>,
-}
-
-impl Failures {
-    fn list(&self, msg: String) {
-        self.listed
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner)
-            .push(msg);
-    }
-
-    /// The listed failures, sorted (the run is parallel), and the too-few-pairs count.
-    fn summary(&self) -> (Vec<String>, usize) {
-        let mut v = self
-            .listed
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner)
-            .clone();
-        v.sort();
-        let n = *self
-            .too_few_pairs
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner);
-        (v, n)
-    }
-}
-
 /// What every part of one method's run reads.
 struct Ctx<'a> {
     args: &'a Args,
@@ -117,6 +88,43 @@ struct Ctx<'a> {
     test: usize,
     method: Method,
     failures: &'a Failures,
+}
+
+/// One face's geodesic set-up for one method: its solver, reference configuration and
+/// nose-tip field (also `section6`'s).
+pub(crate) struct FacePrep {
+    pub(crate) solver: Box<dyn GeodesicSolver>,
+    pub(crate) refs: Refs,
+    pub(crate) un: Vec<f64>,
+}
+
+impl FacePrep {
+    /// The solver of `method` on the face and its references from the landmark vertices.
+    pub(crate) fn new(face: &Face, method: Method) -> Result<Self> {
+        let solver = geodesic::new_solver(&face.mesh, method)?;
+        let (refs, un) = Refs::of_face(face, solver.as_ref())?;
+        Ok(Self { solver, refs, un })
+    }
+
+    /// The references with the left outer eye corner q moved to `sp`: its field from the
+    /// face's solver, D the mean of both fields at the other corner, the frame rebuilt.
+    pub(crate) fn with_q_moved(&self, face: &Face, sp: SurfacePoint) -> Result<Refs> {
+        let (m, r, nose) = (&face.mesh, self.refs.r, self.refs.nose);
+        let uq = field(self.solver.as_ref(), Source::Point(sp))?;
+        let q = m.point_position(&sp)?;
+        let right = face.landmarks.right_eye_outer as usize;
+        let d = 0.5 * (uq[right] + field_at(m, &self.refs.ur, &sp));
+        let (ur, frame) = (self.refs.ur.clone(), face_frame(m, r, q, nose));
+        Ok(Refs {
+            ur,
+            uq,
+            d,
+            r,
+            q,
+            nose,
+            frame,
+        })
+    }
 }
 
 impl Ctx<'_> {
@@ -137,8 +145,8 @@ impl Ctx<'_> {
         match bipolar(&surface, refs, n, region, self.args.descriptor, None, None) {
             Ok(d) => Some(d),
             Err(e) => {
-                self.failures
-                    .list(format!("{}: descriptor of {}: {e}", self.mname(), what()));
+                let msg = format!("{}: descriptor of {}: {e}", self.mname(), what());
+                self.failures.list(msg);
                 None
             }
         }
@@ -166,11 +174,7 @@ impl Ctx<'_> {
         match r {
             Ok(d) => d,
             Err(ShapeDistError::TooFewPairs { .. }) => {
-                *self
-                    .failures
-                    .too_few_pairs
-                    .lock()
-                    .unwrap_or_else(std::sync::PoisonError::into_inner) += 1;
+                self.failures.too_few();
                 f64::NAN
             }
             Err(e) => {
@@ -278,37 +282,17 @@ pub fn run(args: Args) -> Result<()> {
     Ok(())
 }
 
-/// One method's solvers, reference configurations and nose-tip fields.
-struct Prepared {
-    solvers: Vec<Box<dyn GeodesicSolver>>,
-    refs: Vec<Refs>,
-    nose_fields: Vec<Vec<f64>>,
-}
-
-fn prepare(ctx: &Ctx<'_>) -> Result<Prepared> {
+/// The [`FacePrep`] of every face with the context's method.
+fn prepare(ctx: &Ctx<'_>) -> Result<Vec<FacePrep>> {
     let pb = crate::pipeline::bar(ctx.faces.len(), &format!("{}: base fields", ctx.mname()));
-    let prepared: Vec<(Box<dyn GeodesicSolver>, Refs, Vec<f64>)> = ctx
-        .faces
-        .par_iter()
-        .map(|f| -> Result<_> {
-            let solver = geodesic::new_solver(&f.mesh, ctx.method)?;
-            let (refs, un) = Refs::of_face(f, solver.as_ref())?;
-            pb.inc(1);
-            Ok((solver, refs, un))
-        })
-        .collect::<Result<_>>()?;
+    let prepared = ctx.faces.par_iter().map(|f| {
+        let p = FacePrep::new(f, ctx.method);
+        pb.inc(1);
+        p
+    });
+    let prepared = prepared.collect::<Result<Vec<_>>>()?;
     pb.finish();
-    let mut out = Prepared {
-        solvers: Vec::new(),
-        refs: Vec::new(),
-        nose_fields: Vec::new(),
-    };
-    for (s, r, u) in prepared {
-        out.solvers.push(s);
-        out.refs.push(r);
-        out.nose_fields.push(u);
-    }
-    Ok(out)
+    Ok(prepared)
 }
 
 fn run_method(ctx: &Ctx<'_>, out: &Path) -> Result<MethodResults> {
@@ -317,7 +301,7 @@ fn run_method(ctx: &Ctx<'_>, out: &Path) -> Result<MethodResults> {
     let prep = prepare(ctx)?;
     let mut res = MethodResults {
         name: ctx.mname().to_string(),
-        d: prep.refs.iter().map(|r| r.d).collect(),
+        d: prep.iter().map(|p| p.refs.d).collect(),
         ..Default::default()
     };
     base::renders(ctx, &prep, out)?;

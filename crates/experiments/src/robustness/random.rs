@@ -2,7 +2,7 @@
 //! [0, 5 %] of D, uniform direction) on q, on both corners, and on the nose tip; the matrices
 //! between the perturbed descriptors.
 
-use super::{eye_mid, Ctx, Desc, MethodResults, Prepared};
+use super::{eye_mid, Ctx, Desc, FacePrep, MethodResults};
 use crate::pipeline::{bar, field, field_at, perturb, Refs, Region};
 use crate::polar::{polar_descriptor, Pole};
 use crate::walk::Walker;
@@ -45,29 +45,19 @@ fn draw(
     last.ok_or_else(|| anyhow::anyhow!("no perturbation drawn"))
 }
 
-fn one_face(ctx: &Ctx<'_>, prep: &Prepared, i: usize) -> Result<Run> {
+fn one_face(ctx: &Ctx<'_>, prep: &FacePrep, i: usize) -> Result<Run> {
     let f = &ctx.faces[i];
-    let r0 = &prep.refs[i];
+    let r0 = &prep.refs;
     let w = &ctx.walkers[i];
-    let s = prep.solvers[i].as_ref();
+    let s = prep.solver.as_ref();
     let lm = f.landmarks;
     let n = ctx.args.set.res.levels;
     let mut rng =
         ChaCha8Rng::seed_from_u64(ctx.args.seed ^ (i as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
     // One corner (q).
     let (rad, th, spq) = draw(&mut rng, w, r0.d, lm.left_eye_outer, r0.r)?;
-    let uq = field(s, Source::Point(spq))?;
-    let q = f.mesh.point_position(&spq)?;
-    let d1 = 0.5 * (uq[lm.right_eye_outer as usize] + field_at(&f.mesh, &r0.ur, &spq));
-    let one = Refs {
-        ur: r0.ur.clone(),
-        uq: uq.clone(),
-        d: d1,
-        r: r0.r,
-        q,
-        nose: r0.nose,
-        frame: face_frame(&f.mesh, r0.r, q, r0.nose),
-    };
+    let one = prep.with_q_moved(f, spq)?;
+    let (uq, q) = (one.uq.clone(), one.q);
     let one = ctx.describe(&f.mesh, &one, n, Region::Static, || {
         format!("{} (random error on q)", f.name)
     });
@@ -101,13 +91,13 @@ fn one_face(ctx: &Ctx<'_>, prep: &Prepared, i: usize) -> Result<Run> {
 }
 
 /// Fills the random-error matrices.
-pub(super) fn run(ctx: &Ctx<'_>, prep: &Prepared, res: &mut MethodResults) -> Result<()> {
+pub(super) fn run(ctx: &Ctx<'_>, prep: &[FacePrep], res: &mut MethodResults) -> Result<()> {
     let nf = ctx.faces.len();
     let pb = bar(nf, &format!("{}: random errors", ctx.mname()));
     let runs: Vec<Run> = (0..nf)
         .into_par_iter()
         .map(|i| {
-            let r = one_face(ctx, prep, i);
+            let r = one_face(ctx, &prep[i], i);
             pb.inc(1);
             r
         })

@@ -2,20 +2,18 @@
 //! the refusals listed instead of stopping the run.
 
 use super::Args;
-use crate::curves::{facial_curves, facial_distance, iso_curves, iso_distance};
 use crate::pipeline::{bipolar, dist, DescriptorRule, Refs, Region};
 use crate::polar::{self, polar_descriptor, PolarOptions, Pole};
+use crate::report::Failures;
 use crate::walk::Walker;
 use anyhow::Result;
 use bipolar::PolarDescriptor;
+use facecurves::nose::{facial_curves, facial_distance, iso_curves, iso_distance};
 use facecurves::{ElasticOptions, FacialCurvesDescriptor, IsoCurvatureDescriptor, IsoLevels};
-use facemodel::Face;
-use geodesic::{GeodesicSolver, Method};
 use meshcore::{Surface, TriMesh};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
-use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 /// The four descriptors of one face configuration (`None`: not asked for, or refused and
@@ -26,30 +24,6 @@ pub(super) struct Descs {
     pub polar: Option<PolarDescriptor>,
     pub facial: Option<FacialCurvesDescriptor>,
     pub iso: Option<IsoCurvatureDescriptor>,
-}
-
-/// Errors met (listed in the report); their cells are NaN.
-#[derive(Debug, Default)]
-pub(super) struct Failures(Mutex<Vec<String>>);
-
-impl Failures {
-    /// Lists an error.
-    fn list(&self, s: String) {
-        self.0
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner)
-            .push(s);
-    }
-    /// The errors listed, sorted.
-    pub(super) fn sorted(&self) -> Vec<String> {
-        let mut v = self
-            .0
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner)
-            .clone();
-        v.sort();
-        v
-    }
 }
 
 /// Which descriptors [`Ctx::describe`] builds.
@@ -66,16 +40,6 @@ pub(super) const ALL: Which = Which {
     bipolar: true,
     nose: true,
 };
-
-/// One face's geodesic set-up.
-pub(super) struct Prep {
-    /// The exact geodesic solver of the face.
-    pub solver: Box<dyn GeodesicSolver>,
-    /// The reference configuration (corner fields, D, frame).
-    pub refs: Refs,
-    /// The nose tip's field.
-    pub un: Vec<f64>,
-}
 
 /// What describing a configuration needs besides the fields.
 pub(super) struct Ctx<'a> {
@@ -94,13 +58,7 @@ impl Ctx<'_> {
         r: Result<T, E>,
         what: impl FnOnce() -> String,
     ) -> Option<T> {
-        match r {
-            Ok(x) => Some(x),
-            Err(e) => {
-                self.failures.list(format!("{}: {e}", what()));
-                None
-            }
-        }
+        self.failures.ok(r, what)
     }
 
     /// The descriptors asked for by `which`: bipolar from `refs`; single pole, facial curves
@@ -195,13 +153,6 @@ impl Ctx<'_> {
         }
         (d, t)
     }
-}
-
-/// The exact solver, reference configuration and nose field of a face.
-pub(super) fn prepare(f: &Face) -> Result<Prep> {
-    let solver = geodesic::new_solver(&f.mesh, Method::Exact)?;
-    let (refs, un) = Refs::of_face(f, solver.as_ref())?;
-    Ok(Prep { solver, refs, un })
 }
 
 /// `mesh` with Gaussian noise of standard deviation `sigma` (mesh units) along its vertex

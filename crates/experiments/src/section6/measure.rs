@@ -1,14 +1,15 @@
 //! The measurements of section 6 on a described face set: the between-person matrices and
 //! the time per comparison, the reference-point grid, the depth noise and figure 15.
 
-use super::describe::{noisy, prepare, Ctx, Descs, Prep, Which, ALL};
+use super::describe::{noisy, Ctx, Descs, Which, ALL};
 use super::figure15::{figure15, Fig15};
-use crate::pipeline::{bar, error_grid, field, field_at, perturb, single_thread, Refs};
+use crate::pipeline::{bar, error_grid, field, perturb, single_thread};
 use crate::polar::Pole;
 use crate::robustness::stats::Sep;
+use crate::robustness::FacePrep;
 use crate::walk::Walker;
 use anyhow::{Context, Result};
-use facemodel::{face_frame, Face};
+use facemodel::Face;
 use geodesic::Source;
 use rayon::prelude::*;
 use std::time::Duration;
@@ -19,7 +20,7 @@ pub(super) struct Set<'a> {
     /// The faces.
     pub faces: &'a [Face],
     /// Per face: solver, reference configuration, nose field.
-    pub preps: &'a [Prep],
+    pub preps: &'a [FacePrep],
     /// Per face: the straightest-geodesic walker.
     pub walkers: &'a [Walker<'a>],
     /// Per face: the four descriptors.
@@ -91,7 +92,8 @@ pub(super) fn between_persons(s: &Set<'_>) -> Result<Between> {
         v.sort_by(f64::total_cmp);
         v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
     });
-    let seps: Vec<Sep> = mats.iter().map(|m| Sep::of(m, faces, test)).collect();
+    let persons: Vec<&str> = faces.iter().map(|f| f.person.as_str()).collect();
+    let seps: Vec<Sep> = mats.iter().map(|m| Sep::of(m, &persons, test)).collect();
     let scale: Vec<f64> = seps.iter().map(|s| s.row_min_diff).collect();
     Ok(Between {
         mats,
@@ -135,18 +137,7 @@ fn grid_cell(s: &Set<'_>, pct: f64, theta: f64) -> Result<[f64; 4]> {
     let name = format!("{} moved {pct} % at {:.0} deg", tf.name, theta.to_degrees());
     // Left outer eye corner moved: the bipolar descriptor.
     let (sq, cut_q) = perturb(w, lm.left_eye_outer, tp.refs.r, radius, theta)?;
-    let uq = field(tp.solver.as_ref(), Source::Point(sq))?;
-    let q = tf.mesh.point_position(&sq)?;
-    let d = 0.5 * (uq[lm.right_eye_outer as usize] + field_at(&tf.mesh, &tp.refs.ur, &sq));
-    let refs = Refs {
-        ur: tp.refs.ur.clone(),
-        uq,
-        d,
-        r: tp.refs.r,
-        q,
-        nose: tp.refs.nose,
-        frame: face_frame(&tf.mesh, tp.refs.r, q, tp.refs.nose),
-    };
+    let refs = tp.with_q_moved(tf, sq)?;
     // Nose tip moved: the other three (same D, the corners are not moved).
     let (sn, cut_n) = perturb(w, lm.nose_tip, eye_mid, radius, theta)?;
     let un = field(tp.solver.as_ref(), Source::Point(sn))?;
@@ -210,7 +201,7 @@ pub(super) fn depth_noise(s: &Set<'_>, mm: f64) -> Result<Cells<(f64, usize)>> {
                 mesh: m,
                 ..tf.clone()
             };
-            let p = prepare(&noisy_face)?;
+            let p = FacePrep::new(&noisy_face, geodesic::Method::Exact)?;
             let wn = Walker::new(&noisy_face.mesh);
             let name = format!("{} with {sigma_mm} mm noise, draw {k}", tf.name);
             let dsc = ctx.describe(

@@ -15,14 +15,16 @@
 //! other person), so the four distances, on different scales, can be compared. The report
 //! states for each claim of section 6 whether the numbers support it.
 
-use crate::curves::reference_iso_levels;
 use crate::paths::FaceSetArgs;
 use crate::pipeline::bar;
 use crate::polar::Pole;
+use crate::report::Failures;
 use crate::report::Report;
+use crate::robustness::FacePrep;
 use crate::walk::Walker;
 use anyhow::{bail, Context, Result};
-use describe::{prepare, Ctx, Descs, Failures, Prep, ALL};
+use describe::{Ctx, Descs, ALL};
+use facecurves::nose::reference_iso_levels;
 use measure::Set;
 use meshcore::Surface;
 use rayon::prelude::*;
@@ -85,10 +87,10 @@ pub fn run(args: Args) -> Result<()> {
     let mut rep = Report::new(&out, "Section 6: the four representations side by side")?;
     let walkers: Vec<Walker<'_>> = faces.par_iter().map(|f| Walker::new(&f.mesh)).collect();
     let pb = bar(faces.len(), "geodesic fields");
-    let preps: Vec<Prep> = faces
+    let preps: Vec<FacePrep> = faces
         .par_iter()
         .map(|f| {
-            let p = prepare(f);
+            let p = FacePrep::new(f, geodesic::Method::Exact);
             pb.inc(1);
             p
         })
@@ -140,7 +142,7 @@ pub fn run(args: Args) -> Result<()> {
         fig15,
         fig15_rings,
         mm,
-        failures: failures.sorted(),
+        failures: failures.summary().0,
         t_start,
     };
     write::write_report(&mut rep, &results)?;
@@ -155,7 +157,7 @@ pub fn run(args: Args) -> Result<()> {
 fn describe_all(
     ctx: &Ctx<'_>,
     faces: &[facemodel::Face],
-    preps: &[Prep],
+    preps: &[FacePrep],
     walkers: &[Walker<'_>],
 ) -> Vec<Descs> {
     let pb = bar(faces.len(), "descriptors");

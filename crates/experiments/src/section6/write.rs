@@ -9,7 +9,7 @@ use super::{Args, CSV_COLUMNS, REL_COLUMNS, REPS};
 use crate::pipeline::RADII_PCT;
 use crate::report::{f4, joined, polylines, render_face, Report};
 use crate::robustness::pole::ROTATED;
-use crate::robustness::stats::{max, mean};
+use crate::robustness::stats::{max, mean, verdict};
 use anyhow::Result;
 use facecurves::PrincipalField;
 use facemodel::{face_frame, Face};
@@ -205,10 +205,10 @@ fn between_section(rep: &mut Report, r: &Results<'_>) -> Result<()> {
             REPS[k].to_string(),
             fmt(s.max_same),
             fmt(s.min_diff),
-            format!("{:.2} ({})", s.ratio(), s.verdict()),
+            format!("{:.2} ({})", s.ratio(), verdict(s.ratio())),
             fmt(s.row_max_same),
             fmt(s.row_min_diff),
-            format!("{:.2} ({})", s.row_ratio(), s.row_verdict()),
+            format!("{:.2} ({})", s.row_ratio(), verdict(s.row_ratio())),
             format!("{:.3}", times[k]),
         ]);
     }
@@ -232,7 +232,7 @@ fn between_section(rep: &mut Report, r: &Results<'_>) -> Result<()> {
         rep.csv(
             &name,
             &header,
-            &crate::robustness::stats::matrix_rows(faces, m),
+            &crate::report::labelled_rows(&header[1..], m),
         )?;
     }
     rep.para(&format!("Times: median wall time of one comparison on one thread (a one-thread pool), over the test face's {n_timed} comparisons, on a shared machine (compare them as ratios)."));

@@ -12,17 +12,17 @@
 //! * iso-angle points: on the circle of level `i` (`a = i step`), `cos = +-alpha k / K` is met
 //!   where `cot b = -cos / cot a`, one point on each side.
 //!
-//! Reported: the normalised keyed shape distance `min_R ||A - R B|| / sqrt(|A|^2 + |B|^2)`
+//! The analytic points and the errors against them are `bipolar::synthetic` (`sphere_truth`,
+//! `SphereErrors`). Reported: the normalised keyed shape distance `min_R ||A - R B|| / sqrt(|A|^2 + |B|^2)`
 //! (common keys, centred, rotation only), mean position error and mean angle (cosine) error.
 
 use anyhow::Context;
+use bipolar::synthetic::{sphere_truth, SphereErrors};
 use bipolar::{Descriptor, DescriptorOptions, LevelSpec, SelectionRule, Source, TangentMethod};
 use glam::DVec3;
-use indicatif::{ProgressBar, ProgressStyle};
 use meshcore::{FaceLocator, TriMesh};
 use std::time::Instant;
 
-mod analytic;
 mod output;
 
 /// Opening limit alpha of the iso-angle and filter rules.
@@ -31,25 +31,26 @@ const ALPHA: f64 = 0.95;
 const K: u32 = 8;
 /// Level resolutions N measured.
 const LEVELS: [u32; 5] = [4, 6, 8, 12, 16];
-/// The tangent methods compared, in table and plot order.
-const METHODS: [TangentMethod; 3] = [
-    TangentMethod::Strip,
-    TangentMethod::Spline,
-    TangentMethod::Gradient,
+/// The tangent methods compared, in table and plot order, with their names in the tables.
+const METHODS: [(TangentMethod, &str); 3] = [
+    (TangentMethod::Strip, "strip (M1)"),
+    (TangentMethod::Spline, "spline (M2)"),
+    (TangentMethod::Gradient, "gradient"),
 ];
 
 /// The selection rules measured, with their names in the tables.
 fn rules() -> [(SelectionRule, &'static str); 3] {
+    let tolerance = ALPHA / (4.0 * f64::from(K));
     [
         (SelectionRule::IsoAngle, "isoangle"),
-        (
-            SelectionRule::Filter {
-                tolerance: ALPHA / (4.0 * K as f64),
-            },
-            "filter",
-        ),
+        (SelectionRule::Filter { tolerance }, "filter"),
         (SelectionRule::All, "all"),
     ]
+}
+
+/// The analytic representation of `rule` at `n` levels (levels 1..2N-1).
+fn truth(rule: SelectionRule, n: u32) -> bipolar::synthetic::SphereTruth {
+    sphere_truth(rule, n, 2 * n - 1, K, ALPHA)
 }
 
 /// A unit sphere mesh with its two poles.
@@ -97,12 +98,10 @@ impl SphereMesh {
             tangent,
             ..DescriptorOptions::default()
         };
+        let references = Some(&self.refs[..]);
         bipolar::describe(
             surface,
-            bipolar::Fields::Precomputed {
-                fields,
-                references: Some(&self.refs),
-            },
+            bipolar::Fields::Precomputed { fields, references },
             &opts,
         )
     }
@@ -114,24 +113,19 @@ fn meshes() -> anyhow::Result<Vec<SphereMesh>> {
     for sub in [3u32, 4, 5] {
         let mesh = bipolar::synthetic::icosphere(sub);
         let loc = FaceLocator::new(&mesh);
-        let r = loc.nearest(DVec3::Z)?.0;
-        let q = loc.nearest(DVec3::X)?.0;
-        out.push(SphereMesh {
-            name: format!("ico{sub} ({} v)", mesh.n_vertices()),
-            refs: [Source::Point(r), Source::Point(q)],
-            mesh,
-        });
+        let (r, q) = (loc.nearest(DVec3::Z)?.0, loc.nearest(DVec3::X)?.0);
+        let name = format!("ico{sub} ({} v)", mesh.n_vertices());
+        let refs = [Source::Point(r), Source::Point(q)];
+        out.push(SphereMesh { name, refs, mesh });
     }
     for (nlat, nlon) in [(24usize, 48usize), (48, 96)] {
         let mesh = bipolar::synthetic::uv_sphere(nlat, nlon);
         // North pole is vertex 0; +X is ring nlat/2, sector 0.
-        let qv = 1 + (nlat / 2 - 1) * nlon;
-        anyhow::ensure!((mesh.position(qv as u32) - DVec3::X).length() < 1e-12);
-        out.push(SphereMesh {
-            name: format!("uv{nlat}x{nlon} ({} v)", mesh.n_vertices()),
-            refs: [Source::Vertex(0), Source::Vertex(qv as u32)],
-            mesh,
-        });
+        let qv = (1 + (nlat / 2 - 1) * nlon) as u32;
+        anyhow::ensure!((mesh.position(qv) - DVec3::X).length() < 1e-12);
+        let name = format!("uv{nlat}x{nlon} ({} v)", mesh.n_vertices());
+        let refs = [Source::Vertex(0), Source::Vertex(qv)];
+        out.push(SphereMesh { name, refs, mesh });
     }
     Ok(out)
 }
@@ -145,52 +139,38 @@ struct Row {
     levels: u32,
     rule: &'static str,
     method: &'static str,
-    n_points: usize,
-    n_analytic: usize,
-    n_common: usize,
-    distance: f64,
-    pos_err: f64,
-    cos_err: f64,
-    cos_err_max: f64,
+    /// Points of the descriptor, of the analytic representation, and keys in common.
+    counts: [usize; 3],
+    /// Shape distance, mean position error, mean and largest cos error.
+    errors: [f64; 4],
     ms: f64,
 }
 
 impl Row {
+    fn distance(&self) -> f64 {
+        self.errors[0]
+    }
+
     /// The cells of the row: every column at full precision for `results.csv` (`csv`), or the
     /// columns of the report's tables.
     fn cells(&self, csv: bool) -> Vec<String> {
         let digits = if csv { 6 } else { 2 };
         let mut c = vec![self.mesh.clone()];
         if csv {
-            c.push(self.n_vertices.to_string());
-            c.push(format!("{:.6}", self.mean_edge));
+            c.extend([
+                self.n_vertices.to_string(),
+                format!("{:.6}", self.mean_edge),
+            ]);
         }
         c.push(self.levels.to_string());
         if csv {
             c.push(self.rule.to_string());
         }
         c.push(self.method.to_string());
-        for count in [self.n_points, self.n_analytic, self.n_common] {
-            c.push(count.to_string());
-        }
-        for x in [self.distance, self.pos_err, self.cos_err, self.cos_err_max] {
-            c.push(format!("{x:.digits$e}"));
-        }
-        c.push(if csv {
-            format!("{:.3}", self.ms)
-        } else {
-            format!("{:.1}", self.ms)
-        });
+        c.extend(self.counts.iter().map(usize::to_string));
+        c.extend(self.errors.iter().map(|x| format!("{x:.digits$e}")));
+        c.push(format!("{:.*}", if csv { 3 } else { 1 }, self.ms));
         c
-    }
-}
-
-/// The name of a tangent method in the tables.
-fn method_name(m: TangentMethod) -> &'static str {
-    match m {
-        TangentMethod::Gradient => "gradient",
-        TangentMethod::Strip => "strip (M1)",
-        TangentMethod::Spline => "spline (M2)",
     }
 }
 
@@ -209,21 +189,24 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     std::fs::create_dir_all(&out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
     let meshes = meshes()?;
     let m = measure(&meshes)?;
-    output::write_csv(&out_dir, &m.rows)?;
+    let header = "mesh,vertices,mean_edge,levels,rule,method,points,analytic_points,common_keys,shape_distance,mean_position_error,mean_cos_error,max_cos_error,describe_ms";
+    let rows: Vec<Vec<String>> = m.rows.iter().map(|r| r.cells(true)).collect();
+    crate::report::write_csv(
+        &out_dir.join("results.csv"),
+        &header.split(',').collect::<Vec<_>>(),
+        &rows,
+    )?;
     let plots = output::write_plots(&out_dir, &m.rows, &meshes)?;
     let renders = output::write_renders(&out_dir, &meshes[1])?;
-    let md = output::write_report(
-        &out_dir,
-        &m.rows,
-        &output::ReportInputs {
-            meshes: &meshes,
-            solver_name: m.solver_name,
-            geodesic_ms: &m.geodesic_ms,
-            plots: &plots,
-            renders: &renders,
-            t_start,
-        },
-    )?;
+    let inputs = output::ReportInputs {
+        meshes: &meshes,
+        solver_name: m.solver_name,
+        geodesic_ms: &m.geodesic_ms,
+        plots: &plots,
+        renders: &renders,
+        t_start,
+    };
+    let md = output::write_report(&out_dir, &m.rows, &inputs)?;
     println!("{}", md.lines().take(12).collect::<Vec<_>>().join("\n"));
     println!("wrote {}", out_dir.display());
     Ok(())
@@ -241,46 +224,49 @@ struct Measured {
 /// the analytic representation.
 fn measure(meshes: &[SphereMesh]) -> anyhow::Result<Measured> {
     let rules = rules();
-    let total = (meshes.len() * LEVELS.len() * rules.len() * METHODS.len()) as u64;
-    let pb = ProgressBar::new(total);
-    pb.set_style(
-        ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    let pb = crate::pipeline::bar(
+        meshes.len() * LEVELS.len() * rules.len() * METHODS.len(),
+        "",
     );
-    let mut rows: Vec<Row> = Vec::new();
-    let mut solver_name = "exact";
-    let mut geodesic_ms = Vec::new();
+    let mut m = Measured {
+        rows: Vec::new(),
+        solver_name: "exact",
+        geodesic_ms: Vec::new(),
+    };
     for sm in meshes {
         pb.set_message(format!("geodesics on {}", sm.name));
         let tg = Instant::now();
         let (fields, used) = sm.pole_fields()?;
-        solver_name = used;
-        geodesic_ms.push((sm.name.clone(), tg.elapsed().as_secs_f64() * 1e3));
+        m.solver_name = used;
+        m.geodesic_ms
+            .push((sm.name.clone(), tg.elapsed().as_secs_f64() * 1e3));
         let surface = bipolar::Surface::new(sm.mesh.clone());
         for &n in &LEVELS {
-            let max_level = 2 * n - 1;
             for &(rule, rname) in &rules {
-                let truth = analytic::analytic(rule, n, max_level);
-                for &m in &METHODS {
-                    pb.set_message(format!("{} N={n} {rname} {}", sm.name, method_name(m)));
+                let truth = truth(rule, n);
+                for &(method, mname) in &METHODS {
+                    pb.set_message(format!("{} N={n} {rname} {mname}", sm.name));
                     let t0 = Instant::now();
-                    let d = sm.describe(&surface, &fields, n, rule, m)?;
+                    let d = sm.describe(&surface, &fields, n, rule, method)?;
                     let ms = t0.elapsed().as_secs_f64() * 1e3;
-                    let c = analytic::compare(&d, &truth);
-                    rows.push(Row {
+                    let e = SphereErrors::of(&d, &truth);
+                    let n_common = e.mesh_points.len();
+                    let distance = if n_common == 0 {
+                        f64::NAN
+                    } else {
+                        let kabsch = shapedist::RotationMethod::Kabsch;
+                        shapedist::align_pairs(&e.mesh_points, &e.truth_points, None, kabsch)
+                            .map_or(f64::NAN, |al| al.distance)
+                    };
+                    m.rows.push(Row {
                         mesh: sm.name.clone(),
                         n_vertices: sm.mesh.n_vertices(),
                         mean_edge: sm.mesh.mean_edge_length(),
                         levels: n,
                         rule: rname,
-                        method: method_name(m),
-                        n_points: d.len(),
-                        n_analytic: truth.len(),
-                        n_common: c.n_common,
-                        distance: c.distance,
-                        pos_err: c.pos_err,
-                        cos_err: c.cos_err,
-                        cos_err_max: c.cos_err_max,
+                        method: mname,
+                        counts: [d.len(), truth.len(), n_common],
+                        errors: [distance, e.pos_err, e.cos_err, e.cos_err_max],
                         ms,
                     });
                     pb.inc(1);
@@ -289,9 +275,5 @@ fn measure(meshes: &[SphereMesh]) -> anyhow::Result<Measured> {
         }
     }
     pb.finish_with_message("done");
-    Ok(Measured {
-        rows,
-        solver_name,
-        geodesic_ms,
-    })
+    Ok(m)
 }

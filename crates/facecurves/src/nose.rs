@@ -1,5 +1,5 @@
-//! The two curve representations of the paper's section 6 (`facecurves`) as the experiments
-//! build and score them, shared by `cargo xtask section6` and `cargo xtask recognition`:
+//! Both curve representations of a face built around its nose tip, as the experiments
+//! (`cargo xtask section6`, `cargo xtask recognition`) build and score them:
 //!
 //! * **facial curves**: the level curves of the geodesic distance `U_n` from the nose tip at
 //!   `D / N, 2 D / N, ..., D` (`D` the geodesic distance between the outer eye corners),
@@ -9,7 +9,7 @@
 //!   quantiles of one reference face), compared by the normalised RMS closest-point distance
 //!   after a global ICP.
 
-use facecurves::{
+use crate::{
     describe_facial_curves, describe_iso_curvature, facial_curves_distance, iso_curvature_distance,
     Aggregate, ElasticOptions, FaceCurvesError, FacialCurvesDescriptor, FacialCurvesOptions,
     IsoCurvatureDescriptor, IsoCurvatureOptions, IsoLevels,
