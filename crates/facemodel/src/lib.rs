@@ -13,6 +13,9 @@
 //!   [`RIGHT_EYE_OUTER`], [`LEFT_EYE_OUTER`], [`NOSE_TIP`].
 //! * [`frame`]: the landmark-derived [`FaceFrame`] and the static-area vertex mask
 //!   [`static_mask`].
+//! * [`variation`]: faces beyond the model's span, for tests: [`FaceModel::strong_expression`]
+//!   (expressions past full strength or mixed) and [`random_warp`] (smooth non-rigid warps of
+//!   2-6 mm).
 //!
 //! Every fallible function returns [`FaceModelError`]. Meshes, `.npy` arrays and the landmark
 //! file are read with `mesh-io`.
@@ -22,6 +25,7 @@ pub mod faceset;
 pub mod frame;
 pub mod model;
 pub mod shared;
+pub mod variation;
 
 pub use error::FaceModelError;
 pub use faceset::{load_face_set, Face, FaceLandmarks, LEFT_EYE_OUTER, NOSE_TIP, RIGHT_EYE_OUTER};
@@ -31,3 +35,4 @@ pub use shared::{
     default_model_dir, default_paper_set, shared_dir, workspace_root_from, MODEL, PAPER_SET,
     SHARED_ENV,
 };
+pub use variation::{random_warp, Warp};

@@ -12,6 +12,8 @@
 //!   Kabsch and Horn rotations, the one rigid fit [`linalg::fit_rigid`]).
 //! * [`repair`]: explicit, opt-in repairs (drop degenerate faces, weld duplicate vertices),
 //!   the one implementation every reader and binary uses.
+//! * [`subdivide_midpoint`]: one step of midpoint subdivision (every triangle into four, the
+//!   surface unchanged).
 //! * [`Choice`] and [`choice!`]: option enums that parse by name, with [`UnknownChoice`]
 //!   listing the valid names.
 //!
@@ -26,6 +28,7 @@ mod locate;
 mod mesh;
 pub mod repair;
 pub mod shapes;
+mod subdivide;
 mod surface;
 mod topology;
 pub mod units;
@@ -37,5 +40,6 @@ pub use file::{read_text, write_bytes, FileError};
 pub use glam::{DAffine3, DMat3, DQuat, DVec3};
 pub use locate::{closest_point_on_triangle, FaceLocator};
 pub use mesh::{Aabb, SurfacePoint, TriMesh};
+pub use subdivide::subdivide_midpoint;
 pub use surface::Surface;
 pub use topology::{Edge, Topology, NO_FACE};

@@ -23,12 +23,15 @@
 //!   or outside the grid.
 //! * Visibility ([`visible_faces`]): the faces of a mesh a scanner would measure from a given
 //!   direction (occlusion and an incidence limit), as a mask of the mesh itself.
+//! * Flying pixels ([`add_flying_pixels`]): the depths between a silhouette and its background
+//!   that time-of-flight and stereo depth cameras return, added to a scanned grid.
 //!
 //! Library code never panics on user input: bad options or meshes the grid cannot hold end in
 //! [`ScanError`].
 
 mod artifacts;
 mod camera;
+mod flying;
 mod render;
 mod visibility;
 
@@ -36,6 +39,7 @@ pub use artifacts::{
     Artifacts, Border, DepthNoise, GrazingDropout, Holes, Outliers, Quantisation, Spikes,
 };
 pub use camera::{HeadPose, Projection};
+pub use flying::{add_flying_pixels, FlyingPixels};
 pub use visibility::visible_faces;
 
 use camera::Camera;

@@ -18,6 +18,9 @@
 //! 4. Optional **smoothing** ([`taubin_smooth`]) and **decimation** to a target edge length
 //!    ([`decimate`]).
 //!
+//! [`remesh`] carries a mesh to another topology of a given edge length (subdivided, then
+//! decimated): test faces whose vertices are not a model's.
+//!
 //! Holes larger than the limit are left and reported ([`Hole::filled`] false). Every step is
 //! deterministic (decisions taken on the step's input, fixed orders, ties to smaller indices);
 //! only [`CleanReport::timings`] varies between runs. Nothing panics on user input: errors are
@@ -26,6 +29,7 @@
 mod decimate;
 mod grid;
 mod mesh;
+mod remesh;
 
 pub use decimate::{decimate, DecimationReport, COLLAPSE_BELOW, MAX_NEW_EDGE};
 pub use grid::{
@@ -36,6 +40,7 @@ pub use mesh::{
     close_mesh_gaps, compact, crop_sphere, fill_mesh_holes, incidence_mask, remove_mesh_spikes,
     remove_small_components, taubin_smooth,
 };
+pub use remesh::{remesh, MAX_SUBDIVISIONS};
 
 use mesh_io::{BntGrid, BntOptions};
 use meshcore::units::{Units, UnitsDetection, UnitsError};
