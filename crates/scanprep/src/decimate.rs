@@ -3,7 +3,7 @@
 use crate::mesh::compact;
 use crate::ScanPrepError;
 use meshcore::TriMesh;
-use std::cmp::Ordering;
+use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 
 /// What [`decimate`] did.
@@ -29,30 +29,14 @@ pub const COLLAPSE_BELOW: f64 = 0.8;
 /// A collapse that would make an edge longer than this times the target is not done.
 pub const MAX_NEW_EDGE: f64 = 4.0 / 3.0;
 
-#[derive(Debug, PartialEq)]
-struct Cand {
-    len: f64,
-    a: u32,
-    b: u32,
-    va: u32,
-    vb: u32,
-}
-impl Eq for Cand {}
-impl Ord for Cand {
-    // Min-heap on (length, a, b).
-    fn cmp(&self, o: &Self) -> Ordering {
-        o.len
-            .total_cmp(&self.len)
-            .then(o.a.cmp(&self.a))
-            .then(o.b.cmp(&self.b))
-            .then(o.va.cmp(&self.va))
-            .then(o.vb.cmp(&self.vb))
-    }
-}
-impl PartialOrd for Cand {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
+/// A collapse candidate in the min-heap: (length, a, b, version of a, version of b) packed so
+/// that integer order is the order of the tuple (a length is never negative, and for those
+/// `f64::to_bits` orders as `f64::total_cmp`).
+type Cand = Reverse<(u64, u64, u64)>;
+
+fn cand(len: f64, a: u32, b: u32, va: u32, vb: u32) -> Cand {
+    let pack = |x: u32, y: u32| (u64::from(x) << 32) | u64::from(y);
+    Reverse((len.to_bits(), pack(a, b), pack(va, vb)))
 }
 
 /// Collapses edges, shortest first, while an edge is shorter than `COLLAPSE_BELOW * target`;
@@ -85,68 +69,49 @@ pub fn decimate(mesh: &TriMesh, target: f64) -> Result<(TriMesh, DecimationRepor
     let mut version = vec![0u32; n];
     let lo = COLLAPSE_BELOW * target;
     let hi = MAX_NEW_EDGE * target;
-    let mut heap = BinaryHeap::new();
+    // Each short edge once (an edge of two faces would be a second, identical candidate).
+    let mut first: Vec<Cand> = Vec::new();
     for t in &tris {
         for k in 0..3 {
             let (a, b) = (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
             let len = (pos[a as usize] - pos[b as usize]).length();
             if a != b && len < lo {
-                heap.push(Cand {
-                    len,
-                    a,
-                    b,
-                    va: 0,
-                    vb: 0,
-                });
+                first.push(cand(len, a, b, 0, 0));
             }
         }
     }
-    // Faces of v (alive) and neighbours.
-    let ring = |v: u32, vf: &[Vec<u32>], tris: &[[u32; 3]]| -> Vec<u32> {
-        let mut out: Vec<u32> = vf[v as usize]
-            .iter()
-            .flat_map(|&f| tris[f as usize])
-            .filter(|&w| w != v)
-            .collect();
-        out.sort_unstable();
-        out.dedup();
-        out
-    };
-    let edge_faces = |a: u32, b: u32, vf: &[Vec<u32>], tris: &[[u32; 3]]| -> Vec<u32> {
-        vf[a as usize]
-            .iter()
-            .copied()
-            .filter(|&f| tris[f as usize].contains(&b))
-            .collect()
-    };
-    let is_boundary = |v: u32, vf: &[Vec<u32>], tris: &[[u32; 3]]| -> bool {
-        ring(v, vf, tris)
-            .iter()
-            .any(|&w| edge_faces(v, w, vf, tris).len() != 2)
-    };
+    first.sort_unstable();
+    first.dedup();
+    let mut heap = BinaryHeap::from(first);
     let before_mean = mesh.mean_edge_length();
     let mut collapses = 0usize;
-    while let Some(c) = heap.pop() {
-        let (a, b) = (c.a, c.b);
+    // Scratch lists reused by every candidate: the faces on the edge, the two rings.
+    let (mut ef, mut ra, mut rb) = (Vec::new(), Vec::new(), Vec::new());
+    while let Some(Reverse((_, ab, vab))) = heap.pop() {
+        let (a, b) = ((ab >> 32) as u32, ab as u32);
         if !vert_alive[a as usize]
             || !vert_alive[b as usize]
-            || version[a as usize] != c.va
-            || version[b as usize] != c.vb
+            || version[a as usize] != (vab >> 32) as u32
+            || version[b as usize] != vab as u32
         {
             continue;
         }
-        let ef = edge_faces(a, b, &vf, &tris);
+        ef.clear();
+        ef.extend(
+            vf[a as usize]
+                .iter()
+                .copied()
+                .filter(|&f| tris[f as usize].contains(&b)),
+        );
         if ef.is_empty() || ef.len() > 2 {
             continue;
         }
-        let ra = ring(a, &vf, &tris);
-        let rb = ring(b, &vf, &tris);
+        let ba = star(a, &vf, &tris, &mut ra);
+        let bb = star(b, &vf, &tris, &mut rb);
         let common = ra.iter().filter(|w| rb.binary_search(w).is_ok()).count();
         if common != ef.len() {
             continue;
         }
-        let ba = is_boundary(a, &vf, &tris);
-        let bb = is_boundary(b, &vf, &tris);
         if ef.len() == 2 && ba && bb {
             continue;
         }
@@ -214,17 +179,12 @@ pub fn decimate(mesh: &TriMesh, target: f64) -> Result<(TriMesh, DecimationRepor
         vert_alive[b as usize] = false;
         version[a as usize] += 1;
         collapses += 1;
-        for w in ring(a, &vf, &tris) {
+        star(a, &vf, &tris, &mut ra);
+        for &w in &ra {
             let len = (pos[w as usize] - pos[a as usize]).length();
             if len < lo {
                 let (x, y) = (a.min(w), a.max(w));
-                heap.push(Cand {
-                    len,
-                    a: x,
-                    b: y,
-                    va: version[x as usize],
-                    vb: version[y as usize],
-                });
+                heap.push(cand(len, x, y, version[x as usize], version[y as usize]));
             }
         }
     }
@@ -244,6 +204,38 @@ pub fn decimate(mesh: &TriMesh, target: f64) -> Result<(TriMesh, DecimationRepor
         collapses,
     };
     Ok((out, report))
+}
+
+/// The ring of `v` (its neighbours in its faces `vf[v]`, sorted, once each) into `ring`, and
+/// whether `v` is on a boundary: some neighbour shares other than two of those faces with it.
+fn star(v: u32, vf: &[Vec<u32>], tris: &[[u32; 3]], ring: &mut Vec<u32>) -> bool {
+    ring.clear();
+    for &f in &vf[v as usize] {
+        let t = tris[f as usize];
+        // Each neighbour once per face: the face counts once for that edge.
+        for (k, &w) in t.iter().enumerate() {
+            if w != v && !t[..k].contains(&w) {
+                ring.push(w);
+            }
+        }
+    }
+    ring.sort_unstable();
+    let mut boundary = false;
+    let mut i = 0;
+    let mut out = 0;
+    while i < ring.len() {
+        let w = ring[i];
+        let mut j = i + 1;
+        while j < ring.len() && ring[j] == w {
+            j += 1;
+        }
+        boundary |= j - i != 2;
+        ring[out] = w;
+        out += 1;
+        i = j;
+    }
+    ring.truncate(out);
+    boundary
 }
 
 #[cfg(test)]
