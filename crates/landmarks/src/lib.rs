@@ -26,7 +26,7 @@ mod regress;
 pub use curvature::{curvedness, shape_index, Curvature, CurvatureOptions};
 pub use detect::{
     detect, detect_seen_from, detect_visible, detect_with, mesh_units_per_model_unit,
-    DetectOptions, GRAZING_RIM_DEG, MIN_PLACED, RIM_AGREEMENT,
+    DetectOptions, GRADED_COVERAGE, GRAZING_RIM_DEG, MIN_PLACED, RIM_AGREEMENT,
 };
 pub use model::{DetectParams, GenericModel, Template, TrainOptions};
 pub use regress::{LandmarkRegressor, RegressorOptions, RegressorPatch};
