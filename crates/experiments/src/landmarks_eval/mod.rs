@@ -98,6 +98,10 @@ pub struct Args {
     /// agreeing landmarks are returned graded instead of refused).
     #[arg(long)]
     pub refuse_local_agreement: Option<f64>,
+    /// Override `DetectOptions::comparable_fit_cost` (fits costing more than this multiple of
+    /// the best fit's are tried after every pass over the better fits).
+    #[arg(long)]
+    pub comparable_fit_cost: Option<f64>,
     /// Print the detector's trace to standard error (`DetectOptions::trace`).
     #[arg(long)]
     pub trace: bool,
@@ -268,6 +272,9 @@ fn detect_options(args: &Args) -> DetectOptions {
     dopt.trace = args.trace;
     if let Some(x) = args.refuse_local_agreement {
         dopt.refuse_local_agreement = x;
+    }
+    if let Some(x) = args.comparable_fit_cost {
+        dopt.comparable_fit_cost = x;
     }
     dopt
 }

@@ -20,6 +20,9 @@ struct ScanOutcome {
     name: String,
     errors: [Result<f64, String>; 5],
     unseen: [Option<String>; 5],
+    /// Per outer eye corner reported unseen: how far the detector's prediction is from the
+    /// true corner (on the scan or not), mm.
+    predicted_unseen: Vec<f64>,
     not_found: Option<String>,
     valid_samples: usize,
     vertices: usize,
@@ -69,6 +72,7 @@ pub(super) fn run_scans(
         "silent_wrong": s.silent.iter().map(|(f, w)| serde_json::json!({"face": f, "what": w})).collect::<Vec<_>>(),
         "truth_not_on_cleaned_scan": s.unseen,
         "reported_unseen": {"truth_not_on_scan": s.unseen_right, "truth_on_scan": s.unseen_missed},
+        "unseen_outer_corners_predicted_mm": s.predicted_quantiles().map(|[m, p, x]| serde_json::json!({"n": s.predicted.len(), "median": m, "p95": p, "max": x})),
         "scan_failures": scan_failures,
         "targets": targets.iter().map(|(w, ok)| serde_json::json!({"target": w, "met": ok})).collect::<Vec<_>>(),
         "seconds": secs,
@@ -177,10 +181,19 @@ fn scan_and_detect(
                 .and_then(|d| d.get(n).err())
                 .map(|u| u.to_string())
         });
+        let predicted_unseen = match &f.detected {
+            Ok(d) => [LandmarkName::OuterEyeRight, LandmarkName::OuterEyeLeft]
+                .iter()
+                .filter(|&&n| d.get(n).is_err())
+                .map(|&n| (d.predicted[n as usize] - f.truth[n as usize].position).length())
+                .collect(),
+            Err(_) => Vec::new(),
+        };
         outcomes.push(ScanOutcome {
             name: spec.name.clone(),
             errors,
             unseen,
+            predicted_unseen,
             not_found: f.detected.as_ref().err().cloned(),
             valid_samples: f.valid_samples,
             vertices: f.mesh.n_vertices(),
@@ -215,9 +228,20 @@ struct Summary<'a> {
     med_vertices: f64,
     /// Median detection wall time (ms).
     med_detect: f64,
+    /// Distances of the predictions of the outer eye corners reported unseen from the truth
+    /// (mm), sorted.
+    predicted: Vec<f64>,
 }
 
 impl<'a> Summary<'a> {
+    /// Median, 95th percentile and maximum of [`Summary::predicted`] (`None`: no unseen outer
+    /// eye corner).
+    fn predicted_quantiles(&self) -> Option<[f64; 3]> {
+        let v = &self.predicted;
+        let q = |p: f64| v[((v.len() - 1) as f64 * p).round() as usize];
+        (!v.is_empty()).then(|| [q(0.5), q(0.95), q(1.0)])
+    }
+
     fn of(outcomes: &'a [ScanOutcome]) -> Self {
         // Errors of the landmarks whose truth is on the cleaned scan (inf: not found).
         let st: Vec<Stats> = LandmarkName::ALL
@@ -288,6 +312,14 @@ impl<'a> Summary<'a> {
             med_valid: med(&mut vs),
             med_vertices: med(&mut vv),
             med_detect: med(&mut dt),
+            predicted: {
+                let mut v: Vec<f64> = outcomes
+                    .iter()
+                    .flat_map(|o| o.predicted_unseen.iter().copied())
+                    .collect();
+                v.sort_by(f64::total_cmp);
+                v
+            },
         }
     }
 
@@ -391,6 +423,15 @@ fn print_summary(
         "landmarks of found faces reported unseen: {} whose truth is not on the cleaned scan, {} whose truth is (counted as not found above)",
         s.unseen_right, s.unseen_missed
     );
+    if let Some(q) = s.predicted_quantiles() {
+        println!(
+            "unseen outer eye corners: {}, predicted {:.2} mm from the truth (median), {:.2} mm (p95), {:.2} mm (max)",
+            s.predicted.len(),
+            q[0],
+            q[1],
+            q[2]
+        );
+    }
     println!("silent wrong landmarks: {}", s.silent.len());
     for (name, w) in s.silent.iter().take(20) {
         println!("  {name}: {w}");
