@@ -25,51 +25,39 @@ pub(super) struct ScanSpec {
     seed: u64,
 }
 
+/// The fixed list of settings: seven scans (name, pitch mm, noise mm, quantisation mm, yaw and
+/// pitch degrees; seeds 1-7) and the face mesh itself, last.
 pub(super) fn settings() -> Vec<Setting> {
-    let s = |pitch_mm, noise_mm, quant_mm, yaw_deg, pitch_deg, seed| {
-        Some(ScanSpec {
+    type Scan = (&'static str, f64, f64, Option<f64>, f64, f64);
+    const SCANS: [Scan; 7] = [
+        ("p0.75 n0.1", 0.75, 0.1, None, 0.0, 0.0),
+        ("p0.5 n0.1", 0.5, 0.1, None, 0.0, 0.0),
+        ("p1.0 n0.1", 1.0, 0.1, None, 0.0, 0.0),
+        ("p0.75 n0.2", 0.75, 0.2, None, 0.0, 0.0),
+        ("p0.75 yaw20", 0.75, 0.1, None, 20.0, 0.0),
+        ("p0.75 pitch10", 0.75, 0.1, None, 0.0, 10.0),
+        ("p0.75 q2mm", 0.75, 0.1, Some(2.0), 0.0, 0.0),
+    ];
+    let scans = SCANS.iter().zip(1..).map(|(s, seed)| {
+        let &(name, pitch_mm, noise_mm, quant_mm, yaw_deg, pitch_deg) = s;
+        let spec = ScanSpec {
             pitch_mm,
             noise_mm,
             quant_mm,
             yaw_deg,
             pitch_deg,
             seed,
-        })
+        };
+        Setting {
+            name,
+            scan: Some(spec),
+        }
+    });
+    let mesh = Setting {
+        name: "mesh (mm)",
+        scan: None,
     };
-    vec![
-        Setting {
-            name: "p0.75 n0.1",
-            scan: s(0.75, 0.1, None, 0.0, 0.0, 1),
-        },
-        Setting {
-            name: "p0.5 n0.1",
-            scan: s(0.5, 0.1, None, 0.0, 0.0, 2),
-        },
-        Setting {
-            name: "p1.0 n0.1",
-            scan: s(1.0, 0.1, None, 0.0, 0.0, 3),
-        },
-        Setting {
-            name: "p0.75 n0.2",
-            scan: s(0.75, 0.2, None, 0.0, 0.0, 4),
-        },
-        Setting {
-            name: "p0.75 yaw20",
-            scan: s(0.75, 0.1, None, 20.0, 0.0, 5),
-        },
-        Setting {
-            name: "p0.75 pitch10",
-            scan: s(0.75, 0.1, None, 0.0, 10.0, 6),
-        },
-        Setting {
-            name: "p0.75 q2mm",
-            scan: s(0.75, 0.1, Some(2.0), 0.0, 0.0, 7),
-        },
-        Setting {
-            name: "mesh (mm)",
-            scan: None,
-        },
-    ]
+    scans.chain([mesh]).collect()
 }
 
 /// Millimetres per unit of the paper-set meshes (cm).
