@@ -7,11 +7,8 @@ use anyhow::{bail, Context, Result};
 use facemodel::{face_frame, static_mask, Face, FaceFrame};
 use geodesic::{GeodesicSolver, Method, SolveOptions, Source};
 use indicatif::{ProgressBar, ProgressStyle};
-use meshcore::linalg::fit_rigid;
-use meshcore::{DAffine3, DVec3, FaceLocator, SurfacePoint, TriMesh};
-use shapedist::{
-    icp_to_target, Convergence, IcpLoopOptions, IcpVariant, ShapeDistError, TrimRounding,
-};
+use meshcore::{DVec3, SurfacePoint, TriMesh};
+use shapedist::ShapeDistError;
 
 /// Which area a bipolar descriptor covers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -71,55 +68,7 @@ impl Refs {
     }
 }
 
-/// The experiments' ICP of points onto a surface: point-to-point with translation onto the
-/// closest surface points, the worst 10 % of pairs trimmed (kept count rounded down), at most
-/// `max_iterations`, stop after a step when the trimmed RMS changed by at most `1e-6` relative.
-pub fn trimmed_icp(max_iterations: usize) -> IcpLoopOptions {
-    IcpLoopOptions {
-        variant: IcpVariant::PointToPoint,
-        max_iterations,
-        translation: true,
-        trim: 0.1,
-        trim_rounding: TrimRounding::Down,
-        convergence: Convergence::RelativeRmseAfterStep { tolerance: 1e-6 },
-        evaluate_final: false,
-        ..IcpLoopOptions::default()
-    }
-}
-
-/// ICP of `probe` onto the surface of `target` ([`shapedist::icp_to_target`] with
-/// [`trimmed_icp`]`(max_iterations)`), started from the rigid fit of `probe_lm` onto
-/// `target_lm` (the same landmarks on both faces): the [`rms_to_surface`] of all probe points
-/// at the final pose, NaN when the fit or a step fails.
-pub fn landmark_icp_rms(
-    probe: &[DVec3],
-    probe_lm: &[DVec3],
-    target: &FaceLocator<'_>,
-    target_lm: &[DVec3],
-    max_iterations: usize,
-) -> f64 {
-    let Some(init) = fit_rigid(probe_lm, target_lm, None) else {
-        return f64::NAN;
-    };
-    let Ok(res) = icp_to_target(target, probe, None, init, &trimmed_icp(max_iterations)) else {
-        return f64::NAN;
-    };
-    rms_to_surface(target, probe, &res.motion)
-}
-
-/// Root mean square distance of the `points` moved by `motion` to the surface of `target`
-/// (every point counted; NaN where a query fails): how ICP results are scored.
-pub fn rms_to_surface(target: &FaceLocator<'_>, points: &[DVec3], motion: &DAffine3) -> f64 {
-    let ss: f64 = points
-        .iter()
-        .map(|p| {
-            target
-                .nearest(motion.transform_point3(*p))
-                .map_or(f64::NAN, |(_, d)| d * d)
-        })
-        .sum();
-    (ss / points.len().max(1) as f64).sqrt()
-}
+pub use shapedist::landmark_icp_rms;
 
 /// Distance field from one source.
 pub fn field(solver: &dyn GeodesicSolver, src: Source) -> Result<Vec<f64>> {
@@ -204,25 +153,7 @@ pub fn restrict(mask: Option<Vec<bool>>, seen: Option<&[bool]>) -> Option<Vec<bo
     }
 }
 
-/// The vertices the bipolar descriptors of `surface` may use: those of `seen` (all without
-/// it) outside the band of `margin` along the boundary (`bipolar::boundary_band`). For many
-/// descriptors of one surface, pass this as their vertex mask with no `boundary_margin`:
-/// `DescriptorOptions::boundary_margin` builds the band again (an exact solve from the
-/// boundary) on every call, and the two leave out the same vertices.
-pub fn kept_vertices(
-    surface: &bipolar::Surface,
-    seen: Option<Vec<bool>>,
-    margin: Option<f64>,
-) -> Result<Option<Vec<bool>>, bipolar::BipolarError> {
-    let Some(m) = margin else {
-        return Ok(seen);
-    };
-    let outside: Vec<bool> = bipolar::boundary_band(surface, m)?
-        .into_iter()
-        .map(|b| !b)
-        .collect();
-    Ok(restrict(Some(outside), seen.as_deref()))
-}
+pub use facematch::kept_vertices;
 
 /// A keyed point set as `shapedist::keyed_distance` takes it.
 pub trait Keyed {

@@ -12,75 +12,14 @@ use facemodel::FaceModel;
 use indicatif::ProgressBar;
 use landmarks::{DetectOptions, GenericModel, LandmarkName, VisibleLandmarks};
 use meshcore::{DVec3, TriMesh};
-use rand::SeedableRng;
+use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rangescan::{Artifacts, DepthNoise, HeadPose, Quantisation, ScanOptions, Visibility};
+use rangescan::Visibility;
 use rayon::prelude::*;
 use scanprep::{CleanOptions, Crop, Input};
 use std::time::{Duration, Instant};
 
-/// The scanner settings of one scan.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ScanSettings {
-    /// Sample pitch, mm.
-    pub pitch_mm: f64,
-    /// Standard deviation of the Gaussian depth noise, mm (0: none).
-    pub noise_mm: f64,
-    /// Depth quantisation step, mm (0: none).
-    pub quantisation_mm: f64,
-    /// Spikes (0.1 % of the samples, 2-10 mm) and 50 background outliers.
-    pub spikes: bool,
-    /// Holes: 4 random holes of 1-4 mm radius and dropouts at grazing angles (70-80 degrees).
-    pub holes: bool,
-    /// Head rotation about the vertical axis, degrees (positive turns the face to the
-    /// scanner's right).
-    pub yaw_deg: f64,
-    /// Head rotation about the horizontal axis, degrees (positive lifts the chin).
-    pub pitch_deg: f64,
-}
-
-impl ScanSettings {
-    /// The scanner's artifact model for these settings (the parts of
-    /// `Artifacts::structured_light` that are switched on, with the noise and quantisation
-    /// given here).
-    pub fn artifacts(&self) -> Artifacts {
-        let sl = Artifacts::structured_light();
-        Artifacts {
-            noise: (self.noise_mm > 0.0).then_some(DepthNoise {
-                sigma_mm: self.noise_mm,
-            }),
-            quantisation: (self.quantisation_mm > 0.0).then_some(Quantisation {
-                step_mm: self.quantisation_mm,
-            }),
-            spikes: sl.spikes.filter(|_| self.spikes),
-            outliers: sl.outliers.filter(|_| self.spikes),
-            grazing: sl.grazing.filter(|_| self.holes),
-            holes: sl.holes.filter(|_| self.holes),
-            border: None,
-        }
-    }
-
-    /// A short label (`pitch 0.5 mm, noise 0.1 mm, holes, spikes, yaw 30`).
-    pub fn label(&self) -> String {
-        let mut s = format!("pitch {} mm, noise {} mm", self.pitch_mm, self.noise_mm);
-        if self.quantisation_mm > 0.0 {
-            s += &format!(", quantisation {} mm", self.quantisation_mm);
-        }
-        if self.holes {
-            s += ", holes";
-        }
-        if self.spikes {
-            s += ", spikes";
-        }
-        if self.yaw_deg != 0.0 {
-            s += &format!(", yaw {}", self.yaw_deg);
-        }
-        if self.pitch_deg != 0.0 {
-            s += &format!(", pitch {}", self.pitch_deg);
-        }
-        s
-    }
-}
+pub use rangescan::{scan_seed, ScanSettings};
 
 /// One face to scan: its weights in the ICT model, the scanner settings and the scan's seed.
 #[derive(Debug, Clone)]
@@ -126,14 +65,74 @@ pub fn sample_weights(
         .collect()
 }
 
-/// The scan seed of face `index` of a set with seed `seed` (SplitMix64 of both).
-pub fn scan_seed(seed: u64, index: u64) -> u64 {
-    let mut z = seed
-        .wrapping_mul(0x9E37_79B9_7F4A_7C15)
-        .wrapping_add(index.wrapping_add(1).wrapping_mul(0xBF58_476D_1CE4_E5B9));
-    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    z ^ (z >> 31)
+/// Noise levels of the probes of the scan benchmark, mm.
+pub const PROBE_NOISE: [f64; 3] = [0.1, 0.2, 0.4];
+
+/// Makes the [`FaceSpec`]s of one sampled set ([`sample_weights`]), numbering their scan seeds
+/// ([`scan_seed`]) in the order they are made, from 1.
+#[derive(Debug)]
+pub struct SpecMaker {
+    weights: Vec<(Vec<f64>, Vec<Vec<f64>>)>,
+    seed: u64,
+    made: u64,
+}
+
+impl SpecMaker {
+    /// The weights of `identities` x `expressions` faces of the set with seed `seed`.
+    pub fn new(model: &FaceModel, identities: usize, expressions: usize, seed: u64) -> Self {
+        Self {
+            weights: sample_weights(model, identities, expressions, seed),
+            seed,
+            made: 0,
+        }
+    }
+
+    /// Expression `expression` of `identity` at `settings`, named `idII-eE` and `tag`, with the
+    /// set's next scan seed.
+    pub fn spec(
+        &mut self,
+        identity: usize,
+        expression: usize,
+        settings: ScanSettings,
+        tag: &str,
+    ) -> FaceSpec {
+        self.made += 1;
+        FaceSpec {
+            name: format!("id{identity:02}-e{expression}{tag}"),
+            identity,
+            identity_weights: self.weights[identity].0.clone(),
+            expression_weights: self.weights[identity].1[expression].clone(),
+            settings,
+            seed: scan_seed(self.seed, self.made),
+        }
+    }
+
+    /// The scan benchmark's gallery and probes: per identity its neutral face at `base`, then
+    /// per identity and other expression a probe under a random yaw (0-45 degrees, either
+    /// side) and noise ([`PROBE_NOISE`]), both drawn from the set's own stream.
+    pub fn gallery_and_probes(&mut self, base: ScanSettings) -> (Vec<FaceSpec>, Vec<FaceSpec>) {
+        let (identities, expressions) = (
+            self.weights.len(),
+            self.weights.first().map_or(0, |w| w.1.len()),
+        );
+        let gallery = (0..identities).map(|i| self.spec(i, 0, base, "")).collect();
+        let mut rng = ChaCha8Rng::seed_from_u64(scan_seed(self.seed, u64::MAX));
+        let mut probes = Vec::new();
+        for i in 0..identities {
+            for e in 1..expressions {
+                let yaw =
+                    rng.random_range(0..=45) as f64 * if rng.random::<bool>() { 1.0 } else { -1.0 };
+                let noise = PROBE_NOISE[rng.random_range(0..PROBE_NOISE.len())];
+                let st = ScanSettings {
+                    yaw_deg: yaw,
+                    noise_mm: noise,
+                    ..base
+                };
+                probes.push(self.spec(i, e, st, &format!("-yaw{yaw}-noise{noise}")));
+            }
+        }
+        (gallery, probes)
+    }
 }
 
 /// A ground-truth landmark on the cleaned scan.
@@ -208,9 +207,8 @@ pub const REFERENCE_LANDMARKS: [LandmarkName; 3] = [
     LandmarkName::NoseTip,
 ];
 
-/// The direction toward the scanner in the frame of every scan `rangescan` writes (it looks
-/// down the z axis).
-pub const SCANNER_SIDE: DVec3 = DVec3::Z;
+/// The direction toward the scanner in the frame of every scan `rangescan` writes.
+pub use facematch::GRID_SCANNER as SCANNER_SIDE;
 
 /// Options of [`scan_faces`].
 #[derive(Debug, Clone)]
@@ -331,22 +329,8 @@ pub fn scan_raw(model: &FaceModel, spec: &FaceSpec) -> Result<(rangescan::Scan, 
         "m" => 1000.0,
         _ => 10.0,
     };
-    let st = &spec.settings;
-    let scan = rangescan::scan_with_landmarks(
-        &face,
-        &marks,
-        &ScanOptions {
-            input_mm_per_unit: mm_per_unit,
-            pitch_mm: st.pitch_mm,
-            pose: HeadPose {
-                yaw_deg: st.yaw_deg,
-                pitch_deg: st.pitch_deg,
-            },
-            artifacts: st.artifacts(),
-            seed: spec.seed,
-            ..ScanOptions::default()
-        },
-    )?;
+    let options = spec.settings.options(mm_per_unit, spec.seed);
+    let scan = rangescan::scan_with_landmarks(&face, &marks, &options)?;
     Ok((scan, t0.elapsed()))
 }
 
@@ -427,45 +411,4 @@ pub fn clean_scan(
             detect: t3 - t2,
         },
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn settings_switch_the_artifacts() {
-        let mut s = ScanArgs {
-            scan_pitch: 0.5,
-            scan_noise: 0.1,
-            scan_quantisation: 0.0,
-            no_holes: false,
-            no_spikes: false,
-            scan_yaw: 0.0,
-            crop_radius: 100.0,
-        }
-        .settings();
-        let a = s.artifacts();
-        assert!(a.noise.is_some() && a.spikes.is_some() && a.holes.is_some());
-        assert!(a.quantisation.is_none());
-        s.spikes = false;
-        s.holes = false;
-        s.noise_mm = 0.0;
-        s.quantisation_mm = 2.0;
-        let a = s.artifacts();
-        assert!(a.noise.is_none() && a.spikes.is_none() && a.outliers.is_none());
-        assert!(a.holes.is_none() && a.grazing.is_none());
-        assert_eq!(a.quantisation.map(|q| q.step_mm), Some(2.0));
-        assert!(a.validate().is_ok());
-    }
-
-    #[test]
-    fn scan_seeds_differ_and_repeat() {
-        assert_eq!(scan_seed(7, 3), scan_seed(7, 3));
-        let mut v: Vec<u64> = (0..1000).map(|i| scan_seed(7, i)).collect();
-        v.extend((0..1000).map(|i| scan_seed(8, i)));
-        v.sort_unstable();
-        v.dedup();
-        assert_eq!(v.len(), 2000);
-    }
 }

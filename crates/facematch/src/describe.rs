@@ -186,9 +186,11 @@ fn static_descriptor(
 }
 
 /// The vertices the descriptors of `surface` may use: those of `seen` (all without it) outside
-/// the band of `margin` along the boundary ([`bipolar::boundary_band`], built once for all the
-/// descriptors of a surface).
-fn kept_vertices(
+/// the band of `margin` along the boundary ([`bipolar::boundary_band`]). For many descriptors
+/// of one surface, pass this as their vertex mask with no `boundary_margin`:
+/// `DescriptorOptions::boundary_margin` builds the band again (an exact solve from the
+/// boundary) on every call, and the two leave out the same vertices.
+pub fn kept_vertices(
     surface: &Surface,
     seen: Option<Vec<bool>>,
     margin: Option<f64>,
@@ -470,6 +472,26 @@ pub(crate) mod tests {
             }),
             ..poles
         }
+    }
+
+    #[test]
+    fn kept_vertices_leave_out_the_band_along_the_border_and_the_unseen() {
+        // A 20 x 20 sheet of 2 mm squares: a 5 mm band takes the outer two rings of vertices.
+        let (m, ..) = plane_face(20, 20, [(5, 10), (15, 10), (10, 5)]);
+        let surface = Surface::new(m);
+        let n = surface.mesh().n_vertices();
+        assert_eq!(kept_vertices(&surface, None, None).unwrap(), None);
+        let kept = kept_vertices(&surface, None, Some(5.0)).unwrap().unwrap();
+        let at = |i: usize, j: usize| kept[j * 21 + i];
+        assert!(!at(0, 10) && !at(2, 10) && at(3, 10) && at(10, 10) && !at(20, 20));
+        // The seen mask is kept as it is without a margin and joined with the band's.
+        let seen: Vec<bool> = (0..n).map(|v| v % 2 == 0).collect();
+        let only_seen = kept_vertices(&surface, Some(seen.clone()), None).unwrap();
+        assert_eq!(only_seen.as_deref(), Some(&seen[..]));
+        let both = kept_vertices(&surface, Some(seen.clone()), Some(5.0))
+            .unwrap()
+            .unwrap();
+        assert!((0..n).all(|v| both[v] == (kept[v] && seen[v])));
     }
 
     /// A solver that counts the fields it solves.

@@ -22,7 +22,8 @@
 //!    the template's view nearest the probe's scanner direction), the score (the least over the
 //!    pairs), and everything the comparison used or fell back on ([`Comparison`]).
 //!
-//! The options and their defaults (the benchmark's) are written once, in [`MatchOptions`].
+//! The options and their defaults (the benchmark's) are written once, in [`MatchOptions`]. The
+//! figures a set of scores is judged by (rank-1, EER, ROC, McNemar, Wilson) are in [`metrics`].
 
 mod compare;
 mod describe;
@@ -30,6 +31,7 @@ mod error;
 pub mod fixture;
 mod gallery;
 mod keyed;
+pub mod metrics;
 mod options;
 mod poles;
 mod prepare;
@@ -37,7 +39,9 @@ mod template;
 mod view;
 
 pub use compare::{compare, pair_score, Comparison, PairUse, ViewUse};
-pub use describe::{describe, describe_with_fields, face_fields, Description, FaceFields};
+pub use describe::{
+    describe, describe_with_fields, face_fields, kept_vertices, Description, FaceFields,
+};
 pub use error::MatchError;
 pub use gallery::{rank, Gallery, Ranked};
 pub use keyed::KeyedSet;

@@ -25,6 +25,9 @@
 //!   direction (occlusion and an incidence limit), as a mask of the mesh itself.
 //! * Flying pixels ([`add_flying_pixels`]): the depths between a silhouette and its background
 //!   that time-of-flight and stereo depth cameras return, added to a scanned grid.
+//! * Benchmark settings ([`ScanSettings`]): pitch, noise, quantisation, the structured-light
+//!   spikes and holes on or off and the head pose, as [`ScanOptions`]; [`scan_seed`] gives
+//!   each scan of a set its own seed.
 //!
 //! Library code never panics on user input: bad options or meshes the grid cannot hold end in
 //! [`ScanError`].
@@ -33,6 +36,7 @@ mod artifacts;
 mod camera;
 mod flying;
 mod render;
+mod settings;
 mod visibility;
 
 pub use artifacts::{
@@ -40,6 +44,7 @@ pub use artifacts::{
 };
 pub use camera::{HeadPose, Projection};
 pub use flying::{add_flying_pixels, FlyingPixels};
+pub use settings::{scan_seed, ScanSettings};
 pub use visibility::visible_faces;
 
 use camera::Camera;

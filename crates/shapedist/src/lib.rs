@@ -26,6 +26,9 @@
 //!   Python bindings call.
 //! * [`pairwise_matrix`] and [`write_matrix_csv`]: parallel symmetric distance matrices;
 //!   [`Separation`]: how such a matrix separates groups.
+//! * [`landmark_icp_rms`]: points onto a mesh surface by a trimmed ICP started from
+//!   corresponding landmarks, scored by their RMS distance to the surface (the benchmarks' ICP
+//!   score on raw meshes).
 //!
 //! The normalisations and their proofs of lying in [0, 1] are in `docs/shape-distance.md`.
 //! Nothing panics on user input: errors are [`ShapeDistError`].
@@ -37,6 +40,7 @@ pub mod keyed;
 mod matrix;
 pub mod nn;
 pub mod points;
+mod surface_icp;
 pub mod target;
 
 use glam::{DAffine3, DVec3};
@@ -54,6 +58,7 @@ pub use keyed::{
     RobustLoss, RotationMethod,
 };
 pub use matrix::{pairwise_matrix, write_matrix_csv, PairError, Separation};
+pub use surface_icp::{landmark_icp_rms, rms_to_surface, strided_points, trimmed_icp};
 pub use target::{
     icp_to_target, Convergence, Damping, IcpLoopOptions, IcpTarget, Match, PointTarget,
     TrimRounding,

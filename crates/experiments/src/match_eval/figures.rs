@@ -48,34 +48,6 @@ fn view_label(v: &facematch::ViewUse) -> String {
     }
 }
 
-/// Equal error rate of genuine (lower is same) and impostor scores.
-fn eer(genuine: &[f64], impostor: &[f64]) -> f64 {
-    eer_at(genuine, impostor).0
-}
-
-/// The equal error rate and the threshold (a score; at or below it: the same person) where it
-/// is reached.
-pub(super) fn eer_at(genuine: &[f64], impostor: &[f64]) -> (f64, f64) {
-    let mut t: Vec<f64> = genuine.iter().chain(impostor).copied().collect();
-    t.sort_by(f64::total_cmp);
-    let mut best = (f64::INFINITY, 1.0, f64::NAN);
-    for &th in &t {
-        let (frr, far) = error_rates(genuine, impostor, th);
-        if (frr - far).abs() < best.0 {
-            best = ((frr - far).abs(), 0.5 * (frr + far), th);
-        }
-    }
-    (best.1, best.2)
-}
-
-/// The share of genuine scores above `th` (same person refused) and of impostor scores at or
-/// below it (other person accepted).
-pub(super) fn error_rates(genuine: &[f64], impostor: &[f64], th: f64) -> (f64, f64) {
-    let frr = genuine.iter().filter(|&&g| g > th).count() as f64 / genuine.len().max(1) as f64;
-    let far = impostor.iter().filter(|&&i| i <= th).count() as f64 / impostor.len().max(1) as f64;
-    (frr, far)
-}
-
 /// The figures of one set (`p`, with its probe specs) under options `o`: every probe
 /// compared with every template, rank-1, EER, the score ratio and the fallbacks.
 pub(super) fn figures(p: &Processed, probes: &[Spec], o: &MatchOptions) -> Figures {
@@ -133,7 +105,7 @@ pub(super) fn figures(p: &Processed, probes: &[Spec], o: &MatchOptions) -> Figur
             _ => f.no_score += 1,
         }
     }
-    f.eer = eer(&f.genuine, &f.impostor);
+    f.eer = facematch::metrics::eer(&f.genuine, &f.impostor).rate;
     let max_g = f.genuine.iter().copied().fold(f64::NAN, f64::max);
     let min_i = f.impostor.iter().copied().fold(f64::NAN, f64::min);
     f.ratio = min_i / max_g;
@@ -155,18 +127,5 @@ pub(super) fn gate_label(g: f64) -> String {
     match gate_of(g) {
         Some(g) => format!("{g} mm"),
         None => "none".into(),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn eer_of_separated_and_overlapping_scores() {
-        assert_eq!(eer(&[0.1, 0.2], &[0.5, 0.6]), 0.0);
-        // One genuine above one impostor of two each: one error each side at the best threshold.
-        let e = eer(&[0.1, 0.55], &[0.5, 0.6]);
-        assert!((e - 0.5).abs() < 1e-12, "{e}");
     }
 }

@@ -21,9 +21,10 @@
 
 use crate::report::{f4, Report};
 use anyhow::{Context, Result};
+use facematch::metrics::{eer, error_rates};
 use facematch::{prepare, Description, Gallery, MatchOptions, ScanInput, Template};
 use facemodel::FaceModel;
-use figures::{eer_at, error_rates, figures, gate_label, gate_of, rank1, Figures, SCORE_COLUMNS};
+use figures::{figures, gate_label, gate_of, rank1, Figures, SCORE_COLUMNS};
 use mesh_io::BntGrid;
 use sets::{held_out_specs, process, scan_all, tuning_specs, Processed, Spec};
 use std::path::Path;
@@ -204,8 +205,7 @@ fn figures_section(rep: &mut Report, per_set: &[PerSet], chosen: f64) -> Result<
         }
     }
     rep.heading(2, "Identification and verification");
-    rep.table(&header, &rows);
-    rep.csv("figures.csv", &header, &rows)?;
+    rep.table_csv("figures.csv", &header, &rows)?;
     Ok(rows)
 }
 
@@ -256,12 +256,12 @@ fn threshold_section(rep: &mut Report, per_set: &[PerSet], chosen: f64, o: &Matc
     let Some((_, f)) = per_set[0].1.iter().find(|(g, _)| *g == chosen) else {
         return;
     };
-    let (e, th) = eer_at(&f.genuine, &f.impostor);
+    let e = eer(&f.genuine, &f.impostor);
     rep.heading(2, "Verification threshold");
     let mut lines = vec![format!(
         "tuning set at the chosen gate: EER {} at score {} (facematch::VERIFY_THRESHOLD is {})",
-        f4(e),
-        f4(th),
+        f4(e.rate),
+        f4(e.threshold),
         o.verify_threshold
     )];
     for (name, fs) in per_set {

@@ -3,7 +3,7 @@
 
 use super::Args;
 use crate::pipeline::bar;
-use crate::scans::{sample_weights, scan_seed, ScanSettings};
+use crate::scans::{sample_weights, scan_seed, FaceSpec, ScanSettings, SpecMaker};
 use anyhow::{Context, Result};
 use facematch::{prepare, Description, MatchOptions, ScanInput, Template};
 use facemodel::FaceModel;
@@ -23,63 +23,26 @@ pub(super) struct Spec {
     pub scan: ScanOptions,
 }
 
-/// The scanner options of the tuning set's scans (the scan benchmark's scanner).
-fn benchmark_scan(settings: ScanSettings, seed: u64) -> ScanOptions {
-    ScanOptions {
-        input_mm_per_unit: 10.0,
-        pitch_mm: settings.pitch_mm,
-        pose: HeadPose {
-            yaw_deg: settings.yaw_deg,
-            pitch_deg: settings.pitch_deg,
-        },
-        artifacts: settings.artifacts(),
-        seed,
-        ..ScanOptions::default()
+impl Spec {
+    /// The spec of a scan of the scan benchmark's sets ([`FaceSpec`], a mesh in cm).
+    fn of(f: FaceSpec) -> Self {
+        Spec {
+            scan: f.settings.options(10.0, f.seed),
+            name: f.name,
+            identity: f.identity,
+            identity_weights: f.identity_weights,
+            expression_weights: f.expression_weights,
+        }
     }
 }
 
-/// The tuning set: gallery specs (neutral, frontal) and probe specs, as the scan benchmark
-/// samples them.
+/// The tuning set: the scan benchmark's gallery specs (neutral, frontal) and probe specs
+/// ([`SpecMaker::gallery_and_probes`] at the default settings).
 pub(super) fn tuning_specs(model: &FaceModel, a: &Args) -> (Vec<Spec>, Vec<Spec>) {
-    let base = ScanSettings {
-        pitch_mm: 0.5,
-        noise_mm: 0.1,
-        quantisation_mm: 0.0,
-        spikes: true,
-        holes: true,
-        yaw_deg: 0.0,
-        pitch_deg: 0.0,
-    };
-    let weights = sample_weights(model, a.identities, a.expressions, a.seed);
-    let mut rng = ChaCha8Rng::seed_from_u64(scan_seed(a.seed, u64::MAX));
-    let mut n = 0u64;
-    let mut spec = |i: usize, e: usize, st: ScanSettings, tag: String| {
-        n += 1;
-        Spec {
-            name: format!("id{i:02}-e{e}{tag}"),
-            identity: i,
-            identity_weights: weights[i].0.clone(),
-            expression_weights: weights[i].1[e].clone(),
-            scan: benchmark_scan(st, scan_seed(a.seed, n)),
-        }
-    };
-    let gallery = (0..a.identities)
-        .map(|i| spec(i, 0, base, String::new()))
-        .collect();
-    let mut probes = Vec::new();
-    for i in 0..a.identities {
-        for e in 1..a.expressions {
-            let yaw = rng.random_range(0..=45) as f64 * if rng.random() { 1.0 } else { -1.0 };
-            let noise = [0.1, 0.2, 0.4][rng.random_range(0..3)];
-            let st = ScanSettings {
-                yaw_deg: yaw,
-                noise_mm: noise,
-                ..base
-            };
-            probes.push(spec(i, e, st, format!("-yaw{yaw}-noise{noise}")));
-        }
-    }
-    (gallery, probes)
+    let (g, p) = SpecMaker::new(model, a.identities, a.expressions, a.seed)
+        .gallery_and_probes(ScanSettings::default());
+    let of = |v: Vec<FaceSpec>| v.into_iter().map(Spec::of).collect();
+    (of(g), of(p))
 }
 
 /// The held-out set's scanner: settings drawn from `rng` outside the benchmark's.

@@ -1,13 +1,9 @@
 //! The benchmark on clean meshes: faces sampled from the ICT model under random rigid motions,
 //! described with the model's landmarks and with detected ones.
 
-use super::compare::{
-    icp_points, score_row, time_comparisons, time_descriptions, timed_pairs, Row, TIMED_FACES,
-    TIMED_PAIRS,
-};
+use super::compare::{icp_points, score_set, time_descriptions, TIMED_FACES, TIMED_PAIRS};
 use super::describe::{
     describe_face, elastic_options, iso_levels_of, DescribeOptions, Described, ISO_POINTS,
-    SEARCH_DIRECTIONS,
 };
 use super::metrics::{paired_table, results_table, roc_figure, summarize, write_summary, Metrics};
 use super::{Args, Lm};
@@ -79,27 +75,12 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         let solver = geodesic::new_solver(&s.mesh, method)?;
         iso_levels_of(&s.mesh, solver.as_ref(), gt, args.iso_levels)?
     };
-    let desc_opts = DescribeOptions {
-        levels: args.res.levels,
-        sectors: args.res.sectors,
-        iso_levels: Some(iso_levels),
-        boundary_margin: None,
-        max_incidence_deg: None,
-        ref_search: None,
-        view_match: None,
-        side_pair_deg: None,
-        least_pair: false,
-        search_all_pairs: false,
-        second_weight: 0.0,
-        predicted_corners: false,
-    };
-    // The reference-point search is the probes' (the gallery keeps its one description); its
-    // radius is given in mm, the model is in cm.
+    // The reference-point search is the probes' (the gallery keeps its one description).
     let probe_opts = DescribeOptions {
-        ref_search: (args.ref_search > 0.0)
-            .then(|| args.ref_search / meshcore::units::Units::Centimetre.mm_per_unit()),
-        ..desc_opts.clone()
+        iso_levels: Some(iso_levels),
+        ..DescribeOptions::of_args(args, false)
     };
+    let desc_opts = probe_opts.without_search();
     // Landmark detection.
     let generic = landmarks::GenericModel::default_model()
         .map_err(|e| anyhow::anyhow!("landmark model: {e}"))?;
@@ -234,21 +215,13 @@ fn score_all(args: &Args, s: &Setup<'_>, described: &[Both], gt: Lm) -> Result<V
             .zip(&locators)
             .map(|(&g, l)| described[g][k].as_ref().map(|d| (d, l)))
             .collect();
-        let rows: Vec<Row> = probes
-            .par_iter()
-            .zip(&probe_pts)
-            .map(|(&p, pts)| {
-                let (r, _) = score_row(described[p][k].as_ref(), pts, &gal, &elastic);
-                pb.inc(1);
-                r
-            })
-            .collect();
         let pr: Vec<(Option<&Described>, &[DVec3])> = probes
             .iter()
             .zip(&probe_pts)
             .map(|(&p, pts)| (described[p][k].as_ref(), pts.as_slice()))
             .collect();
-        timed.push((rows, time_comparisons(&timed_pairs(&pr, &gal), &elastic)?));
+        let (rows, _, ms_cmp) = score_set(&pr, &gal, &elastic, &pb)?;
+        timed.push((rows, ms_cmp));
     }
     pb.finish();
     // Description times: the first gallery faces again, one at a time on one thread.
@@ -291,7 +264,7 @@ fn write_report(
         s.identities, s.expressions, args.seed, s.gallery.len(), s.probes.len(), s.method.name(),
         s.method_note.as_ref().map(|n| format!(" (exact requested: {n})")).unwrap_or_default(),
         args.res.levels,
-        s.probe_opts.ref_search.map(|r| format!(", each probe also described from its outer eye corners moved by {r} cm in {SEARCH_DIRECTIONS} directions of their tangent planes (`bipolar::SearchedPole`), its score the least distance over these 49 descriptors")).unwrap_or_default(),
+        s.probe_opts.matching.search.map(|r| format!(", each probe also described from its outer eye corners moved by {} cm in {} directions of their tangent planes (`bipolar::SearchedPole`), its score the least distance over these 49 descriptors", r.radius_mm, r.directions)).unwrap_or_default(),
         args.res.sectors, args.res.levels, icp_points(&s.samples[0].mesh, args.icp_points).len(),
         args.res.levels, args.curve_samples, args.iso_levels
     ));

@@ -10,6 +10,7 @@ use facecurves::nose::{facial_distance, iso_distance_from};
 use facecurves::ElasticOptions;
 use meshcore::linalg::fit_rigid;
 use meshcore::{DVec3, FaceLocator, TriMesh};
+use rayon::prelude::*;
 use shapedist::{IcpOptions, IcpVariant};
 use std::time::Instant;
 
@@ -25,25 +26,13 @@ const ISO_ICP: IcpOptions = IcpOptions {
     coarse_iterations: 10,
 };
 
-/// Iterations of the recognition ICP ([`crate::pipeline::trimmed_icp`]).
+/// Iterations of the recognition ICP ([`shapedist::landmark_icp_rms`]: started from the
+/// landmark alignment, scored by the RMS closest-point distance of all probe points).
 const ICP_ITERATIONS: usize = 6;
 
-/// ICP of the probe points onto the gallery surface, started from the landmark alignment
-/// ([`crate::pipeline::landmark_icp_rms`]); returns the RMS closest-point distance of all probe
-/// points at the final pose (cm), NaN when a step fails.
-pub(super) fn icp_score(
-    probe: &[DVec3],
-    probe_lm: &[DVec3; 3],
-    gallery: &FaceLocator<'_>,
-    gallery_lm: &[DVec3; 3],
-) -> f64 {
-    crate::pipeline::landmark_icp_rms(probe, probe_lm, gallery, gallery_lm, ICP_ITERATIONS)
-}
-
-/// About `n` vertices of a probe for ICP, evenly strided.
+/// About `n` vertices of a probe for ICP, evenly strided ([`shapedist::strided_points`]).
 pub(super) fn icp_points(mesh: &TriMesh, n: usize) -> Vec<DVec3> {
-    let stride = (mesh.n_vertices() / n.max(3)).max(1);
-    mesh.positions().iter().step_by(stride).copied().collect()
+    shapedist::strided_points(mesh.positions(), n)
 }
 
 /// A probe `x` compared with a gallery face `y` by [`facematch::compare`], as with `y`'s
@@ -106,7 +95,7 @@ fn score_one(
     match k {
         0 => bipolar_score(x, bipolar_pairs(x, y).0),
         1 => dist(&x.pol, &y.pol).unwrap_or(f64::NAN),
-        2 => icp_score(pts, &x.lm_pos, loc, &y.lm_pos),
+        2 => shapedist::landmark_icp_rms(pts, &x.lm_pos, loc, &y.lm_pos, ICP_ITERATIONS),
         3 => match (&x.facial, &y.facial) {
             (Ok(a), Ok(b)) => facial_distance(a, b, elastic).unwrap_or(f64::NAN),
             _ => f64::NAN,
@@ -128,7 +117,7 @@ pub(super) type Row = [Vec<f64>; 5];
 /// single pole, ICP, facial curves (elastic distance with `elastic`) and iso-curvature (ICP of
 /// the networks' points from the landmark alignment); with the bipolar distance by each pair
 /// and the comparison's fallbacks ([`bipolar_pairs`]).
-pub(super) fn score_row(
+fn score_row(
     probe: Option<&Described>,
     pts: &[DVec3],
     gallery: &[Option<(&Described, &FaceLocator<'_>)>],
@@ -155,6 +144,31 @@ pub(super) fn score_row(
     (row, pairs)
 }
 
+/// The score rows of a set of probes, their bipolar distances by pair and each score's mean
+/// single-thread time per comparison (ms).
+pub(super) type ScoredSet = (Vec<Row>, Vec<Vec<PairDistances>>, [f64; 5]);
+
+/// The scores of `probes` (description, ICP points) against `gallery` (description, surface):
+/// the rows and bipolar pair distances of [`score_row`], in parallel (`pb` counts the probes),
+/// and each score's mean single-thread time over up to [`TIMED_PAIRS`] of the pairs.
+pub(super) fn score_set(
+    probes: &[(Option<&Described>, &[DVec3])],
+    gallery: &[Option<(&Described, &FaceLocator<'_>)>],
+    elastic: &ElasticOptions,
+    pb: &indicatif::ProgressBar,
+) -> Result<ScoredSet> {
+    let (rows, pairs) = probes
+        .par_iter()
+        .map(|(p, pts)| {
+            let r = score_row(*p, pts, gallery, elastic);
+            pb.inc(1);
+            r
+        })
+        .unzip();
+    let ms = time_comparisons(&timed_pairs(probes, gallery), elastic)?;
+    Ok((rows, pairs, ms))
+}
+
 /// Faces whose descriptions are timed (single thread).
 pub(super) const TIMED_FACES: usize = 6;
 
@@ -164,7 +178,7 @@ pub(super) const TIMED_PAIRS: usize = 24;
 /// Mean single-thread wall time (ms) of each score of [`SCORES`](super::metrics::SCORES) over
 /// `pairs` (probe, its ICP points, gallery face, its surface), run on a one-thread pool after the
 /// parallel scoring.
-pub(super) fn time_comparisons(
+fn time_comparisons(
     pairs: &[(&Described, &[DVec3], &Described, &FaceLocator<'_>)],
     elastic: &ElasticOptions,
 ) -> Result<[f64; 5]> {
@@ -182,7 +196,7 @@ pub(super) fn time_comparisons(
 
 /// Up to [`TIMED_PAIRS`] probe x gallery pairs where both faces are described: probes in
 /// order, each against the gallery faces in turn.
-pub(super) fn timed_pairs<'a>(
+fn timed_pairs<'a>(
     probes: &[(Option<&'a Described>, &'a [DVec3])],
     gallery: &[Option<(&'a Described, &'a FaceLocator<'a>)>],
 ) -> Vec<(

@@ -1,7 +1,7 @@
 //! The four descriptions of a face (bipolar, single pole, facial curves, iso-curvature) and
 //! their settings.
 
-use super::Lm;
+use super::{Args, Lm};
 use crate::polar::{self, polar_descriptor, PolarOptions, Pole};
 use crate::walk::Walker;
 use anyhow::{Context, Result};
@@ -52,82 +52,76 @@ pub(super) struct Described {
 /// Descriptor settings of the benchmark.
 #[derive(Debug, Clone)]
 pub(super) struct DescribeOptions {
-    /// Levels N between the outer eye corners (also the facial curves: N levels up to D).
-    pub(super) levels: u32,
     /// Sectors of the single-pole descriptor.
     pub(super) sectors: u32,
     /// Iso-curvature levels shared by every face (`None`: not described).
     pub(super) iso_levels: Option<IsoLevels>,
-    /// Band next to the mesh boundary left out of the bipolar descriptor (mesh units).
-    pub(super) boundary_margin: Option<f64>,
-    /// Parts seen at more than this incidence (degrees, scanner along +z) left out of the
-    /// bipolar descriptor (`scanprep::incidence_mask`).
-    pub(super) max_incidence_deg: Option<f64>,
-    /// Reference-point search radius (mesh units) of the probes' bipolar descriptors (`None`:
-    /// one descriptor from the given corners).
-    pub(super) ref_search: Option<f64>,
-    /// View matching of the gallery faces (`Args::view_match`, degrees; `None`: off).
-    pub(super) view_match: Option<f64>,
-    /// Probes turned by more than this (degrees) are compared by the bipolar descriptor of
-    /// their nearer corner and the nose tip (`Args::side_pair`; `None`: always the corners).
-    pub(super) side_pair_deg: Option<f64>,
-    /// The bipolar score is the least distance over the three pole pairs (the probe's own with
-    /// its reference-point search); else the probe's own pair's (`Args::own_pair_only`).
-    pub(super) least_pair: bool,
-    /// With `least_pair`, the reference-point search moves the poles of all three pairs, not
-    /// only the probe's own (the default; `Args::own_pair_search` turns it off).
-    pub(super) search_all_pairs: bool,
-    /// With `least_pair`, the weight of the second least pair distance in the score
-    /// (`Args::pair_second`; 0: the least alone).
-    pub(super) second_weight: f64,
-    /// Scans: a detected outer eye corner reported unseen is placed at the vertex nearest the
-    /// fitted face's prediction (within `MAX_SNAP_MM`) instead of being lost
-    /// (`Args::predicted_corners`).
-    pub(super) predicted_corners: bool,
+    /// The bipolar descriptions and their comparisons (`facematch`, in mesh units): its levels
+    /// N between the outer eye corners are also the single pole's and the facial curves'; its
+    /// `search` is the probes' reference-point search, its `view` the gallery faces' view
+    /// matching (`None`: off).
+    pub(super) matching: facematch::MatchOptions,
 }
 
 impl DescribeOptions {
-    /// The bipolar settings as `facematch` options (exact geodesics for the views; the caller
-    /// sets another method where it uses one): levels, the fields' cut-off of 1.4, the band,
-    /// the incidence limit, side pairs, the score's rule, the search's radius in mesh units and
-    /// [`SEARCH_DIRECTIONS`], the snap distance of a carried landmark; no gate, no stored views.
-    pub(super) fn matching(&self) -> facematch::MatchOptions {
-        facematch::MatchOptions {
+    /// The settings `args` give, the iso-curvature levels not yet set: facematch's defaults
+    /// with the flags' values, exact geodesics for the views (the caller sets another method
+    /// where it uses one), no gate. On clean meshes (`scans` false, cm) only the search is
+    /// taken from the flags (its radius converted from mm), for the outer eye corners' pair.
+    pub(super) fn of_args(args: &Args, scans: bool) -> Self {
+        let on = |x: f64| (scans && x > 0.0).then_some(x);
+        let mm_per_unit = if scans {
+            1.0
+        } else {
+            meshcore::units::Units::Centimetre.mm_per_unit()
+        };
+        let matching = facematch::MatchOptions {
             method: geodesic::Method::Exact,
-            levels: self.levels,
-            field_cutoff: FIELD_CUTOFF,
-            boundary_margin_mm: self.boundary_margin,
-            max_incidence_deg: self.max_incidence_deg,
-            side_pair_deg: self.side_pair_deg,
-            least_pair: self.least_pair,
-            second_weight: self.second_weight,
-            search: self.ref_search.map(|r| facematch::SearchOptions {
-                radius_mm: r,
-                directions: SEARCH_DIRECTIONS,
-                all_pairs: self.search_all_pairs,
+            levels: args.res.levels,
+            boundary_margin_mm: on(args.boundary_margin),
+            max_incidence_deg: on(args.max_incidence),
+            side_pair_deg: (scans && !args.no_side_pair).then_some(args.side_pair),
+            least_pair: scans && !(args.no_side_pair || args.own_pair_only),
+            second_weight: if scans { args.pair_second } else { 0.0 },
+            search: (args.ref_search > 0.0).then(|| facematch::SearchOptions {
+                radius_mm: args.ref_search / mm_per_unit,
+                all_pairs: scans && !args.own_pair_search,
+                ..facematch::SearchOptions::default()
             }),
-            view: None,
-            predicted_corners: self.predicted_corners,
-            snap_mm: crate::scans::MAX_SNAP_MM,
+            view: (scans && !args.no_view_match).then(|| facematch::ViewOptions {
+                min_angle_deg: args.view_match,
+                ..facematch::ViewOptions::default()
+            }),
+            predicted_corners: scans && args.predicted_corners,
             gate_mm: None,
             ..facematch::MatchOptions::default()
+        };
+        Self {
+            sectors: args.res.sectors,
+            iso_levels: None,
+            matching,
         }
+    }
+
+    /// The same settings without the reference-point search: the gallery's.
+    pub(super) fn without_search(&self) -> Self {
+        let mut o = self.clone();
+        o.matching.search = None;
+        o
     }
 }
 
-/// The landmarks' fields are cut off at this factor times |q - r|.
-const FIELD_CUTOFF: f64 = 1.4;
-
 /// The iso-curvature levels of a benchmark: `count` per principal field from the reference
-/// face `mesh` with landmarks `lm` ([`reference_iso_levels`] on its nose disc of radius D).
+/// face `mesh` with landmarks `lm` ([`reference_iso_levels`] on its nose disc of radius D; the
+/// fields cut off as facematch's default cuts them).
 pub(super) fn iso_levels_of(
     mesh: &TriMesh,
     solver: &dyn geodesic::GeodesicSolver,
     lm: Lm,
     count: usize,
 ) -> Result<IsoLevels> {
-    let f = facematch::face_fields(mesh, solver, lm, FIELD_CUTOFF)
-        .map_err(|e| anyhow::anyhow!("{e}"))?;
+    let cutoff = facematch::MatchOptions::default().field_cutoff;
+    let f = facematch::face_fields(mesh, solver, lm, cutoff).map_err(|e| anyhow::anyhow!("{e}"))?;
     let d = f.scale(lm).map_err(|e| anyhow::anyhow!("{e}"))?;
     reference_iso_levels(&Surface::new(mesh.clone()), &f.un, d, count)
         .context("iso-curvature levels of the reference face")
@@ -145,14 +139,14 @@ pub(super) fn describe_face(
     lm: Lm,
     o: &DescribeOptions,
 ) -> Result<Described, String> {
-    let f = facematch::face_fields(mesh, solver, lm, FIELD_CUTOFF)?;
+    let matching = &o.matching;
+    let f = facematch::face_fields(mesh, solver, lm, matching.field_cutoff)?;
     let [r, q, nose] = lm.positions(mesh);
     let (t_corners, t_nose) = (f.secs[0] + f.secs[1], f.secs[2]);
     let t = Instant::now();
     let t_surface = Instant::now();
     let surface = Surface::new(mesh.clone());
     let t_surface = t_surface.elapsed().as_secs_f64();
-    let matching = o.matching();
     let bip = facematch::describe_with_fields(
         &surface,
         solver,
@@ -160,8 +154,8 @@ pub(super) fn describe_face(
         lm,
         crate::scans::SCANNER_SIDE,
         None,
-        &matching,
-        o.ref_search.is_some(),
+        matching,
+        matching.search.is_some(),
     )
     .map_err(|e| e.to_string());
     let t_bip = t.elapsed().as_secs_f64();
@@ -169,8 +163,8 @@ pub(super) fn describe_face(
     let scale = f.scale(lm);
     let d = scale.clone().unwrap_or(f64::NAN);
     let opts = PolarOptions {
-        step: d / f64::from(o.levels),
-        levels: o.levels,
+        step: d / f64::from(matching.levels),
+        levels: matching.levels,
         sectors: o.sectors,
     };
     let t = Instant::now();
@@ -182,7 +176,8 @@ pub(super) fn describe_face(
     let t_pol = t.elapsed().as_secs_f64();
     let t = Instant::now();
     let facial = scale.clone().and_then(|d| {
-        facial_curves(&surface, &f.un, d, o.levels).map_err(|e| format!("facial curves: {e}"))
+        facial_curves(&surface, &f.un, d, matching.levels)
+            .map_err(|e| format!("facial curves: {e}"))
     });
     let t_facial = t.elapsed().as_secs_f64();
     let t = Instant::now();
@@ -200,7 +195,7 @@ pub(super) fn describe_face(
     let t_iso = t.elapsed().as_secs_f64();
     Ok(Described {
         bip,
-        matching,
+        matching: matching.clone(),
         pol,
         facial,
         iso,
@@ -214,6 +209,3 @@ pub(super) fn describe_face(
         ],
     })
 }
-
-/// Directions of the reference-point search around each pole (both recognition benchmarks).
-pub(super) const SEARCH_DIRECTIONS: usize = 6;

@@ -1,11 +1,12 @@
-//! The figures of the recognition benchmarks: identification and verification metrics of a
-//! score matrix (rank-1, EER, ROC), the paired comparison of two scores (McNemar), and their
-//! tables, summary and figures.
+//! The tables, summary and figures of the recognition benchmarks: the identification and
+//! verification figures of each score matrix (`facematch::metrics`: rank-1, EER, ROC, the
+//! paired McNemar test) as the report shows them.
 
 use super::compare::Row;
 use super::Args;
-use crate::report::{f4, line_plot, Report, Series};
+use crate::report::{f4, Report, Series};
 use anyhow::Result;
+use facematch::metrics::{discordant, mcnemar_exact, score_figures};
 
 /// Identification/verification figures of one score matrix.
 #[derive(Debug, Clone, serde::Serialize)]
@@ -25,92 +26,10 @@ pub(super) struct Metrics {
     pub(super) ms_per_description: f64,
     #[serde(skip)]
     pub(super) roc: Vec<(f64, f64)>,
-    /// Per probe, in the run's probe order: identified at rank 1 ([`identified`]); in
+    /// Per probe, in the run's probe order: identified at rank 1
+    /// ([`facematch::metrics::identified`]); in
     /// `summary.json`, so that runs of several seeds can be pooled probe by probe.
     pub(super) identified: Vec<bool>,
-}
-
-/// (rank-1 rate, EER, ROC points, mean genuine score, mean impostor score, failed pairs).
-pub(super) type Figures = (f64, f64, Vec<(f64, f64)>, f64, f64, usize);
-
-/// Rank-1 rate, EER and ROC from a probes x gallery score matrix (NaN = failure = worst).
-pub(super) fn metrics(scores: &[Vec<f64>], probe_id: &[usize], gallery_id: &[usize]) -> Figures {
-    let correct = identified(scores, probe_id, gallery_id)
-        .into_iter()
-        .filter(|&i| i)
-        .count();
-    let mut gen = Vec::new();
-    let mut imp = Vec::new();
-    let mut failures = 0;
-    for (p, row) in scores.iter().enumerate() {
-        let clean: Vec<f64> = row
-            .iter()
-            .map(|v| if v.is_finite() { *v } else { f64::INFINITY })
-            .collect();
-        failures += row.iter().filter(|v| !v.is_finite()).count();
-        for (g, v) in clean.iter().enumerate() {
-            if gallery_id[g] == probe_id[p] {
-                gen.push(*v);
-            } else {
-                imp.push(*v);
-            }
-        }
-    }
-    let rank1 = correct as f64 / scores.len().max(1) as f64;
-    let (eer, roc) = eer_roc(&gen, &imp);
-    let fmean = |v: &[f64]| {
-        let f: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
-        f.iter().sum::<f64>() / f.len().max(1) as f64
-    };
-    (rank1, eer, roc, fmean(&gen), fmean(&imp), failures)
-}
-
-/// Per probe (row of `scores`, NaN = failure): its nearest gallery face (the lowest index on
-/// ties) is finite and of its own identity.
-pub(super) fn identified(
-    scores: &[Vec<f64>],
-    probe_id: &[usize],
-    gallery_id: &[usize],
-) -> Vec<bool> {
-    scores
-        .iter()
-        .zip(probe_id)
-        .map(|(row, &id)| {
-            let clean = |v: f64| if v.is_finite() { v } else { f64::INFINITY };
-            (0..row.len())
-                .min_by(|&a, &b| clean(row[a]).total_cmp(&clean(row[b])).then(a.cmp(&b)))
-                .is_some_and(|b| gallery_id[b] == id && row[b].is_finite())
-        })
-        .collect()
-}
-
-/// Exact two-sided McNemar test of two classifiers on the same probes, `b` of them identified
-/// by the first only and `c` by the second only: the probability, were both equally good
-/// (each discordant probe a fair coin), of a split at least as uneven,
-/// `min(1, 2 P(X <= min(b, c)))` with `X ~ Binomial(b + c, 1/2)`; 1 without discordant probes.
-pub(super) fn mcnemar_exact(b: usize, c: usize) -> f64 {
-    let n = b + c;
-    let k = b.min(c);
-    // ln C(n, i) - n ln 2, summed term by term.
-    let mut ln_term = -(n as f64) * std::f64::consts::LN_2;
-    let mut tail = ln_term.exp();
-    for i in 1..=k {
-        ln_term += ((n - i + 1) as f64).ln() - (i as f64).ln();
-        tail += ln_term.exp();
-    }
-    (2.0 * tail).min(1.0)
-}
-
-/// Probes (by position) that only `a` identifies and that only `b` identifies.
-pub(super) fn discordant(a: &Metrics, b: &Metrics) -> (usize, usize) {
-    let only = |x: &Metrics, y: &Metrics| {
-        x.identified
-            .iter()
-            .zip(&y.identified)
-            .filter(|(a, b)| **a && !**b)
-            .count()
-    };
-    (only(a, b), only(b, a))
 }
 
 /// Appends the paired comparison of bipolar with every other score on the same probes, per
@@ -124,7 +43,7 @@ pub(super) fn paired_table(rep: &mut Report, all: &[Metrics]) {
             all.iter()
                 .filter(move |o| o.landmarks == b.landmarks && o.descriptor != "bipolar")
                 .map(move |o| {
-                    let (nb, no) = discordant(b, o);
+                    let (nb, no) = discordant(&b.identified, &o.identified);
                     vec![
                         b.landmarks.clone(),
                         o.descriptor.clone(),
@@ -151,40 +70,6 @@ pub(super) fn paired_table(rep: &mut Report, all: &[Metrics]) {
         ],
         &rows,
     );
-}
-
-/// Equal error rate and ROC points (false accept rate, true accept rate) for distance scores:
-/// a pair is accepted when its score is <= the threshold.
-pub(super) fn eer_roc(gen: &[f64], imp: &[f64]) -> (f64, Vec<(f64, f64)>) {
-    let mut thr: Vec<f64> = gen
-        .iter()
-        .chain(imp)
-        .copied()
-        .filter(|x| x.is_finite())
-        .collect();
-    thr.sort_by(f64::total_cmp);
-    thr.dedup();
-    let mut g = gen.to_vec();
-    let mut i = imp.to_vec();
-    g.sort_by(f64::total_cmp);
-    i.sort_by(f64::total_cmp);
-    let frac_le = |v: &[f64], t: f64| v.partition_point(|x| *x <= t) as f64 / v.len().max(1) as f64;
-    let mut roc = vec![(0.0, 0.0)];
-    let mut eer = 1.0;
-    let mut best_gap = f64::INFINITY;
-    for &t in &thr {
-        let far = frac_le(&i, t);
-        let tar = frac_le(&g, t);
-        roc.push((far, tar));
-        let frr = 1.0 - tar;
-        let gap = (far - frr).abs();
-        if gap < best_gap {
-            best_gap = gap;
-            eer = 0.5 * (far + frr);
-        }
-    }
-    roc.push((1.0, 1.0));
-    (eer, roc)
 }
 
 /// Names of the five scores of [`score_row`](super::compare::score_row).
@@ -233,20 +118,19 @@ pub(super) fn summarize(
         .enumerate()
         .map(|(j, dname)| {
             let m: Vec<Vec<f64>> = rows.iter().map(|r| r[j].clone()).collect();
-            let (rank1, eer, roc, gm, im, failures) = metrics(&m, probe_id, gallery_id);
-            let identified = identified(&m, probe_id, gallery_id);
+            let f = score_figures(&m, probe_id, gallery_id);
             Metrics {
                 descriptor: dname.to_string(),
                 landmarks: landmarks.to_string(),
-                rank1,
-                eer,
-                genuine_mean: gm,
-                impostor_mean: im,
-                failures,
+                rank1: f.rank1,
+                eer: f.eer.rate,
+                genuine_mean: f.genuine_mean,
+                impostor_mean: f.impostor_mean,
+                failures: f.failures,
                 ms_per_comparison: ms_comparison[j],
                 ms_per_description: DESCRIPTION_OF[j].map_or(f64::NAN, |k| ms_description[k]),
-                roc,
-                identified,
+                roc: f.roc,
+                identified: f.identified,
             }
         })
         .collect()
@@ -289,8 +173,7 @@ pub(super) fn results_table(rep: &mut Report, all: &[Metrics], csv: &str) -> Res
         "ms per comparison",
         "ms per description",
     ];
-    rep.table(&hdr, &rows);
-    rep.csv(csv, &hdr, &rows)
+    rep.table_csv(csv, &hdr, &rows)
 }
 
 /// Writes `summary.json` into `out` and prints the results ([`print_results`]). The summary
@@ -350,13 +233,11 @@ pub(super) fn roc_figure(rep: &mut Report, all: &[Metrics], file: &str, title: &
             dashed: m.landmarks == "detected",
         })
         .collect();
-    line_plot(
-        &rep.path(file),
-        title,
-        "false accept rate",
-        "true accept rate",
+    let labels = (title, "false accept rate", "true accept rate");
+    rep.plot(
+        file,
+        labels,
         &series,
-    )?;
-    rep.figure(file, &format!("{title}; dashed: detected landmarks"));
-    Ok(())
+        &format!("{title}; dashed: detected landmarks"),
+    )
 }

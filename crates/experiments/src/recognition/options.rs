@@ -26,7 +26,7 @@ pub struct Args {
     #[arg(long = "iso-levels", default_value_t = 6)]
     pub iso_levels: usize,
     /// Segments each facial curve is resampled into for the elastic distance.
-    #[arg(long = "curve-samples", default_value_t = CURVE_SAMPLES)]
+    #[arg(long = "curve-samples", default_value_t = 50)]
     pub curve_samples: usize,
     /// Probe vertices used by ICP (evenly strided).
     #[arg(long, default_value_t = 100)]
@@ -45,7 +45,7 @@ pub struct Args {
     pub scan: ScanArgs,
     /// Target edge length (mm) the cleaned scans are decimated to before detection and
     /// description (`--scans`; 0 keeps the scan's sampling).
-    #[arg(long, default_value_t = SCAN_EDGE_MM)]
+    #[arg(long, default_value_t = facematch::DEFAULT_EDGE_MM)]
     pub scan_edge: f64,
     /// Taubin smoothing iterations of the cleaned scans, before the decimation (`--scans`; 0:
     /// none).
@@ -63,11 +63,11 @@ pub struct Args {
     pub no_sweeps: bool,
     /// Band (mm) along the holes and the border of each cleaned scan that the bipolar
     /// descriptor leaves out (`--scans`; 0 keeps everything).
-    #[arg(long, default_value_t = SCAN_BOUNDARY_MARGIN_MM)]
+    #[arg(long, default_value_t = fm().boundary_margin_mm.unwrap_or(0.0))]
     pub boundary_margin: f64,
     /// Parts of each scan seen at more than this incidence (degrees) left out of the bipolar
     /// descriptor (`--scans`; 0 keeps everything).
-    #[arg(long, default_value_t = SCAN_MAX_INCIDENCE_DEG)]
+    #[arg(long, default_value_t = fm().max_incidence_deg.unwrap_or(0.0))]
     pub max_incidence: f64,
     /// Reference-point search of the bipolar score (mm, 0: off; on the clean meshes the outer
     /// eye corners' pair alone, as their only pair): each probe is also
@@ -75,7 +75,7 @@ pub struct Args {
     /// its two poles moved by this distance in 6 directions of their tangent planes (48 more
     /// descriptors per pair; only the probe's own pair with `--own-pair-search`), and its
     /// distance by a pair is the least over the pair's 49 descriptors.
-    #[arg(long, default_value_t = SCAN_REF_SEARCH_MM)]
+    #[arg(long, default_value_t = fm().search.map_or(0.0, |s| s.radius_mm))]
     pub ref_search: f64,
     /// View matching of the bipolar score (`--scans`; degrees): when a probe's scanner
     /// direction, carried into a gallery face's frame by the landmark alignment, is more than
@@ -84,7 +84,7 @@ pub struct Args {
     /// part of it a scanner turned by 15, 25, 35 or 45 degrees to either side would see,
     /// `rangescan::visible_faces`, incidence up to 75 degrees), so that both sides miss the
     /// same surface.
-    #[arg(long, default_value_t = SCAN_VIEW_MATCH_DEG)]
+    #[arg(long, default_value_t = fm().view.map_or(0.0, |v| v.min_angle_deg))]
     pub view_match: f64,
     /// No view matching (`--scans`): every probe is compared with the gallery face's one
     /// description.
@@ -98,7 +98,7 @@ pub struct Args {
     /// from its scanner by more than this is compared by the bipolar descriptor of its outer
     /// eye corner nearer the scanner and its nose tip (the gallery faces are described by
     /// both side pairs), not by its two corners, whose far one its scanner barely saw.
-    #[arg(long, default_value_t = SCAN_SIDE_PAIR_DEG)]
+    #[arg(long, default_value_t = fm().side_pair_deg.unwrap_or(0.0))]
     pub side_pair: f64,
     /// No side pairs (`--scans`): every probe is compared by its outer eye corners.
     #[arg(long)]
@@ -153,31 +153,8 @@ pub struct Args {
     pub only_identities: Vec<usize>,
 }
 
-/// Default of `--scan-edge`, mm.
-const SCAN_EDGE_MM: f64 = 1.5;
-
-/// Default of `--boundary-margin`: the band next to the holes where the fields of two scans
-/// disagree most (docs/scans.md, "Yaw").
-const SCAN_BOUNDARY_MARGIN_MM: f64 = 6.0;
-
-/// The default of `--max-incidence`, chosen on scan-study (60 degrees raised every same-face
-/// figure and kept the other-person minimum; 45 degrees left too few shared keys on the face
-/// mesh; docs/scans.md, "Grazing incidence").
-const SCAN_MAX_INCIDENCE_DEG: f64 = 60.0;
-
-/// The default of `--ref-search`: 2 mm raised bipolar with detected landmarks from 0.656 to
-/// 0.750 (16 identities) and from 0.550 to 0.690 (50) and kept or raised it with ground truth;
-/// 1.2 and 3 mm differ from it by one probe on 16 identities (docs/scans.md, "Reference-point
-/// search").
-const SCAN_REF_SEARCH_MM: f64 = 2.0;
-
-/// The default of `--view-match` (degrees). Not tuned: below it a probe is near frontal, its
-/// scanner saw what the gallery's did, and the gallery's own description is used.
-const SCAN_VIEW_MATCH_DEG: f64 = 10.0;
-
-/// The default of `--side-pair` (degrees), chosen on 16 identities: 25 moved one probe from
-/// rank 1 to 3 and gained nothing else (docs/scans.md, "Side pairs and lost corners").
-const SCAN_SIDE_PAIR_DEG: f64 = 30.0;
-
-/// Default of `--curve-samples`.
-const CURVE_SAMPLES: usize = 50;
+/// facematch's options with their defaults: the defaults of the bipolar flags on scans, written
+/// (and the choices explained) once, in `facematch::MatchOptions`.
+fn fm() -> facematch::MatchOptions {
+    facematch::MatchOptions::default()
+}

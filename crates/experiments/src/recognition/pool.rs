@@ -7,10 +7,11 @@
 //! interval; the paired comparison adds up each seed's probes that only one of two scores
 //! identifies (the probes of one seed are the same for every score).
 
-use super::metrics::{discordant, mcnemar_exact, paired_table, Metrics};
+use super::metrics::{paired_table, Metrics};
 use super::Args;
-use crate::report::{line_plot, Report, Series};
+use crate::report::{Report, Series};
 use anyhow::{bail, Context, Result};
+use facematch::metrics::{discordant, mcnemar_exact, wilson95};
 use std::path::{Path, PathBuf};
 
 /// The folder of one seed's run inside the pooled run's folder.
@@ -102,19 +103,6 @@ pub(super) fn read_run(dir: &Path) -> Result<Vec<RunRow>> {
 fn same_score<'a>(rows: &'a [RunRow], descriptor: &str, landmarks: &str) -> Option<&'a RunRow> {
     rows.iter()
         .find(|r| r.descriptor == descriptor && r.landmarks == landmarks)
-}
-
-/// Wilson score interval (95 %) of `k` successes in `n` trials.
-pub(super) fn wilson95(k: usize, n: usize) -> (f64, f64) {
-    if n == 0 {
-        return (f64::NAN, f64::NAN);
-    }
-    let z = 1.959_963_984_540_054_f64;
-    let (k, n) = (k as f64, n as f64);
-    let p = k / n;
-    let centre = (p + z * z / (2.0 * n)) / (1.0 + z * z / n);
-    let half = z / (1.0 + z * z / n) * (p * (1.0 - p) / n + z * z / (4.0 * n * n)).sqrt();
-    ((centre - half).max(0.0), (centre + half).min(1.0))
 }
 
 /// The pooled scores: per (score, landmark set) in the first run's order, the concatenated
@@ -245,17 +233,12 @@ fn write_pooled(out: &Path, runs: &[(u64, Vec<RunRow>)]) -> Result<()> {
             dashed: m.landmarks == "detected",
         })
         .collect();
-    line_plot(
-        &rep.path("rank1-seeds.svg"),
-        "Rank-1 per seed",
-        "seed",
-        "rank-1",
-        &series,
-    )?;
-    rep.figure(
+    rep.plot(
         "rank1-seeds.svg",
+        ("Rank-1 per seed", "seed", "rank-1"),
+        &series,
         "Rank-1 of each seed's run; dashed: detected landmarks",
-    );
+    )?;
     rep.png_twins()?;
     rep.finish()?;
     for m in &pool {
@@ -275,7 +258,7 @@ fn write_pooled(out: &Path, runs: &[(u64, Vec<RunRow>)]) -> Result<()> {
             .iter()
             .find(|o| o.descriptor == "icp_raw_mesh" && o.landmarks == b.landmarks)
         {
-            let (nb, no) = discordant(b, o);
+            let (nb, no) = discordant(&b.identified, &o.identified);
             eprintln!(
                 "bipolar vs ICP ({}): only bipolar {nb}, only ICP {no}, McNemar p {:.4}",
                 b.landmarks,
@@ -298,20 +281,6 @@ mod tests {
             eer: Some(eer),
             identified: identified.to_vec(),
         }
-    }
-
-    #[test]
-    fn wilson_interval_matches_known_values() {
-        // 90 of 100: 0.825 - 0.945 (Wilson, z = 1.96).
-        let (lo, hi) = wilson95(90, 100);
-        assert!(
-            (lo - 0.8256).abs() < 5e-4 && (hi - 0.9448).abs() < 5e-4,
-            "{lo} {hi}"
-        );
-        // All or none: one end at the bound.
-        assert!((wilson95(10, 10).1 - 1.0).abs() < 1e-12);
-        assert!(wilson95(0, 10).0.abs() < 1e-12);
-        assert!(wilson95(0, 0).0.is_nan());
     }
 
     #[test]

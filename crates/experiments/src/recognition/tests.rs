@@ -1,7 +1,4 @@
-use super::compare::icp_score;
-use super::metrics::{identified, mcnemar_exact, metrics};
 use super::{run, Args};
-use meshcore::{DVec3, FaceLocator};
 
 #[test]
 fn detect_only_writes_one_row_per_scan_and_stops() {
@@ -78,67 +75,4 @@ fn detect_only_writes_one_row_per_scan_and_stops() {
         .to_string();
     assert!(e.contains("no probe left") && e.contains("id05"), "{e}");
     std::fs::remove_dir_all(&out).unwrap();
-}
-
-#[test]
-fn eer_and_rank1_on_known_scores() {
-    // 2 gallery ids, 2 probes each; probe 3 is misidentified.
-    let gid = vec![0, 1];
-    let pid = vec![0, 0, 1, 1];
-    let s = vec![
-        vec![0.1, 0.5],
-        vec![0.2, 0.6],
-        vec![0.7, 0.3],
-        vec![0.4, 0.45],
-    ];
-    let (rank1, eer, roc, gm, im, f) = metrics(&s, &pid, &gid);
-    assert!((rank1 - 0.75).abs() < 1e-12);
-    assert!((gm - (0.1 + 0.2 + 0.3 + 0.45) / 4.0).abs() < 1e-12);
-    assert!((im - (0.5 + 0.6 + 0.7 + 0.4) / 4.0).abs() < 1e-12);
-    assert_eq!(f, 0);
-    // Threshold 0.4: FAR 1/4, FRR 1/4 -> EER 0.25.
-    assert!((eer - 0.25).abs() < 1e-12, "{eer}");
-    assert_eq!(roc.first(), Some(&(0.0, 0.0)));
-    assert_eq!(roc.last(), Some(&(1.0, 1.0)));
-    // Perfect separation gives EER 0; NaN counts as a failure.
-    let (r, e, ..) = metrics(&[vec![0.1, f64::NAN], vec![0.9, 0.2]], &[0, 1], &gid);
-    assert_eq!((r, e), (1.0, 0.0));
-    assert_eq!(identified(&s, &pid, &gid), [true, true, true, false]);
-    // A probe whose every score failed is not identified, even of the first identity.
-    assert_eq!(identified(&[vec![f64::NAN, f64::NAN]], &[0], &gid), [false]);
-}
-
-#[test]
-fn the_mcnemar_p_value_is_the_two_sided_binomial_tail() {
-    // 10 discordant probes split 9 : 1: 2 (1 + 10) / 1024.
-    assert!((mcnemar_exact(9, 1) - 22.0 / 1024.0).abs() < 1e-15);
-    assert!((mcnemar_exact(1, 9) - 22.0 / 1024.0).abs() < 1e-15);
-    // 10 : 0: 2 / 1024; an even split and no discordant probe: 1.
-    assert!((mcnemar_exact(10, 0) - 2.0 / 1024.0).abs() < 1e-15);
-    assert_eq!(mcnemar_exact(5, 5), 1.0);
-    assert_eq!(mcnemar_exact(0, 0), 1.0);
-    // 6 : 2 (the figure of a 50-identity run): 2 (1 + 8 + 28) / 256.
-    assert!((mcnemar_exact(6, 2) - 74.0 / 256.0).abs() < 1e-14);
-    // Many probes, no underflow: 2 sum_{i <= 200} C(500, i) / 2^500 = 8.9401e-6 (exact
-    // integer sum).
-    let p = mcnemar_exact(300, 200);
-    assert!((p / 8.940066542253267e-6 - 1.0).abs() < 1e-9, "{p}");
-}
-
-#[test]
-fn icp_recovers_a_rigid_copy() {
-    let m = meshcore::shapes::icosphere(2);
-    let rot = meshcore::DMat3::from_quat(meshcore::DQuat::from_axis_angle(
-        DVec3::new(1.0, 0.3, 0.2).normalize(),
-        1.1,
-    ));
-    let t = DVec3::new(3.0, -2.0, 1.0);
-    let probe: Vec<DVec3> = m.positions().iter().map(|p| rot * *p + t).collect();
-    let lm_g = [m.position(0), m.position(5), m.position(9)];
-    let lm_p = lm_g.map(|p| rot * p + t);
-    let loc = FaceLocator::new(&m);
-    assert!(icp_score(&probe, &lm_p, &loc, &lm_g) < 1e-9);
-    // A scaled copy is not at distance 0.
-    let big: Vec<DVec3> = probe.iter().map(|p| (*p - t) * 1.1 + t).collect();
-    assert!(icp_score(&big, &lm_p, &loc, &lm_g) > 0.01);
 }

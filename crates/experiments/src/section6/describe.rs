@@ -26,21 +26,6 @@ pub(super) struct Descs {
     pub iso: Option<IsoCurvatureDescriptor>,
 }
 
-/// Which descriptors [`Ctx::describe`] builds.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Which {
-    /// The bipolar descriptor (moves with the eye corners).
-    pub bipolar: bool,
-    /// Single pole, facial curves and iso-curvature (move with the nose tip).
-    pub nose: bool,
-}
-
-/// All four.
-pub(super) const ALL: Which = Which {
-    bipolar: true,
-    nose: true,
-};
-
 /// What describing a configuration needs besides the fields.
 pub(super) struct Ctx<'a> {
     /// The task's arguments (resolution).
@@ -61,66 +46,68 @@ impl Ctx<'_> {
         self.failures.ok(r, what)
     }
 
-    /// The descriptors asked for by `which`: bipolar from `refs`; single pole, facial curves
-    /// and iso-curvature (the `nose` group) from the nose field `un` with the pole `nose`
-    /// (region of radius D).
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn describe(
+    /// The static-area bipolar descriptor of `refs` (`None`: refused, listed).
+    pub(super) fn bipolar(
         &self,
         mesh: &TriMesh,
-        walker: &Walker<'_>,
+        refs: &Refs,
+        name: &str,
+    ) -> Option<bipolar::Descriptor> {
+        let surface = bipolar::Surface::new(mesh.clone());
+        let n = self.args.set.res.levels;
+        let d = bipolar(
+            &surface,
+            refs,
+            n,
+            Region::Static,
+            DescriptorRule::CrateAll,
+            None,
+            None,
+        );
+        self.ok(d, || format!("bipolar descriptor of {name}"))
+    }
+
+    /// Single pole, facial curves and iso-curvature (region of radius D) from the nose field
+    /// `un` with the pole `nose`; no bipolar descriptor.
+    pub(super) fn nose_descs(
+        &self,
+        (mesh, walker): (&TriMesh, &Walker<'_>),
         refs: &Refs,
         un: &[f64],
         nose: Pole,
         name: &str,
-        which: Which,
     ) -> Descs {
         let n = self.args.set.res.levels;
-        let bip = which.bipolar.then(|| {
-            self.ok(
-                bipolar(
-                    &bipolar::Surface::new(mesh.clone()),
-                    refs,
-                    n,
-                    Region::Static,
-                    DescriptorRule::CrateAll,
-                    None,
-                    None,
-                ),
-                || format!("bipolar descriptor of {name}"),
-            )
-        });
-        if !which.nose {
-            return Descs {
-                bipolar: bip.flatten(),
-                polar: None,
-                facial: None,
-                iso: None,
-            };
-        }
         let popts = PolarOptions {
             step: refs.d / f64::from(n),
             levels: n,
             sectors: self.args.set.res.sectors,
         };
-        let polar = self
-            .ok(
-                polar_descriptor(walker, un, nose, 0.5 * (refs.r + refs.q), &popts),
-                || format!("single pole of {name}"),
-            )
-            .unwrap_or_else(|| polar::empty(&popts));
+        let polar = polar_descriptor(walker, un, nose, 0.5 * (refs.r + refs.q), &popts);
+        let polar = self.ok(polar, || format!("single pole of {name}"));
         let surface = Surface::new(mesh.clone());
-        let facial = self.ok(facial_curves(&surface, un, refs.d, n), || {
-            format!("facial curves of {name}")
-        });
-        let iso = self.ok(iso_curves(&surface, un, refs.d, &self.iso_levels), || {
-            format!("iso-curvature curves of {name}")
-        });
+        let facial = facial_curves(&surface, un, refs.d, n);
+        let iso = iso_curves(&surface, un, refs.d, &self.iso_levels);
         Descs {
-            bipolar: bip.flatten(),
-            polar: Some(polar),
-            facial,
-            iso,
+            bipolar: None,
+            polar: Some(polar.unwrap_or_else(|| polar::empty(&popts))),
+            facial: self.ok(facial, || format!("facial curves of {name}")),
+            iso: self.ok(iso, || format!("iso-curvature curves of {name}")),
+        }
+    }
+
+    /// All four descriptors: [`Ctx::bipolar`] and [`Ctx::nose_descs`].
+    pub(super) fn describe(
+        &self,
+        mesh_walker: (&TriMesh, &Walker<'_>),
+        refs: &Refs,
+        un: &[f64],
+        nose: Pole,
+        name: &str,
+    ) -> Descs {
+        Descs {
+            bipolar: self.bipolar(mesh_walker.0, refs, name),
+            ..self.nose_descs(mesh_walker, refs, un, nose, name)
         }
     }
 

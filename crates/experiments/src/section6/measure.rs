@@ -1,9 +1,9 @@
 //! The measurements of section 6 on a described face set: the between-person matrices and
 //! the time per comparison, the reference-point grid, the depth noise and figure 15.
 
-use super::describe::{noisy, Ctx, Descs, Which, ALL};
+use super::describe::{noisy, Ctx, Descs};
 use super::figure15::{figure15, Fig15};
-use crate::pipeline::{bar, error_grid, field, perturb, single_thread};
+use crate::pipeline::{bar, dist, error_grid, field, perturb, single_thread};
 use crate::polar::Pole;
 use crate::robustness::stats::Sep;
 use crate::robustness::FacePrep;
@@ -141,38 +141,14 @@ fn grid_cell(s: &Set<'_>, pct: f64, theta: f64) -> Result<[f64; 4]> {
     // Nose tip moved: the other three (same D, the corners are not moved).
     let (sn, cut_n) = perturb(w, lm.nose_tip, eye_mid, radius, theta)?;
     let un = field(tp.solver.as_ref(), Source::Point(sn))?;
-    let only_bipolar = Which {
-        bipolar: true,
-        nose: false,
-    };
-    let only_nose = Which {
-        bipolar: false,
-        nose: true,
-    };
-    let moved_q = ctx.describe(
-        &tf.mesh,
-        w,
-        &refs,
-        &tp.un,
-        Pole::Vertex(lm.nose_tip),
-        &name,
-        only_bipolar,
-    );
-    let moved_n = ctx.describe(
-        &tf.mesh,
-        w,
-        &tp.refs,
-        &un,
-        Pole::Point(sn),
-        &name,
-        only_nose,
-    );
+    let moved_q = ctx.bipolar(&tf.mesh, &refs, &name);
+    let moved_n = ctx.nose_descs((&tf.mesh, w), &tp.refs, &un, Pole::Point(sn), &name);
     let base = &s.base[s.test];
-    let (dq, _) = ctx.distances(base, &moved_q, &name);
+    let dq = dist(&base.bipolar, &moved_q).unwrap_or(f64::NAN);
     let (dn, _) = ctx.distances(base, &moved_n, &name);
     let nan_if = |cut: bool, v: f64| if cut { f64::NAN } else { v };
     Ok([
-        nan_if(cut_q, dq[0]),
+        nan_if(cut_q, dq),
         nan_if(cut_n, dn[1]),
         nan_if(cut_n, dn[2]),
         nan_if(cut_n, dn[3]),
@@ -204,15 +180,8 @@ pub(super) fn depth_noise(s: &Set<'_>, mm: f64) -> Result<Cells<(f64, usize)>> {
             let p = FacePrep::new(&noisy_face, geodesic::Method::Exact)?;
             let wn = Walker::new(&noisy_face.mesh);
             let name = format!("{} with {sigma_mm} mm noise, draw {k}", tf.name);
-            let dsc = ctx.describe(
-                &noisy_face.mesh,
-                &wn,
-                &p.refs,
-                &p.un,
-                Pole::Vertex(tf.landmarks.nose_tip),
-                &name,
-                ALL,
-            );
+            let nose = Pole::Vertex(tf.landmarks.nose_tip);
+            let dsc = ctx.describe((&noisy_face.mesh, &wn), &p.refs, &p.un, nose, &name);
             let (d, _) = ctx.distances(&s.base[s.test], &dsc, &name);
             pb.inc(1);
             Ok(d)

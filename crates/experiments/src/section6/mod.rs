@@ -23,7 +23,7 @@ use crate::report::Report;
 use crate::robustness::FacePrep;
 use crate::walk::Walker;
 use anyhow::{bail, Context, Result};
-use describe::{Ctx, Descs, ALL};
+use describe::{Ctx, Descs};
 use facecurves::nose::reference_iso_levels;
 use measure::Set;
 use meshcore::Surface;
@@ -166,15 +166,8 @@ fn describe_all(
         .zip(preps)
         .zip(walkers)
         .map(|((f, p), w)| {
-            let d = ctx.describe(
-                &f.mesh,
-                w,
-                &p.refs,
-                &p.un,
-                Pole::Vertex(f.landmarks.nose_tip),
-                &f.name,
-                ALL,
-            );
+            let nose = Pole::Vertex(f.landmarks.nose_tip);
+            let d = ctx.describe((&f.mesh, w), &p.refs, &p.un, nose, &f.name);
             pb.inc(1);
             d
         })

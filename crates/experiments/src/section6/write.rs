@@ -55,11 +55,6 @@ pub(super) fn renders(out: &Path, face: &Face, d: &Descs) -> Result<()> {
     Ok(())
 }
 
-/// A distance in the tables (4 decimals, `n/a` when not finite).
-fn fmt(x: f64) -> String {
-    f4(x)
-}
-
 /// A table row of movements: `label`, then per representation `agg` of the distances `d` with,
 /// in brackets, its value relative to `scale` (the distance between persons).
 fn rel_row<'a>(
@@ -73,7 +68,7 @@ fn rel_row<'a>(
         .chain((0..4).map(|k| {
             let v: Vec<f64> = d.iter().map(|x| x[k]).collect();
             let a = agg(&v);
-            format!("{} ({:.2})", fmt(a), a / scale[k])
+            format!("{} ({:.2})", f4(a), a / scale[k])
         }))
         .collect()
 }
@@ -203,11 +198,11 @@ fn between_section(rep: &mut Report, r: &Results<'_>) -> Result<()> {
         let s = &seps[k];
         rows.push(vec![
             REPS[k].to_string(),
-            fmt(s.max_same),
-            fmt(s.min_diff),
+            f4(s.max_same),
+            f4(s.min_diff),
             format!("{:.2} ({})", s.ratio(), verdict(s.ratio())),
-            fmt(s.row_max_same),
-            fmt(s.row_min_diff),
+            f4(s.row_max_same),
+            f4(s.row_min_diff),
             format!("{:.2} ({})", s.row_ratio(), verdict(s.row_ratio())),
             format!("{:.3}", times[k]),
         ]);
@@ -298,7 +293,7 @@ fn figure15_section(rep: &mut Report, r: &Results<'_>) {
     ));
     let rows: Vec<Vec<String>> = fig15
         .iter()
-        .map(|(n, r, o)| vec![n.to_string(), fmt(*r), fmt(*o), format!("{:.3}", r / o)])
+        .map(|(n, r, o)| vec![n.to_string(), f4(*r), f4(*o), format!("{:.3}", r / o)])
         .collect();
     rep.table(
         &["distance", "rotated rings", "other person", "ratio"],

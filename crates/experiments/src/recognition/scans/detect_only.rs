@@ -232,8 +232,7 @@ fn yaw_section(rep: &mut Report, specs: &[&FaceSpec], outcomes: &[Outcome]) -> R
             .map(|(pts, n)| Series::new(n, pts))
             .collect();
         let x_label = "yaw (degrees, 10-degree bins)";
-        crate::report::line_plot(&rep.path(file), title, x_label, y_label, &series)?;
-        rep.figure(file, caption);
+        rep.plot(file, (title, x_label, y_label), &series, caption)?;
     }
     Ok(())
 }

@@ -140,17 +140,9 @@ impl Pipeline<'_> {
             face.prepare_notes = p.notes.clone();
         }
         // The reference-point search is the probes' (the gallery keeps its one description).
-        let gallery_opts;
-        let dopt = if keep_mesh {
-            gallery_opts = DescribeOptions {
-                ref_search: None,
-                ..dopt.clone()
-            };
-            &gallery_opts
-        } else {
-            dopt
-        };
-        let allow_lost = dopt.side_pair_deg.is_some();
+        let gallery_opts = dopt.without_search();
+        let dopt = if keep_mesh { &gallery_opts } else { dopt };
+        let allow_lost = dopt.matching.side_pair_deg.is_some();
         let t = Instant::now();
         let lms = [
             truth_lm(&s, allow_lost),
@@ -159,7 +151,7 @@ impl Pipeline<'_> {
                     &p.mesh,
                     &p.detected,
                     allow_lost,
-                    dopt.predicted_corners,
+                    dopt.matching.predicted_corners,
                     MAX_SNAP_MM,
                 )
             }),
@@ -177,20 +169,14 @@ impl Pipeline<'_> {
                 .and_then(|solver| {
                     describe_face(mesh, solver.as_ref(), &Walker::new(mesh), *lm, dopt)
                 });
-            if let (true, Some(min_angle_deg), Ok(d)) =
-                (keep_mesh, dopt.view_match, &mut face.desc[k])
-            {
+            if let (true, Some(view), Ok(d)) = (keep_mesh, &dopt.matching.view, &mut face.desc[k]) {
                 // The gallery face's template views (facematch's, computed once).
-                let view = facematch::ViewOptions {
-                    min_angle_deg,
-                    ..facematch::ViewOptions::default()
-                };
                 let matching = facematch::MatchOptions {
                     method,
-                    ..dopt.matching()
+                    ..dopt.matching.clone()
                 };
-                let views = facematch::views_of(mesh, *lm, SCANNER_SIDE, &matching, &view);
-                d.views = Some((views, view));
+                let views = facematch::views_of(mesh, *lm, SCANNER_SIDE, &matching, view);
+                d.views = Some((views, view.clone()));
             }
         }
         face.secs[3] = t.elapsed().as_secs_f64();

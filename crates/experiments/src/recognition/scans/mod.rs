@@ -41,9 +41,6 @@ use std::time::Instant;
 /// The two landmark sets.
 const SETS: [&str; 2] = ["ground_truth", "detected"];
 
-/// Noise levels of the probes of the main run, mm.
-const PROBE_NOISE: [f64; 3] = [0.1, 0.2, 0.4];
-
 /// The run's settings, as the report states them.
 #[derive(Clone, Copy)]
 struct Setup<'a> {
@@ -183,20 +180,7 @@ fn settings(args: &Args) -> Result<(ScanSetOptions, DescribeOptions, facematch::
         detect_smoothing: args.detect_smooth,
         ..ScanSetOptions::default()
     };
-    let dopt = DescribeOptions {
-        levels: args.res.levels,
-        sectors: args.res.sectors,
-        iso_levels: None,
-        boundary_margin: (args.boundary_margin > 0.0).then_some(args.boundary_margin),
-        max_incidence_deg: (args.max_incidence > 0.0).then_some(args.max_incidence),
-        ref_search: (args.ref_search > 0.0).then_some(args.ref_search),
-        view_match: (!args.no_view_match).then_some(args.view_match),
-        side_pair_deg: (!args.no_side_pair).then_some(args.side_pair),
-        least_pair: !(args.no_side_pair || args.own_pair_only),
-        second_weight: args.pair_second,
-        predicted_corners: args.predicted_corners,
-        search_all_pairs: !args.own_pair_search,
-    };
+    let dopt = DescribeOptions::of_args(args, true);
     // The detected landmarks' path is a user's: `facematch::prepare` with the same cleaning,
     // its crop around the detected nose tip.
     let prep = facematch::MatchOptions {
@@ -209,7 +193,7 @@ fn settings(args: &Args) -> Result<(ScanSetOptions, DescribeOptions, facematch::
             detect_smoothing: args.detect_smooth,
             detect: scan_opts.detect.unwrap_or_default(),
         },
-        ..dopt.matching()
+        ..dopt.matching.clone()
     };
     Ok((scan_opts, dopt, prep))
 }
@@ -270,12 +254,7 @@ fn describe_and_score(
         .take(TIMED_FACES)
         .collect();
     let ms_desc = time_descriptions(&first, pipeline.method, pipeline.dopt)?;
-    let Scored {
-        metrics: main,
-        per_probe,
-        by_pair,
-        fallbacks,
-    } = score_group(&gallery, &locators, &probes, elastic, &ms_desc)?;
+    let scored = score_group(&gallery, &locators, &probes, elastic, &ms_desc)?;
     let mut fails = failures(&gallery, "gallery");
     fails.extend(failures(&probes, "probes"));
     // Sweeps.
@@ -295,12 +274,7 @@ fn describe_and_score(
         gallery,
         probes,
         sweep_faces,
-        scored: Scored {
-            metrics: main,
-            per_probe,
-            by_pair,
-            fallbacks,
-        },
+        scored,
         sweep_results,
         fails,
     })

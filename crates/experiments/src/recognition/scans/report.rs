@@ -1,13 +1,12 @@
 //! The report of a scan run: `report.md` with its tables and figures, the CSVs (results,
 //! probes, bipolar pairs, landmarks, sweeps, failures) and `summary.json`.
 
-use super::super::describe::SEARCH_DIRECTIONS;
 use super::super::metrics::{median, paired_table, results_table, roc_figure, write_summary};
 use super::face::Face;
 use super::score::Scored;
-use super::{p95, Results, Setup, PROBE_NOISE};
-use crate::report::{line_plot, Report, Series};
-use crate::scans::MAX_SNAP_MM;
+use super::{p95, Results, Setup};
+use crate::report::{Report, Series};
+use crate::scans::{MAX_SNAP_MM, PROBE_NOISE};
 use anyhow::Result;
 
 /// Writes the report, its CSVs and figures and `summary.json`; prints the fallbacks' counts, the
@@ -75,8 +74,8 @@ pub(super) fn write(s: &Setup<'_>, r: &Results, secs: f64) -> Result<()> {
         "scan_edge_mm": scan_opts.clean.target_edge_mm,
         "scan_smoothing_iterations": scan_opts.clean.smoothing_iterations,
         "detect_smoothing_iterations": scan_opts.detect_smoothing,
-        "boundary_margin_mm": dopt.boundary_margin,
-        "max_incidence_deg": dopt.max_incidence_deg,
+        "boundary_margin_mm": dopt.matching.boundary_margin_mm,
+        "max_incidence_deg": dopt.matching.max_incidence_deg,
         "sweeps": sweep_defs.iter().zip(sweep_results).map(|(sw, pv)| serde_json::json!({
             "name": sw.name,
             "unit": sw.unit,
@@ -107,6 +106,7 @@ fn intro(s: &Setup<'_>, r: &Results) -> String {
         ..
     } = *s;
     let (gallery, probes) = (&r.gallery, &r.probes);
+    let m = &dopt.matching;
     format!(
     "{identities} identities x {expressions} faces (seed {}). Gallery: {} neutral frontal scans ({}). Probes: {} scans of the other expressions, each under a random yaw of 0-45 degrees to either side and a noise of {} mm (other settings as the gallery). Scans by `rangescan` (orthographic), cleaned by `scanprep` (spikes, holes up to 10 mm, small components, crop of {} mm around the nose tip{}): for the ground-truth landmarks around the true nose tip; for the detected landmarks by `facematch::prepare`, as a user's scans are (cleaned, landmarks detected, cleaned again with the crop around the *detected* nose tip, detected again: no ground truth on that path, and ICP's detected rows use these scans too). Geodesics: {}. Bipolar descriptor: static area, N = {} levels between the outer eye corners, {}; single pole: {} sectors around the nose tip; ICP: about {} probe vertices onto the gallery surface from the 3-landmark alignment, 10 % trimmed, score = RMS closest-point distance (mm); facial curves: N level curves of the nose-tip field up to D, elastic distance ({} segments per curve, one start-point candidate, one alternation), root sum of squares; iso-curvature: {} levels per principal field (quantiles of the first gallery scan) in the geodesic disc of radius D around the nose tip, normalised RMS closest-point distance after an ICP started from the 3-landmark alignment. Times, single thread (one-thread pool after the parallel work): per comparison the mean over up to 24 probe x gallery pairs per group and landmark set; per description the median over the first 6 gallery scans (ground truth) of the fields a representation needs plus its build. Ground-truth landmarks: the model's landmark vertices carried through the scanner, at the nearest vertex of the cleaned scan (a landmark the scanner does not see is a failure); detected: `landmarks::detect_visible` on the scan `facematch::prepare` made, seen from the scanner (+z).",
     args.seed,
@@ -122,7 +122,7 @@ fn intro(s: &Setup<'_>, r: &Results) -> String {
         .unwrap_or_default(),
     method.name(),
     args.res.levels,
-    match (dopt.boundary_margin, dopt.max_incidence_deg) {
+    match (m.boundary_margin_mm, m.max_incidence_deg) {
         (None, None) => "every part of the scan".to_string(),
         (b, i) => format!(
             "leaving out {}",
@@ -132,22 +132,23 @@ fn intro(s: &Setup<'_>, r: &Results) -> String {
                 .collect::<Vec<_>>()
                 .join(" and ")
         ),
-    } + &dopt
-        .ref_search
-        .map(|r| format!(", each probe also described from its outer eye corners moved by {r} mm in {SEARCH_DIRECTIONS} directions (`bipolar::reference_candidates`), its score the least distance over these descriptors and its own"))
+    } + &m
+        .search
+        .map(|r| format!(", each probe also described from its outer eye corners moved by {} mm in {} directions (`bipolar::reference_candidates`), its score the least distance over these descriptors and its own", r.radius_mm, r.directions))
         .unwrap_or_default()
-        + &dopt
-            .view_match
-            .map(|a| format!("; view matching: where a probe's scanner direction, carried into a gallery scan's frame by the 3-landmark alignment, is more than {a} degrees from the gallery's own, the probe is compared with the gallery face's template view nearest that direction (`facematch::views_of`, described once per gallery face: the faces a scanner turned by {:?} degrees to either side would measure, `rangescan::visible_faces`, incidence up to {} degrees; landmarks whose faces are all gone moved to the nearest vertex left, within {MAX_SNAP_MM} mm)", facematch::ViewOptions::default().yaws_deg, facematch::ViewOptions::default().incidence_deg))
+        + &m
+            .view
+            .as_ref()
+            .map(|v| format!("; view matching: where a probe's scanner direction, carried into a gallery scan's frame by the 3-landmark alignment, is more than {} degrees from the gallery's own, the probe is compared with the gallery face's template view nearest that direction (`facematch::views_of`, described once per gallery face: the faces a scanner turned by {:?} degrees to either side would measure, `rangescan::visible_faces`, incidence up to {} degrees; landmarks whose faces are all gone moved to the nearest vertex left, within {MAX_SNAP_MM} mm)", v.min_angle_deg, v.yaws_deg, v.incidence_deg))
             .unwrap_or_default()
-        + &dopt
+        + &m
             .side_pair_deg
-            .map(|a| format!("; side pairs: every face is also described by each outer eye corner with the nose tip (their lens above the nose tip's horizontal plane); a probe turned by more than {a} degrees (its eye line against its scanner), or with an outer eye corner off the scan, takes its nearer (or remaining) corner's side pair as its own pair, which the reference-point search moves; {}", if dopt.least_pair {
-                format!("its score is the least distance over the three pairs (outer eye corners, right corner and nose tip, left corner and nose tip){}, each view-matched{}", if dopt.second_weight > 0.0 {
-                    format!(" blended with the second least ({} x least + {} x second least)", 1.0 - dopt.second_weight, dopt.second_weight)
+            .map(|a| format!("; side pairs: every face is also described by each outer eye corner with the nose tip (their lens above the nose tip's horizontal plane); a probe turned by more than {a} degrees (its eye line against its scanner), or with an outer eye corner off the scan, takes its nearer (or remaining) corner's side pair as its own pair, which the reference-point search moves; {}", if m.least_pair {
+                format!("its score is the least distance over the three pairs (outer eye corners, right corner and nose tip, left corner and nose tip){}, each view-matched{}", if m.second_weight > 0.0 {
+                    format!(" blended with the second least ({} x least + {} x second least)", 1.0 - m.second_weight, m.second_weight)
                 } else {
                     String::new()
-                }, if dopt.search_all_pairs && dopt.ref_search.is_some() {
+                }, if m.search.is_some_and(|s| s.all_pairs) {
                     ", and the reference-point search moves the poles of all three pairs (a nose tip's first direction toward the corners' midpoint)"
                 } else {
                     ""
@@ -340,20 +341,14 @@ fn sweeps_section(rep: &mut Report, s: &Setup<'_>, r: &Results) -> Result<()> {
                 r
             })
             .collect();
-        let hdr_ref: Vec<&str> = hdr.iter().map(String::as_str).collect();
-        rep.table(&hdr_ref, &rows);
-        let file = format!("sweep-{}.svg", sw.name);
-        line_plot(
-            &rep.path(&file),
-            &format!("Rank-1 against {}", sw.name),
-            &format!("{} ({})", sw.name, sw.unit),
-            "rank-1",
+        rep.table(&hdr, &rows);
+        let title = format!("Rank-1 against {}", sw.name);
+        rep.plot(
+            &format!("sweep-{}.svg", sw.name),
+            (&title, &format!("{} ({})", sw.name, sw.unit), "rank-1"),
             &series,
+            &format!("{title}; dashed: detected landmarks"),
         )?;
-        rep.figure(
-            &file,
-            &format!("Rank-1 against {}; dashed: detected landmarks", sw.name),
-        );
         rep.table(
             &[
                 "method (landmarks)",
@@ -368,7 +363,6 @@ fn sweeps_section(rep: &mut Report, s: &Setup<'_>, r: &Results) -> Result<()> {
         main.iter()
             .map(|m| format!("{} ({})", m.descriptor, m.landmarks)),
     );
-    let hdr_ref: Vec<&str> = hdr.iter().map(String::as_str).collect();
-    rep.csv("sweeps.csv", &hdr_ref, &csv_rows)?;
+    rep.csv("sweeps.csv", &hdr, &csv_rows)?;
     Ok(())
 }

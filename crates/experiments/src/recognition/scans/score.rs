@@ -1,7 +1,7 @@
 //! The scores of a probe group against the gallery: its figures, each probe's rank and every
 //! failure.
 
-use super::super::compare::{score_row, time_comparisons, timed_pairs, PairDistances, Row};
+use super::super::compare::score_set;
 use super::super::describe::Described;
 use super::super::metrics::{summarize, Metrics, SCORES};
 use super::face::Face;
@@ -9,7 +9,6 @@ use super::SETS;
 use anyhow::Result;
 use facecurves::ElasticOptions;
 use meshcore::{DVec3, FaceLocator};
-use rayon::prelude::*;
 
 /// Figures of a probe group against the gallery, per landmark set and score, with the times
 /// per comparison (timed on pairs of this group) and per description (`ms_desc`).
@@ -32,15 +31,12 @@ pub(super) fn score_group(
             .zip(locators)
             .map(|(g, l)| g.desc[k].as_ref().ok().zip(l[k].as_ref()))
             .collect();
-        let (rows, pairs): (Vec<Row>, Vec<Vec<PairDistances>>) = probes
-            .par_iter()
-            .map(|p| score_row(p.desc[k].as_ref().ok(), &p.pts[k], &gal, elastic))
-            .unzip();
         let pr: Vec<(Option<&Described>, &[DVec3])> = probes
             .iter()
             .map(|p| (p.desc[k].as_ref().ok(), p.pts[k].as_slice()))
             .collect();
-        let ms_cmp = time_comparisons(&timed_pairs(&pr, &gal), elastic)?;
+        let hidden = indicatif::ProgressBar::hidden();
+        let (rows, pairs, ms_cmp) = score_set(&pr, &gal, elastic, &hidden)?;
         all.extend(summarize(&rows, &ms_cmp, ms_desc, &pid, &gid, set));
         for (p, row) in probes.iter().zip(&rows) {
             for (j, score) in SCORES.iter().enumerate() {
@@ -104,8 +100,8 @@ pub(super) struct Scored {
 }
 
 /// One line of `probes.csv`: where the probe's own identity ranks among the gallery for one
-/// score (1 = identified; empty when its genuine score failed), its genuine score, and the
-/// best impostor with its score.
+/// score ([`facematch::metrics::genuine_rank`]; empty when its genuine score failed), its
+/// genuine score, and the best impostor with its score.
 fn probe_rank(
     name: &str,
     identity: usize,
@@ -114,24 +110,7 @@ fn probe_rank(
     row: &[f64],
     gallery_id: &[usize],
 ) -> Vec<String> {
-    let genuine = row
-        .iter()
-        .zip(gallery_id)
-        .filter(|(_, &g)| g == identity)
-        .map(|(v, _)| *v)
-        .fold(f64::NAN, f64::min);
-    let impostor = row
-        .iter()
-        .zip(gallery_id)
-        .filter(|(v, &g)| g != identity && v.is_finite())
-        .min_by(|a, b| a.0.total_cmp(b.0).then(a.1.cmp(b.1)));
-    let rank = genuine.is_finite().then(|| {
-        1 + row
-            .iter()
-            .zip(gallery_id)
-            .filter(|(v, &g)| g != identity && v.is_finite() && **v < genuine)
-            .count()
-    });
+    let r = facematch::metrics::genuine_rank(row, gallery_id, identity);
     let num = |v: f64| {
         if v.is_finite() {
             format!("{v:.6}")
@@ -144,10 +123,12 @@ fn probe_rank(
         identity.to_string(),
         set.to_string(),
         score.to_string(),
-        rank.map(|r| r.to_string()).unwrap_or_default(),
-        num(genuine),
-        impostor.map(|(_, g)| g.to_string()).unwrap_or_default(),
-        impostor.map(|(v, _)| num(*v)).unwrap_or_default(),
+        r.rank.map(|r| r.to_string()).unwrap_or_default(),
+        num(r.genuine),
+        r.best_impostor
+            .map(|(g, _)| g.to_string())
+            .unwrap_or_default(),
+        r.best_impostor.map(|(_, v)| num(v)).unwrap_or_default(),
     ]
 }
 

@@ -2,12 +2,9 @@
 //! scan seed, and the sweeps themselves.
 
 use super::super::Args;
-use super::PROBE_NOISE;
-use crate::scans::{sample_weights, scan_seed, FaceSpec, ScanSettings};
+use crate::scans::{FaceSpec, ScanSettings, SpecMaker};
 use anyhow::{bail, Result};
 use facemodel::FaceModel;
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 
 /// A sweep: a name, the values, and how a value changes the gallery's settings.
 pub(super) struct Sweep {
@@ -71,48 +68,21 @@ impl Specs {
         sweep_defs: &[Sweep],
         sweep_ids: usize,
     ) -> Result<Specs> {
-        let weights = sample_weights(model, identities, expressions, args.seed);
-        let mut rng = ChaCha8Rng::seed_from_u64(scan_seed(args.seed, u64::MAX));
-        let mut n_spec = 0u64;
-        let mut spec = |identity: usize, expression: usize, settings: ScanSettings, tag: &str| {
-            n_spec += 1;
-            FaceSpec {
-                name: format!("id{identity:02}-e{expression}{tag}"),
-                identity,
-                identity_weights: weights[identity].0.clone(),
-                expression_weights: weights[identity].1[expression].clone(),
-                settings,
-                seed: scan_seed(args.seed, n_spec),
+        let mut maker = SpecMaker::new(model, identities, expressions, args.seed);
+        let (gallery_specs, probe_specs) = maker.gallery_and_probes(base);
+        let mut sweep_specs: Vec<Vec<Vec<FaceSpec>>> = Vec::new();
+        for sw in sweep_defs {
+            let mut per_value = Vec::new();
+            for &v in &sw.values {
+                let tag = format!("-{}{v}", sw.name);
+                per_value.push(
+                    (0..sweep_ids)
+                        .map(|i| maker.spec(i, 1, (sw.apply)(base, v), &tag))
+                        .collect(),
+                );
             }
-        };
-        let gallery_specs: Vec<FaceSpec> = (0..identities).map(|i| spec(i, 0, base, "")).collect();
-        let mut probe_specs = Vec::new();
-        for i in 0..identities {
-            for e in 1..expressions {
-                let yaw =
-                    rng.random_range(0..=45) as f64 * if rng.random::<bool>() { 1.0 } else { -1.0 };
-                let noise = PROBE_NOISE[rng.random_range(0..PROBE_NOISE.len())];
-                let st = ScanSettings {
-                    yaw_deg: yaw,
-                    noise_mm: noise,
-                    ..base
-                };
-                probe_specs.push(spec(i, e, st, &format!("-yaw{yaw}-noise{noise}")));
-            }
+            sweep_specs.push(per_value);
         }
-        let sweep_specs: Vec<Vec<Vec<FaceSpec>>> = sweep_defs
-            .iter()
-            .map(|sw| {
-                sw.values
-                    .iter()
-                    .map(|&v| {
-                        (0..sweep_ids)
-                            .map(|i| spec(i, 1, (sw.apply)(base, v), &format!("-{}{v}", sw.name)))
-                            .collect()
-                    })
-                    .collect()
-            })
-            .collect();
         if let Some(&i) = args.only_identities.iter().find(|&&i| i >= identities) {
             bail!(
                 "--only-identities {i}: the run has identities 0 to {}",
