@@ -66,7 +66,7 @@ pub struct DetectOptions {
     /// and a weak landmark whose template finds less than [`GRADED_COVERAGE`] of its surface
     /// (beside a hole or the edge of a scan) is not: it is unseen in [`detect_visible`] and
     /// refuses the fit in [`detect_with`] (it would be returned on the hole's rim). Equal to
-    /// `min_local_agreement`: nothing is graded (the gate of before issue 31).
+    /// `min_local_agreement`: nothing is graded (the former default, 0.85).
     pub refuse_local_agreement: f64,
     /// Fits costing more than this multiple of the best fit's cost (the best among those that
     /// pass [`DetectOptions::min_confidence`] and [`DetectOptions::min_symmetry`]) are tried

@@ -1,4 +1,4 @@
-//! Faces outside the ICT model's span (issue 31), one test per kind of `landmarks-eval
+//! Faces outside the ICT model's span, one test per kind of `landmarks-eval
 //! --beyond`, made from the shared paper set by the library generators: an expression past full
 //! strength, a smooth non-rigid warp (`facemodel::random_warp`), another topology
 //! (`scanprep::remesh`), a depth-camera-class scan with flying pixels
