@@ -227,8 +227,8 @@ pub struct Description {
     pub scanner: DVec3,
 }
 
-/// [`describe_with_fields`] after solving the fields ([`face_fields`]) with a new solver of
-/// `options.method`.
+/// [`describe_with_fields`] after solving the fields ([`crate::description_fields`]) with a new
+/// solver of `options.method`.
 pub fn describe(
     mesh: &TriMesh,
     poles: Poles,
@@ -237,7 +237,7 @@ pub fn describe(
     search: bool,
 ) -> Result<Description, crate::MatchError> {
     let solver = geodesic::new_solver(mesh, options.method)?;
-    let f = face_fields(mesh, solver.as_ref(), poles, options.field_cutoff)
+    let f = crate::description_fields(mesh, solver.as_ref(), poles, options, search)
         .map_err(crate::MatchError::Describe)?;
     let surface = Surface::new(mesh.clone());
     describe_with_fields(

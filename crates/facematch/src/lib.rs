@@ -28,6 +28,7 @@
 mod compare;
 mod describe;
 mod error;
+mod fields;
 pub mod fixture;
 mod gallery;
 mod keyed;
@@ -43,6 +44,7 @@ pub use describe::{
     describe, describe_with_fields, face_fields, kept_vertices, Description, FaceFields,
 };
 pub use error::MatchError;
+pub use fields::description_fields;
 pub use gallery::{rank, Gallery, Ranked};
 pub use keyed::KeyedSet;
 pub use options::{

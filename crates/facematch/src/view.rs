@@ -1,7 +1,7 @@
 //! View matching: the part of a face a scanner from another direction would measure, and the
 //! descriptions of a template's turned views.
 
-use crate::{describe_with_fields, face_fields, KeyedSet, MatchOptions, Poles, ViewOptions};
+use crate::{describe_with_fields, description_fields, KeyedSet, MatchOptions, Poles, ViewOptions};
 use meshcore::{DQuat, DVec3, Surface, TriMesh};
 
 /// The vertices of `mesh` seen within `max_incidence_deg` from its own scanner (`scanner`)
@@ -106,7 +106,7 @@ pub fn describe_view(
         .carried(mesh, &cut, &map, options.snap_mm)
         .ok_or("a landmark is not on the view")?;
     let solver = geodesic::new_solver(&cut, options.method).map_err(|e| e.to_string())?;
-    let f = face_fields(&cut, solver.as_ref(), lm, options.field_cutoff)?;
+    let f = description_fields(&cut, solver.as_ref(), lm, options, false)?;
     let surface = Surface::new(cut);
     let d = describe_with_fields(
         &surface,
