@@ -5,11 +5,10 @@
 use super::base::Base;
 use super::stats::{max, mean, min};
 use super::{eye_mid, Ctx, FacePrep, MethodResults, RESOLUTIONS};
-use crate::pipeline::{bar, error_grid, field, perturb, Refs, Region};
+use crate::pipeline::{bar, error_grid, Refs, Region};
 use crate::polar::{polar_descriptor, Pole};
 use anyhow::Result;
 use bipolar::PolarDescriptor;
-use geodesic::Source;
 use rayon::prelude::*;
 
 /// One perturbation cell: moved-corner references, moved-pole polar descriptor, and whether
@@ -23,23 +22,16 @@ struct Cell {
 
 /// Moves q and the nose tip of the test face for every (radius, direction) cell.
 fn perturbed(ctx: &Ctx<'_>, prep: &[FacePrep], cells: &[(f64, f64)]) -> Result<Vec<Cell>> {
-    let test = ctx.test;
-    let tf = &ctx.faces[test];
-    let tr = &prep[test].refs;
-    let tsolver = prep[test].solver.as_ref();
+    let (test, tr) = (ctx.test, &prep[ctx.test].refs);
     let pb = bar(cells.len(), &format!("{}: perturbation grid", ctx.mname()));
     let grid = cells
         .par_iter()
-        .map(|&(pct, theta)| -> Result<_> {
-            let radius = pct / 100.0 * tr.d;
-            let lm = tf.landmarks;
+        .map(|&cell| -> Result<_> {
             let w = &ctx.walkers[test];
-            let (sp, cut_q) = perturb(w, lm.left_eye_outer, tr.r, radius, theta)?;
-            let refs = prep[test].with_q_moved(tf, sp)?;
-            let (spn, cut_nose) = perturb(w, lm.nose_tip, eye_mid(tr), radius, theta)?;
-            let un = field(tsolver, Source::Point(spn))?;
-            let polar =
-                polar_descriptor(w, &un, Pole::Point(spn), eye_mid(tr), &ctx.polar_opts(tr))?;
+            let (refs, (sn, un), (cut_q, cut_nose)) =
+                prep[test].moved_cell(&ctx.faces[test], w, cell)?;
+            let pole = Pole::Point(sn);
+            let polar = polar_descriptor(w, &un, pole, eye_mid(tr), &ctx.polar_opts(tr))?;
             pb.inc(1);
             Ok(Cell {
                 refs,

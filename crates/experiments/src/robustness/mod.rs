@@ -18,7 +18,7 @@ pub(crate) mod stats;
 
 use crate::paths::FaceSetArgs;
 use crate::pipeline::{
-    bipolar, dist, field, field_at, resolve_methods, DescriptorRule, Refs, Region,
+    bipolar, dist, field, field_at, perturb, resolve_methods, DescriptorRule, Refs, Region,
 };
 use crate::polar::PolarOptions;
 use crate::report::Failures;
@@ -98,6 +98,11 @@ pub(crate) struct FacePrep {
     pub(crate) un: Vec<f64>,
 }
 
+/// One cell of the reference-point error grid on a face ([`FacePrep::moved_cell`]): the
+/// references with q moved, the moved nose tip with its field, and whether the walk of q and of
+/// the nose tip met the boundary before the full radius.
+pub(crate) type MovedCell = (Refs, (SurfacePoint, Vec<f64>), (bool, bool));
+
 impl FacePrep {
     /// The solver of `method` on the face and its references from the landmark vertices.
     pub(crate) fn new(face: &Face, method: Method) -> Result<Self> {
@@ -124,6 +129,23 @@ impl FacePrep {
             nose,
             frame,
         })
+    }
+
+    /// The grid cell `(pct, theta)`: q ([`FacePrep::with_q_moved`]) and the nose tip each
+    /// moved along a straightest geodesic (`walker`, on `face`) of `pct` % of D, leaving at
+    /// `theta` from the direction towards r (q) or towards the corners' midpoint (nose tip).
+    pub(crate) fn moved_cell(
+        &self,
+        face: &Face,
+        walker: &Walker<'_>,
+        (pct, theta): (f64, f64),
+    ) -> Result<MovedCell> {
+        let (lm, radius) = (face.landmarks, pct / 100.0 * self.refs.d);
+        let (sq, cut_q) = perturb(walker, lm.left_eye_outer, self.refs.r, radius, theta)?;
+        let refs = self.with_q_moved(face, sq)?;
+        let (sn, cut_n) = perturb(walker, lm.nose_tip, eye_mid(&self.refs), radius, theta)?;
+        let un = field(self.solver.as_ref(), Source::Point(sn))?;
+        Ok((refs, (sn, un), (cut_q, cut_n)))
     }
 }
 
@@ -231,7 +253,7 @@ impl Ctx<'_> {
 }
 
 /// Midpoint of the two outer eye corners (angular origin of the single pole).
-fn eye_mid(r: &Refs) -> DVec3 {
+pub(crate) fn eye_mid(r: &Refs) -> DVec3 {
     0.5 * (r.r + r.q)
 }
 

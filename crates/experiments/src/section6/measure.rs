@@ -3,14 +3,13 @@
 
 use super::describe::{noisy, Ctx, Descs};
 use super::figure15::{figure15, Fig15};
-use crate::pipeline::{bar, dist, error_grid, field, perturb, single_thread};
+use crate::pipeline::{bar, dist, error_grid, single_thread};
 use crate::polar::Pole;
 use crate::robustness::stats::Sep;
 use crate::robustness::FacePrep;
 use crate::walk::Walker;
 use anyhow::{Context, Result};
 use facemodel::Face;
-use geodesic::Source;
 use rayon::prelude::*;
 use std::time::Duration;
 
@@ -131,16 +130,10 @@ fn grid_cell(s: &Set<'_>, pct: f64, theta: f64) -> Result<[f64; 4]> {
         &s.walkers[s.test],
         s.ctx,
     );
-    let lm = tf.landmarks;
-    let eye_mid = 0.5 * (tp.refs.r + tp.refs.q);
-    let radius = pct / 100.0 * tp.refs.d;
     let name = format!("{} moved {pct} % at {:.0} deg", tf.name, theta.to_degrees());
-    // Left outer eye corner moved: the bipolar descriptor.
-    let (sq, cut_q) = perturb(w, lm.left_eye_outer, tp.refs.r, radius, theta)?;
-    let refs = tp.with_q_moved(tf, sq)?;
-    // Nose tip moved: the other three (same D, the corners are not moved).
-    let (sn, cut_n) = perturb(w, lm.nose_tip, eye_mid, radius, theta)?;
-    let un = field(tp.solver.as_ref(), Source::Point(sn))?;
+    // Left outer eye corner moved: the bipolar descriptor; nose tip moved: the other three
+    // (same D, the corners are not moved).
+    let (refs, (sn, un), (cut_q, cut_n)) = tp.moved_cell(tf, w, (pct, theta))?;
     let moved_q = ctx.bipolar(&tf.mesh, &refs, &name);
     let moved_n = ctx.nose_descs((&tf.mesh, w), &tp.refs, &un, Pole::Point(sn), &name);
     let base = &s.base[s.test];
