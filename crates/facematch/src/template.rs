@@ -62,11 +62,15 @@ impl Template {
         search: bool,
     ) -> Result<Self, MatchError> {
         let poles = scan.poles(options)?;
-        let description = crate::describe(&scan.mesh, poles, scan.scanner, options, search)?;
-        let views = match &options.view {
-            Some(v) => views_of(&scan.mesh, poles, scan.scanner, options, v),
-            None => Vec::new(),
-        };
+        // The description and the views are independent: both cores stay busy.
+        let (description, views) = rayon::join(
+            || crate::describe(&scan.mesh, poles, scan.scanner, options, search),
+            || match &options.view {
+                Some(v) => views_of(&scan.mesh, poles, scan.scanner, options, v),
+                None => Vec::new(),
+            },
+        );
+        let description = description?;
         Ok(Self {
             identity: identity.to_string(),
             source: source.to_string(),
