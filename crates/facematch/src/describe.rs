@@ -3,7 +3,7 @@
 
 use crate::{KeyedSet, MatchOptions, Pair, Poles};
 use facemodel::{face_frame, static_mask, FaceFrame};
-use geodesic::{GeodesicSolver, SolveOptions, Source};
+use geodesic::{GeodesicSolver, SolveOptions};
 use meshcore::{DVec3, Surface, TriMesh};
 
 /// The geodesic fields of a face's landmarks, cut off at `MatchOptions::field_cutoff` times the
@@ -47,59 +47,6 @@ impl FaceFields {
             Pair::LeftNose => (&self.uq, &self.un),
         }
     }
-}
-
-/// The fields of the landmarks `poles` on `mesh` by `solver` (of `mesh`), cut off at `cutoff`
-/// times the corners' straight distance, solved in parallel.
-pub fn face_fields(
-    mesh: &TriMesh,
-    solver: &dyn GeodesicSolver,
-    poles: Poles,
-    cutoff: f64,
-) -> Result<FaceFields, String> {
-    if poles.lost.is_none() && poles.r == poles.q {
-        return Err(format!(
-            "the two outer eye corners are the same vertex {}",
-            poles.r
-        ));
-    }
-    let [pr, pq, _] = poles.positions(mesh);
-    let cut = SolveOptions {
-        max_distance: Some(cutoff * (pq - pr).length()),
-    };
-    let field = |v: u32, lost: bool| {
-        if lost {
-            return Ok((Vec::new(), 0.0));
-        }
-        let t = std::time::Instant::now();
-        solver
-            .distances(&[Source::Vertex(v)], &cut)
-            .map(|u| (u, t.elapsed().as_secs_f64()))
-            .map_err(|e| format!("geodesic field: {e}"))
-    };
-    let lost_right = poles.lost.map(|l| l.right);
-    // The three solves are independent: on two threads when rayon has them.
-    let ((r, q), n) = rayon::join(
-        || {
-            rayon::join(
-                || field(poles.r, lost_right == Some(true)),
-                || field(poles.q, lost_right == Some(false)),
-            )
-        },
-        || field(poles.nose, false),
-    );
-    let ((ur, tr), (uq, tq), (un, tn)) = (r?, q?, n?);
-    let d = match poles.lost {
-        Some(_) => f64::NAN,
-        None => 0.5 * (ur[poles.q as usize] + uq[poles.r as usize]),
-    };
-    Ok(FaceFields {
-        ur,
-        uq,
-        un,
-        d,
-        secs: [tr, tq, tn],
-    })
 }
 
 /// The reference configuration of one pair: its two fields, D, the poles' places, the nose tip
@@ -440,7 +387,7 @@ fn moved_descriptors(
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use geodesic::GeodesicSolver;
+    use geodesic::{GeodesicSolver, Source};
 
     /// A flat sheet of `nx` x `ny` squares of 2 mm, its landmarks at the grid points `at` (r, q,
     /// nose tip), its exact solver and the landmarks' fields.
@@ -456,7 +403,7 @@ pub(crate) mod tests {
         let [r, q, nose] = at.map(|(i, j)| j * (nx as u32 + 1) + i);
         let poles = Poles::new(r, q, nose);
         let solver = geodesic::new_solver(&m, geodesic::Method::Exact).unwrap();
-        let f = face_fields(&m, solver.as_ref(), poles, 1.4).unwrap();
+        let f = crate::face_fields(&m, solver.as_ref(), poles, 1.4).unwrap();
         (m, poles, solver, f)
     }
 
@@ -585,7 +532,7 @@ pub(crate) mod tests {
         // The left corner lost: its true place still sets the frame; only the right pair.
         let lost = left_lost(poles, &m);
         assert_eq!(lost.positions(&m), [r, q, nose]);
-        let f = face_fields(&m, solver.as_ref(), lost, 1.4).unwrap();
+        let f = crate::face_fields(&m, solver.as_ref(), lost, 1.4).unwrap();
         assert!(f.uq.is_empty() && f.scale(lost).is_err());
         assert!(pair_refs(&m, &f, lost, Pair::Corners, frame).is_err());
         assert!(pair_refs(&m, &f, lost, Pair::LeftNose, frame).is_err());

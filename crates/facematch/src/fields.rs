@@ -4,16 +4,39 @@ use crate::{FaceFields, MatchOptions, Poles};
 use geodesic::{GeodesicSolver, SolveOptions, Source};
 use meshcore::TriMesh;
 
+/// The fields of the landmarks `poles` on `mesh` by `solver` (of `mesh`), cut off at `cutoff`
+/// times the corners' straight distance, solved in parallel.
+pub fn face_fields(
+    mesh: &TriMesh,
+    solver: &dyn GeodesicSolver,
+    poles: Poles,
+    cutoff: f64,
+) -> Result<FaceFields, String> {
+    let cut = corners_cut(mesh, poles, cutoff)?;
+    let lost_right = poles.lost.map(|l| l.right);
+    // The three solves are independent: on two threads when rayon has them.
+    let ((r, q), n) = rayon::join(
+        || {
+            rayon::join(
+                || field(solver, poles.r, lost_right == Some(true), cut),
+                || field(solver, poles.q, lost_right == Some(false), cut),
+            )
+        },
+        || field(solver, poles.nose, false, cut),
+    );
+    Ok(assemble(poles, r?, q?, n?))
+}
+
 /// The fields [`crate::describe`] and the template views read: the outer eye corners' as
-/// [`crate::face_fields`] solves them (cut off at `options.field_cutoff` times the corners'
-/// straight distance), the nose tip's cut off just past what the side pairs read. A side pair's
+/// [`face_fields`] solves them (cut off at `options.field_cutoff` times the corners' straight
+/// distance), the nose tip's cut off just past what the side pairs read. A side pair's
 /// descriptor reads its fields up to its D (levels up to N at step D / N) plus an edge, and D is
 /// at most the farther corner's distance to the nose tip on the corners' fields; with `search`,
 /// a moved corner's pair reads up to four search radii farther. So every value a description
-/// reads is the one [`crate::face_fields`] gives (an exact solve gives the same value at a
-/// vertex within any cut-off beyond it), at about half the nose tip field's cost on a face
-/// scan. The corners are solved first (in parallel), then the nose tip; its cut-off is the
-/// corners' when neither corner's field reaches the nose tip.
+/// reads is the one [`face_fields`] gives (an exact solve gives the same value at a vertex
+/// within any cut-off beyond it), at about half the nose tip field's cost on a face scan. The
+/// corners are solved first (in parallel), then the nose tip; its cut-off is the corners' when
+/// neither corner's field reaches the nose tip.
 pub fn description_fields(
     mesh: &TriMesh,
     solver: &dyn GeodesicSolver,
@@ -21,6 +44,36 @@ pub fn description_fields(
     options: &MatchOptions,
     search: bool,
 ) -> Result<FaceFields, String> {
+    let cut = corners_cut(mesh, poles, options.field_cutoff)?;
+    let lost_right = poles.lost.map(|l| l.right);
+    let (r, q) = rayon::join(
+        || field(solver, poles.r, lost_right == Some(true), cut),
+        || field(solver, poles.q, lost_right == Some(false), cut),
+    );
+    let (r, q) = (r?, q?);
+    let reach = [&r.0, &q.0]
+        .iter()
+        .filter_map(|u| u.get(poles.nose as usize).copied())
+        .filter(|d| d.is_finite())
+        .reduce(f64::max);
+    let nose_cut = match reach {
+        None => cut,
+        Some(d) => {
+            let extra = match (search, &options.search) {
+                (true, Some(s)) => 4.0 * s.radius_mm,
+                _ => 0.0,
+            };
+            let c = d * (1.0 + 1e-6) + mesh.longest_edge() * (1.0 + 1e-9) + extra;
+            c.min(cut)
+        }
+    };
+    let n = field(solver, poles.nose, false, nose_cut)?;
+    Ok(assemble(poles, r, q, n))
+}
+
+/// The corners' cut-off: `cutoff` times their straight distance; an error when they are one
+/// vertex.
+fn corners_cut(mesh: &TriMesh, poles: Poles, cutoff: f64) -> Result<f64, String> {
     if poles.lost.is_none() && poles.r == poles.q {
         return Err(format!(
             "the two outer eye corners are the same vertex {}",
@@ -28,63 +81,56 @@ pub fn description_fields(
         ));
     }
     let [pr, pq, _] = poles.positions(mesh);
-    let corners_cut = options.field_cutoff * (pq - pr).length();
-    let field = |v: u32, lost: bool, cut: f64| {
-        if lost {
-            return Ok((Vec::new(), 0.0));
-        }
-        let t = std::time::Instant::now();
-        solver
-            .distances(
-                &[Source::Vertex(v)],
-                &SolveOptions {
-                    max_distance: Some(cut),
-                },
-            )
-            .map(|u| (u, t.elapsed().as_secs_f64()))
-            .map_err(|e| format!("geodesic field: {e}"))
-    };
-    let lost_right = poles.lost.map(|l| l.right);
-    let (r, q) = rayon::join(
-        || field(poles.r, lost_right == Some(true), corners_cut),
-        || field(poles.q, lost_right == Some(false), corners_cut),
-    );
-    let ((ur, tr), (uq, tq)) = (r?, q?);
-    let reach = [&ur, &uq]
-        .iter()
-        .filter_map(|u| u.get(poles.nose as usize).copied())
-        .filter(|d| d.is_finite())
-        .reduce(f64::max);
-    let nose_cut = match reach {
-        None => corners_cut,
-        Some(d) => {
-            let extra = match (search, &options.search) {
-                (true, Some(s)) => 4.0 * s.radius_mm,
-                _ => 0.0,
-            };
-            let cut = d * (1.0 + 1e-6) + mesh.longest_edge() * (1.0 + 1e-9) + extra;
-            cut.min(corners_cut)
-        }
-    };
-    let (un, tn) = field(poles.nose, false, nose_cut)?;
+    Ok(cutoff * (pq - pr).length())
+}
+
+/// The field from `v` cut off at `cut` with its solve's wall time (empty for a lost corner).
+fn field(
+    solver: &dyn GeodesicSolver,
+    v: u32,
+    lost: bool,
+    cut: f64,
+) -> Result<(Vec<f64>, f64), String> {
+    if lost {
+        return Ok((Vec::new(), 0.0));
+    }
+    let t = std::time::Instant::now();
+    solver
+        .distances(
+            &[Source::Vertex(v)],
+            &SolveOptions {
+                max_distance: Some(cut),
+            },
+        )
+        .map(|u| (u, t.elapsed().as_secs_f64()))
+        .map_err(|e| format!("geodesic field: {e}"))
+}
+
+/// The three fields with D (NaN with a lost corner) and their times.
+fn assemble(
+    poles: Poles,
+    (ur, tr): (Vec<f64>, f64),
+    (uq, tq): (Vec<f64>, f64),
+    (un, tn): (Vec<f64>, f64),
+) -> FaceFields {
     let d = match poles.lost {
         Some(_) => f64::NAN,
         None => 0.5 * (ur[poles.q as usize] + uq[poles.r as usize]),
     };
-    Ok(FaceFields {
+    FaceFields {
         ur,
         uq,
         un,
         d,
         secs: [tr, tq, tn],
-    })
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::describe::tests::{left_lost, plane_face};
-    use crate::{describe_with_fields, face_fields};
+    use crate::describe_with_fields;
     use meshcore::{DVec3, Surface};
 
     #[test]

@@ -40,11 +40,9 @@ mod template;
 mod view;
 
 pub use compare::{compare, pair_score, Comparison, PairUse, ViewUse};
-pub use describe::{
-    describe, describe_with_fields, face_fields, kept_vertices, Description, FaceFields,
-};
+pub use describe::{describe, describe_with_fields, kept_vertices, Description, FaceFields};
 pub use error::MatchError;
-pub use fields::description_fields;
+pub use fields::{description_fields, face_fields};
 pub use gallery::{rank, Gallery, Ranked};
 pub use keyed::KeyedSet;
 pub use options::{
