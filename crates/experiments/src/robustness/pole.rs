@@ -1,15 +1,15 @@
 //! Figure 15: rotating some polar rings of the test face individually keeps every per-ring
 //! distance ~0 while the global distance becomes large.
 
-use super::Args;
-use crate::pipeline::{dist, field};
+use super::{eye_mid, Args, FacePrep};
+use crate::pipeline::dist;
 use crate::polar::{polar_descriptor, PolarOptions, Pole};
 use crate::report::{markers, render_face};
 use crate::walk::Walker;
 use anyhow::Result;
 use bipolar::PolarDescriptor;
-use facemodel::{face_frame, Face, FaceFrame};
-use geodesic::{Method, Source};
+use facemodel::{Face, FaceFrame};
+use geodesic::Method;
 use meshcore::{DMat3, DQuat, DVec3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -32,33 +32,24 @@ pub(super) struct Figure15 {
     pub reference: f64,
 }
 
-/// The polar descriptor of face `i` (pole at the nose tip) and its frame.
+/// The polar descriptor of face `f` (pole at the nose tip, step D / `levels` with D the right
+/// corner's field at the left corner) and its frame.
 fn describe(
     f: &Face,
     method: Method,
     levels: u32,
     sectors: u32,
 ) -> Result<(PolarDescriptor, FaceFrame)> {
-    let lm = f.landmarks;
-    let s = geodesic::new_solver(&f.mesh, method)?;
-    let un = field(s.as_ref(), Source::Vertex(lm.nose_tip))?;
-    let ur = field(s.as_ref(), Source::Vertex(lm.right_eye_outer))?;
-    let d = ur[lm.left_eye_outer as usize];
-    let (r, q, nose) = (
-        f.mesh.position(lm.right_eye_outer),
-        f.mesh.position(lm.left_eye_outer),
-        f.mesh.position(lm.nose_tip),
-    );
-    let w = Walker::new(&f.mesh);
+    let p = FacePrep::new(f, method)?;
+    let d = p.refs.ur[f.landmarks.left_eye_outer as usize];
     let opts = PolarOptions {
         step: d / f64::from(levels),
         levels,
         sectors,
     };
-    Ok((
-        polar_descriptor(&w, &un, Pole::Vertex(lm.nose_tip), 0.5 * (r + q), &opts)?,
-        face_frame(&f.mesh, r, q, nose),
-    ))
+    let (w, pole) = (Walker::new(&f.mesh), Pole::Vertex(f.landmarks.nose_tip));
+    let polar = polar_descriptor(&w, &p.un, pole, eye_mid(&p.refs), &opts)?;
+    Ok((polar, p.refs.frame))
 }
 
 /// `s` with rings [`ROTATED`] each rotated about its centroid by a seeded random rotation.
