@@ -59,14 +59,14 @@ pub struct DetectOptions {
     /// [`DetectOptions::min_local_agreement`] the landmarks are returned graded: their
     /// confidences are low and [`crate::VisibleLandmarks::weak_evidence`] names the landmark;
     /// among the fits comparable to the best ([`DetectOptions::comparable_fit_cost`]) one
-    /// whose every landmark agrees is preferred. The default 0.75 returns graded the true faces
-    /// the 0.85 gate refused in `landmarks-eval --beyond` on its tuning seeds 1 and 2 (agreements 0.82-0.85: strong
-    /// expressions, warps, another topology). Only a strong fit
-    /// ([`DetectOptions::strong_confidence`], [`DetectOptions::strong_symmetry`]) is graded,
+    /// whose every landmark agrees is preferred. Only a strong fit
+    /// ([`DetectOptions::strong_confidence`], [`DetectOptions::strong_symmetry`]) with every
+    /// landmark placed is graded (weak agreement and unseen landmarks together are refused),
     /// and a weak landmark whose template finds less than [`GRADED_COVERAGE`] of its surface
-    /// (beside a hole or the edge of a scan) is not: it is unseen in [`detect_visible`] and
-    /// refuses the fit in [`detect_with`] (it would be returned on the hole's rim). Equal to
-    /// `min_local_agreement`: nothing is graded (the former default, 0.85).
+    /// (beside a hole or the edge of a scan) refuses the fit (it would be returned on the
+    /// hole's rim). The default 0.75 was chosen on the tuning seeds of `landmarks-eval
+    /// --beyond` (true faces refused at 0.82-0.85). Equal to `min_local_agreement`, nothing is
+    /// graded (the former default, 0.85).
     pub refuse_local_agreement: f64,
     /// Fits costing more than this multiple of the best fit's cost (the best among those that
     /// pass [`DetectOptions::min_confidence`] and [`DetectOptions::min_symmetry`]) are tried
@@ -383,7 +383,8 @@ pub const RIM_AGREEMENT: f64 = 0.9;
 /// Least share of a weakly agreeing landmark's template (below
 /// [`DetectOptions::min_local_agreement`]) that must find the input surface for the landmark
 /// to be returned graded: a landmark beside a hole of 12 mm agrees weakly and its template
-/// finds the rim (`landmarks/tests/detect.rs`); on whole faces the share is near 1.
+/// finds the rim (`landmarks/tests/detect.rs`). An outer corner near the border of a mesh
+/// cut close around the eyes (the ICT face area) can find as little as 80 % and is refused.
 pub const GRADED_COVERAGE: f64 = 0.9;
 
 /// Least number of landmarks [`detect_visible`] must place (the nose tip among them).
@@ -663,9 +664,10 @@ fn detect_impl(
     // A partial detection takes the first fit that places every landmark, as `detect_with`
     // does, and only when there is none the first that places enough of them.
     // Then, when no fit's landmarks all agree with their templates, the first whose weakest
-    // agreement is at least `refuse_local_agreement`, graded (low confidences, a reason).
+    // agreement is at least `refuse_local_agreement`, graded (low confidences, a reason), with
+    // every landmark placed: weak agreement and unseen landmarks together are refused.
     let passes: &[(bool, bool)] = if partial {
-        &[(false, false), (true, false), (false, true), (true, true)]
+        &[(false, false), (true, false), (false, true)]
     } else {
         &[(false, false), (false, true)]
     };
@@ -735,8 +737,8 @@ fn detect_impl(
         // Graded: only one kind of evidence may be weak. The fit itself must be strong, and a
         // weakly agreeing landmark must find the surface expected around it (at least
         // [`GRADED_COVERAGE`] of its template): one beside a hole or the edge of a scan is most
-        // likely not on the surface (its template finds the rim). It is unseen in a partial
-        // detection and refuses the fit otherwise, never returned on the rim.
+        // likely not on the surface (its template finds the rim), and the fit is refused,
+        // never returning it on the rim.
         if graded
             && options.refuse_local_agreement < options.min_local_agreement
             && weakest(&agreement, &unseen) < options.min_local_agreement
@@ -763,11 +765,7 @@ fn detect_impl(
                 }
                 let c = coverage(&idx, &model.patches[k], &f.h.t, out[k].position, tau);
                 if c < GRADED_COVERAGE {
-                    if allow_unseen {
-                        unseen[k] = Some(Unseen::Bare { coverage: c });
-                    } else {
-                        bare = bare.or(Some((name, agreement[k], c)));
-                    }
+                    bare = bare.or(Some((name, agreement[k], c)));
                 }
             }
             if let Some((name, a, c)) = bare {
