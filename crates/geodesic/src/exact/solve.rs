@@ -106,6 +106,9 @@ pub(crate) struct Buffers {
     pool: Vec<Vec<Window>>,
     pending_emit: Vec<u32>,
     tc_buf: Vec<f64>,
+    /// The children of the list being processed, for its left and right target list (appended
+    /// to those lists in one step each).
+    kids: [Vec<Window>; 2],
 }
 
 impl Buffers {
@@ -142,6 +145,7 @@ impl Buffers {
         self.heap.clear();
         self.pending_emit.clear();
         self.tc_buf.clear();
+        self.kids.iter_mut().for_each(Vec::clear);
     }
 }
 
@@ -300,19 +304,32 @@ impl<'a> Solve<'a> {
         self.add_window(th, w, self.cur_origin);
     }
 
+    /// Gives `w` its record id (path-tracing mode: the record is written here).
     #[inline]
-    fn add_window(&mut self, h: u32, mut w: Window, origin: Origin) {
+    fn record(&mut self, h: u32, w: &mut Window, origin: Origin) {
         if let Some(rec) = self.records.as_mut() {
             w.id = rec.len() as u32;
-            rec.push(Record { h, w, origin });
+            rec.push(Record { h, w: *w, origin });
         }
+    }
+
+    #[inline]
+    fn add_window(&mut self, h: u32, mut w: Window, origin: Origin) {
+        self.record(h, &mut w, origin);
+        self.append(h, std::slice::from_ref(&w));
+    }
+
+    /// Appends `ws` (already recorded) to the list of `h` and queues the list if one of its
+    /// end vertices is inside (or while draining).
+    #[inline]
+    fn append(&mut self, h: u32, ws: &[Window]) {
         let list = &mut self.b.lists[h as usize];
         if list.capacity() == 0 {
             if let Some(v) = self.b.pool.pop() {
                 *list = v;
             }
         }
-        list.push(w);
+        list.extend_from_slice(ws);
         let f = &mut self.b.flags[h as usize];
         *f |= FILLED;
         if *f & QUEUED == 0 {
@@ -536,8 +553,11 @@ impl<'a> Solve<'a> {
             // Oracle mode: every ray goes to the side it actually exits through.
             p_star = f64::NAN;
         }
+        // The children are collected per target list and appended in one step each, the list
+        // that received the first child first (the order of single pushes).
         let tl_tw = g.twin[prev(h) as usize];
         let tr_tw = g.twin[next(h) as usize];
+        let mut right_first = None;
         for (i, w) in ws.iter().enumerate() {
             if w.is_dead() {
                 continue;
@@ -555,7 +575,26 @@ impl<'a> Solve<'a> {
                     self.emit_right(&geo, tr_tw, w, tr, w.b1, tr == tc);
                 }
             }
+            if right_first.is_none() {
+                let [l, r] = &self.b.kids;
+                if !(l.is_empty() && r.is_empty()) {
+                    right_first = Some(l.is_empty());
+                }
+            }
         }
+        let order = if right_first == Some(true) {
+            [(1, tr_tw), (0, tl_tw)]
+        } else {
+            [(0, tl_tw), (1, tr_tw)]
+        };
+        let mut kids = std::mem::take(&mut self.b.kids);
+        for (side, tw) in order {
+            if !kids[side].is_empty() {
+                self.append(tw & IDX, &kids[side]);
+                kids[side].clear();
+            }
+        }
+        self.b.kids = kids;
         self.b.tc_buf = tcs;
         self.recycle(ws);
     }
@@ -578,7 +617,7 @@ impl<'a> Solve<'a> {
         let x_of = |t: f64| -> f64 { edge_crossing(sx, sy, t * cs, -t * sn, ell) };
         let x0 = if t0 <= 0.0 { 0.0 } else { x_of(t0) };
         let x1 = if apex_end { ell } else { x_of(t1) };
-        self.push_child(tw, ell, w, sx, sy, x0, x1);
+        self.push_child(0, tw, ell, w, sx, sy, x0, x1);
     }
 
     /// Child on the right edge c -> b: frame origin c, x towards b.
@@ -595,12 +634,22 @@ impl<'a> Solve<'a> {
         };
         let x0 = if apex_end { 0.0 } else { x_of(t0) };
         let x1 = if t1 >= geo.l { ell } else { x_of(t1) };
-        self.push_child(tw, ell, w, sx, sy, x0, x1);
+        self.push_child(1, tw, ell, w, sx, sy, x0, x1);
     }
 
     #[allow(clippy::too_many_arguments)]
     #[inline]
-    fn push_child(&mut self, tw: u32, ell: f64, w: &Window, sx: f64, sy: f64, x0: f64, x1: f64) {
+    fn push_child(
+        &mut self,
+        side: usize,
+        tw: u32,
+        ell: f64,
+        w: &Window,
+        sx: f64,
+        sy: f64,
+        x0: f64,
+        x1: f64,
+    ) {
         let mut x0 = x0.clamp(0.0, ell);
         let x1 = x1.clamp(0.0, ell);
         if x0 > x1 {
@@ -612,7 +661,7 @@ impl<'a> Solve<'a> {
         } else {
             (x0, x1, sx)
         };
-        let child = Window {
+        let mut child = Window {
             b0,
             b1,
             sigma: w.sigma,
@@ -624,8 +673,8 @@ impl<'a> Solve<'a> {
             return;
         }
         self.propagations += 1;
-        let origin = Origin::Window(w.id);
-        self.add_window(tw & IDX, child, origin);
+        self.record(tw & IDX, &mut child, Origin::Window(w.id));
+        self.b.kids[side].push(child);
     }
 }
 

@@ -101,20 +101,30 @@ pub(crate) enum Trim {
     Both,
 }
 
+/// True when the sigmas of the two windows count as equal: they differ by at most `1e-14`
+/// times the larger [`Window::scale`]. Equal sigmas (every window of one source without
+/// pseudo-sources) need no scale.
+#[inline]
+fn equal_sigmas(w1: &Window, w2: &Window) -> bool {
+    let ad = (w2.sigma - w1.sigma).abs();
+    ad == 0.0
+        || (ad <= 1e-14 * w1.scale_bound().max(w2.scale_bound())
+            && ad <= 1e-14 * w1.scale().max(w2.scale()))
+}
+
+/// `|S1|^2 - |S2|^2` written to avoid cancellation, with `u = sx1 - sx2`.
+#[inline]
+fn source_norm_gap(w1: &Window, w2: &Window, u: f64) -> f64 {
+    u * (w1.sx + w2.sx) + (w1.sy - w2.sy) * (w1.sy + w2.sy)
+}
+
 /// Real roots of `D1(x) = D2(x)` (a superset: squaring may add spurious ones), written into
-/// `out`; returns how many. The sigmas count as equal (perpendicular bisector) when they
-/// differ by at most `1e-14` times the larger [`Window::scale`].
+/// `out`; returns how many. With [`equal_sigmas`] the root is the perpendicular bisector's.
 fn equal_distance_roots(w1: &Window, w2: &Window, out: &mut [f64; 2]) -> usize {
     let delta = w2.sigma - w1.sigma;
     let u = w1.sx - w2.sx;
-    // |S1|^2 - |S2|^2 written to avoid cancellation.
-    let k = u * (w1.sx + w2.sx) + (w1.sy - w2.sy) * (w1.sy + w2.sy);
-    let ad = delta.abs();
-    // Equal sigmas (every window of one source without pseudo-sources) need no scale.
-    if ad == 0.0
-        || (ad <= 1e-14 * w1.scale_bound().max(w2.scale_bound())
-            && ad <= 1e-14 * w1.scale().max(w2.scale()))
-    {
+    let k = source_norm_gap(w1, w2, u);
+    if equal_sigmas(w1, w2) {
         // Perpendicular bisector of the two sources.
         if u != 0.0 {
             out[0] = k / (2.0 * u);
@@ -205,8 +215,45 @@ pub(crate) fn pair_trim(w1: &mut Window, w2: &mut Window, bs: &mut BoundStats) -
 }
 
 /// The exact path of [`pair_trim`] on the overlap `[l, r]` (`l < r`): equal-distance roots,
-/// a midpoint test per segment, then the ends are moved past the lost segments.
+/// a midpoint test per segment, then the ends are moved past the lost segments. Equal sigmas
+/// take [`bisector_trim`] (the same operations unrolled for at most one root).
+#[inline]
 fn exact_trim(w1: &mut Window, w2: &mut Window, l: f64, r: f64) -> Trim {
+    if equal_sigmas(w1, w2) {
+        bisector_trim(w1, w2, l, r)
+    } else {
+        general_trim(w1, w2, l, r)
+    }
+}
+
+/// The midpoint test of [`general_trim`] at `m`: (`w1` loses, `w2` loses).
+#[inline]
+fn lose_at(w1: &Window, w2: &Window, m: f64) -> (bool, bool) {
+    let d1 = w1.dist(m);
+    let d2 = w2.dist(m);
+    let tol = TAU * d1.max(d2);
+    (d1 > d2 + tol, d2 > d1 + tol)
+}
+
+/// [`general_trim`] for [`equal_sigmas`]: the only breakpoint is the bisector's root `x` (the
+/// same floating-point operations, so the same result, without solving a quadratic).
+#[inline]
+fn bisector_trim(w1: &mut Window, w2: &mut Window, l: f64, r: f64) -> Trim {
+    let u = w1.sx - w2.sx;
+    let x = if u != 0.0 {
+        source_norm_gap(w1, w2, u) / (2.0 * u)
+    } else {
+        f64::NAN
+    };
+    if x > l && x < r {
+        trim_segments(w1, w2, [l, x, r])
+    } else {
+        trim_segments(w1, w2, [l, r])
+    }
+}
+
+/// The exact path for any sigmas: roots, midpoint tests per segment, ends moved.
+fn general_trim(w1: &mut Window, w2: &mut Window, l: f64, r: f64) -> Trim {
     let mut roots = [0.0; 2];
     let nr = equal_distance_roots(w1, w2, &mut roots);
     // Breakpoints l < p1 < p2 < r.
@@ -222,20 +269,27 @@ fn exact_trim(w1: &mut Window, w2: &mut Window, l: f64, r: f64) -> Trim {
             np += 1;
         }
     }
-    pts[np] = r;
-    let nseg = np; // segments pts[i]..pts[i+1], i < nseg
-    let mut lose1 = [false; 3];
-    let mut lose2 = [false; 3];
-    for i in 0..nseg {
-        let m = 0.5 * (pts[i] + pts[i + 1]);
-        let d1 = w1.dist(m);
-        let d2 = w2.dist(m);
-        let tol = TAU * d1.max(d2);
-        lose1[i] = d1 > d2 + tol;
-        lose2[i] = d2 > d1 + tol;
+    match np {
+        1 => trim_segments(w1, w2, [l, r]),
+        2 => trim_segments(w1, w2, [l, pts[1], r]),
+        _ => trim_segments(w1, w2, [l, pts[1], pts[2], r]),
     }
-    let all1 = lose1[..nseg].iter().all(|&b| b);
-    let all2 = lose2[..nseg].iter().all(|&b| b);
+}
+
+/// The end of the exact path on the segments between the breakpoints `pts` (`P - 1 <= 3`
+/// segments, the overlap `[pts[0], pts[P - 1]]`): a midpoint test per segment; a window that
+/// lies inside the overlap and loses every segment dies, otherwise its ends move past the
+/// lost segments. A fixed `P` lets the loops unroll.
+#[inline(always)]
+fn trim_segments<const P: usize>(w1: &mut Window, w2: &mut Window, pts: [f64; P]) -> Trim {
+    let (l, r) = (pts[0], pts[P - 1]);
+    let mut lose1 = [false; P];
+    let mut lose2 = [false; P];
+    for i in 0..P - 1 {
+        (lose1[i], lose2[i]) = lose_at(w1, w2, 0.5 * (pts[i] + pts[i + 1]));
+    }
+    let all1 = lose1[..P - 1].iter().all(|&b| b);
+    let all2 = lose2[..P - 1].iter().all(|&b| b);
     if all1 && w1.b0 >= l && w1.b1 <= r {
         w1.kill();
         return Trim::FirstDead;
@@ -244,8 +298,8 @@ fn exact_trim(w1: &mut Window, w2: &mut Window, l: f64, r: f64) -> Trim {
         w2.kill();
         return Trim::SecondDead;
     }
-    trim_ends(w1, &pts, nseg, &lose1, l, r);
-    trim_ends(w2, &pts, nseg, &lose2, l, r);
+    trim_ends(w1, &pts, &lose1);
+    trim_ends(w2, &pts, &lose2);
     Trim::Both
 }
 
@@ -308,10 +362,13 @@ fn lose_overlap(w: &mut Window, l: f64, r: f64) {
     }
 }
 
-/// Moves the ends of `w` that lie at `l` (or `r`) past the lost segments touching them.
-fn trim_ends(w: &mut Window, pts: &[f64; 4], nseg: usize, lose: &[bool; 3], l: f64, r: f64) {
+/// Moves the ends of `w` that lie at the overlap's ends `pts[0]` (or `pts[P - 1]`) past the
+/// lost segments touching them.
+#[inline(always)]
+fn trim_ends<const P: usize>(w: &mut Window, pts: &[f64; P], lose: &[bool; P]) {
+    let nseg = P - 1;
     let (b0, b1) = (w.b0, w.b1);
-    if b0 >= l {
+    if b0 >= pts[0] {
         let mut i = 0;
         while i < nseg && lose[i] {
             i += 1;
@@ -320,7 +377,7 @@ fn trim_ends(w: &mut Window, pts: &[f64; 4], nseg: usize, lose: &[bool; 3], l: f
             w.b0 = pts[i];
         }
     }
-    if b1 <= r {
+    if b1 <= pts[nseg] {
         let mut j = nseg;
         while j > 0 && lose[j - 1] {
             j -= 1;
@@ -419,6 +476,32 @@ mod tests {
         }
     }
 
+    /// A random interval `[b0, b1]` of `[0, 1]`.
+    fn ends(rng: &mut ChaCha8Rng) -> (f64, f64) {
+        let b0: f64 = rng.random_range(0.0..1.0);
+        (b0, rng.random_range(b0..=1.0))
+    }
+
+    /// Two ways of trimming the pair `(a, b)` gave the same outcome and the same surviving
+    /// intervals, bit for bit.
+    fn assert_same_outcome(
+        (a, b): (Window, Window),
+        (fast, x1, y1): (Trim, Window, Window),
+        (slow, x2, y2): (Trim, Window, Window),
+    ) {
+        assert_eq!(fast, slow, "{a:?} {b:?}");
+        for (p, q) in [(x1, x2), (y1, y2)] {
+            assert_eq!(p.is_dead(), q.is_dead(), "{a:?} {b:?}");
+            if !p.is_dead() {
+                assert_eq!(
+                    (p.b0.to_bits(), p.b1.to_bits()),
+                    (q.b0.to_bits(), q.b1.to_bits()),
+                    "{a:?} {b:?}"
+                );
+            }
+        }
+    }
+
     /// The bounding shortcut gives exactly the exact path's result whenever it decides.
     #[test]
     fn bound_shortcut_matches_exact_path() {
@@ -426,8 +509,7 @@ mod tests {
         let mut decided = 0;
         for _ in 0..20000 {
             let mk = |rng: &mut ChaCha8Rng| {
-                let b0: f64 = rng.random_range(0.0..1.0);
-                let b1: f64 = rng.random_range(b0..=1.0);
+                let (b0, b1) = ends(rng);
                 win(
                     b0,
                     b1,
@@ -448,15 +530,59 @@ mod tests {
             decided += 1;
             let (mut x2, mut y2) = (a, b);
             let slow = exact_trim(&mut x2, &mut y2, l, r);
-            assert_eq!(fast, slow, "{a:?} {b:?}");
-            for (p, q) in [(x1, x2), (y1, y2)] {
-                assert_eq!(p.is_dead(), q.is_dead(), "{a:?} {b:?}");
-                if !p.is_dead() {
-                    assert_eq!((p.b0, p.b1), (q.b0, q.b1), "{a:?} {b:?}");
-                }
-            }
+            assert_same_outcome((a, b), (fast, x1, y1), (slow, x2, y2));
         }
         assert!(decided > 1000, "the shortcut decided only {decided} pairs");
+    }
+
+    /// The unrolled bisector path gives bit for bit the general path's result on pairs with
+    /// equal (or nearly equal) sigmas, touching, nested and shared ends included.
+    #[test]
+    fn bisector_path_matches_general_path() {
+        let mut rng = ChaCha8Rng::seed_from_u64(13);
+        let mut split = 0;
+        for i in 0..40000 {
+            let sigma = if i % 2 == 0 {
+                0.0
+            } else {
+                rng.random_range(0.0..3.0)
+            };
+            let (p0, p1) = ends(&mut rng);
+            let (mut q0, mut q1) = ends(&mut rng);
+            match i % 5 {
+                0 => q0 = p0,
+                1 => q1 = p1,
+                2 => (q0, q1) = (p0, p1),
+                _ => {}
+            }
+            let sx = rng.random_range(-3.0..4.0);
+            let a = win(p0, p1, sigma, sx, -rng.random_range(1e-3..3.0));
+            // Nearly equal sources too (the bisector root then falls anywhere).
+            let sx2 = if i % 7 == 0 {
+                sx + rng.random_range(-1e-9..1e-9)
+            } else {
+                rng.random_range(-3.0..4.0)
+            };
+            let sigma2 = if i % 11 == 0 {
+                sigma * (1.0 + 1e-16)
+            } else {
+                sigma
+            };
+            let b = win(q0, q1, sigma2, sx2, -rng.random_range(1e-3..3.0));
+            let (l, r) = (a.b0.max(b.b0), a.b1.min(b.b1));
+            if r <= l || !equal_sigmas(&a, &b) {
+                continue;
+            }
+            let (mut x1, mut y1) = (a, b);
+            let fast = bisector_trim(&mut x1, &mut y1, l, r);
+            let (mut x2, mut y2) = (a, b);
+            let slow = general_trim(&mut x2, &mut y2, l, r);
+            assert_same_outcome((a, b), (fast, x1, y1), (slow, x2, y2));
+            if fast == Trim::Both && (x1.b1 < a.b1 || y1.b0 > b.b0) {
+                split += 1;
+            }
+        }
+        assert!(split > 1000, "only {split} pairs were trimmed at the root");
     }
 
     #[test]
