@@ -10,7 +10,7 @@ use super::{Args, Lm};
 use crate::pipeline::{bar, resolve_methods};
 use crate::report::Report;
 use crate::walk::Walker;
-use anyhow::{bail, Result};
+use anyhow::Result;
 use facemodel::{random_rigid_motion, FaceModel};
 use meshcore::{DVec3, FaceLocator, TriMesh};
 use rand::SeedableRng;
@@ -46,11 +46,7 @@ struct Setup<'a> {
 
 /// Runs the benchmark on clean meshes; prints the output folder on the last line.
 pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
-    let identities = args.identities.unwrap_or(50);
-    let expressions = args.expressions.unwrap_or(6);
-    if identities < 2 || expressions < 2 {
-        bail!("need at least 2 identities and 2 expressions (one neutral gallery face + probes)");
-    }
+    let (identities, expressions) = args.sizes((50, 6))?;
     let out = args.io.out.out_dir("recognition");
     let gt = Lm {
         lost: None,

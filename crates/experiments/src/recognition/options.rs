@@ -158,3 +158,18 @@ pub struct Args {
 fn fm() -> facematch::MatchOptions {
     facematch::MatchOptions::default()
 }
+
+impl Args {
+    /// The identities and faces per identity, `defaults` where not given; at least 2 of each (a
+    /// neutral gallery face and probes).
+    pub(super) fn sizes(&self, defaults: (usize, usize)) -> anyhow::Result<(usize, usize)> {
+        let identities = self.identities.unwrap_or(defaults.0);
+        let expressions = self.expressions.unwrap_or(defaults.1);
+        if identities < 2 || expressions < 2 {
+            anyhow::bail!(
+                "need at least 2 identities and 2 expressions (one neutral gallery face + probes)"
+            );
+        }
+        Ok((identities, expressions))
+    }
+}

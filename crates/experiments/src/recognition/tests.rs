@@ -76,3 +76,17 @@ fn detect_only_writes_one_row_per_scan_and_stops() {
     assert!(e.contains("no probe left") && e.contains("id05"), "{e}");
     std::fs::remove_dir_all(&out).unwrap();
 }
+
+#[test]
+fn runs_need_two_identities_and_two_expressions() {
+    let parse = |extra: &[&str]| crate::parse_args::<Args>(&[&["recognition"], extra].concat());
+    assert_eq!(parse(&[]).sizes((16, 3)).unwrap(), (16, 3));
+    assert_eq!(
+        parse(&["--identities", "4"]).sizes((50, 6)).unwrap(),
+        (4, 6)
+    );
+    for bad in [["--identities", "1"], ["--expressions", "1"]] {
+        let e = parse(&bad).sizes((16, 3)).unwrap_err().to_string();
+        assert!(e.contains("at least 2 identities and 2 expressions"), "{e}");
+    }
+}

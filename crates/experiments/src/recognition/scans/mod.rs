@@ -75,11 +75,7 @@ fn p95(v: Vec<f64>) -> f64 {
 
 /// Runs the scan benchmark; prints the output folder on the last line.
 pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
-    let identities = args.identities.unwrap_or(16);
-    let expressions = args.expressions.unwrap_or(3);
-    if identities < 2 || expressions < 2 {
-        bail!("need at least 2 identities and 2 expressions (one neutral gallery face + probes)");
-    }
+    let (identities, expressions) = args.sizes((16, 3))?;
     let out = args.io.out.out_dir("recognition-scans");
     let base = args.scan.settings();
     let generic =
