@@ -108,8 +108,11 @@ pub fn prepare_with(
         ..p.clean.clone()
     };
     let t0 = Instant::now();
-    let first = scanprep::clean(scan_input, &clean_opts)?;
-    let used = first.report.units.used;
+    // The steps before the crop run once; each crop below finishes them (bit for bit what a
+    // whole `scanprep::clean` with that crop gives).
+    let staged = scanprep::clean_uncropped(scan_input, &clean_opts)?;
+    let first = staged.finish(None)?;
+    let used = staged.units();
     let t1 = Instant::now();
     let first_found = detect(&first.mesh, generic, scanner, p);
     let (found, found_on) = match (first_found, p.crop_radius_mm) {
@@ -125,17 +128,10 @@ pub fn prepare_with(
                 .copied()
                 .max_by(|a, b| a.dot(scanner).total_cmp(&b.dot(scanner)))
                 .ok_or_else(|| MatchError::NoFace("the cleaned scan is empty".into()))?;
-            let around = scanprep::clean(
-                scan_input,
-                &CleanOptions {
-                    units: Some(used),
-                    crop: Some(Crop {
-                        centre: near / used.mm_per_unit(),
-                        radius_mm,
-                    }),
-                    ..clean_opts.clone()
-                },
-            )?;
+            let around = staged.finish(Some(Crop {
+                centre: near / used.mm_per_unit(),
+                radius_mm,
+            }))?;
             let f = detect(&around.mesh, generic, scanner, p).map_err(|e| {
                 MatchError::NoFace(format!(
                     "{why}; cropped around the point nearest the scanner: {}",
@@ -175,14 +171,7 @@ pub fn prepare_with(
             .vertex,
     );
     let centre = nose_mm / used.mm_per_unit();
-    let cropped = scanprep::clean(
-        scan_input,
-        &CleanOptions {
-            units: Some(used),
-            crop: Some(Crop { centre, radius_mm }),
-            ..clean_opts
-        },
-    )?;
+    let cropped = staged.finish(Some(Crop { centre, radius_mm }))?;
     let t3 = Instant::now();
     let detected = detect(&cropped.mesh, generic, scanner, p)?;
     let t4 = Instant::now();

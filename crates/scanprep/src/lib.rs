@@ -355,17 +355,36 @@ fn valid_points(g: &BntGrid) -> Vec<DVec3> {
         .collect()
 }
 
-/// Runs the preparation (see the crate docs) on a grid or a mesh.
+/// Runs the preparation (see the crate docs) on a grid or a mesh: [`clean_uncropped`], then
+/// [`Uncropped::finish`] with `o.crop`.
 pub fn clean(input: Input<'_>, o: &CleanOptions) -> Result<Cleaned, ScanPrepError> {
+    if let Some(c) = &o.crop {
+        crop_sphere_check(c)?;
+    }
+    clean_uncropped(input, o)?.finish(o.crop)
+}
+
+/// A scan cleaned up to the crop: units read, spikes removed, holes filled, triangulated,
+/// small components removed. [`Uncropped::finish`] crops, smooths and decimates it; one
+/// `Uncropped` can be finished with several crops (each result equals [`clean`] with that
+/// crop, bit for bit) without repeating the steps before the crop.
+#[derive(Debug, Clone)]
+pub struct Uncropped {
+    mesh: TriMesh,
+    grid_index: Option<Vec<u32>>,
+    report: CleanReport,
+    options: CleanOptions,
+}
+
+/// The steps of [`clean`] before the crop (`o.crop` is not used; give the crop to
+/// [`Uncropped::finish`]).
+pub fn clean_uncropped(input: Input<'_>, o: &CleanOptions) -> Result<Uncropped, ScanPrepError> {
     let mut timings = Vec::new();
     if !(o.min_coverage.is_finite() && (0.0..=1.0).contains(&o.min_coverage)) {
         return Err(ScanPrepError::InvalidOption(format!(
             "min coverage {} (expected 0 to 1)",
             o.min_coverage
         )));
-    }
-    if let Some(c) = &o.crop {
-        crop_sphere_check(c)?;
     }
     let mut report = CleanReport {
         units: UnitsReport {
@@ -452,30 +471,11 @@ pub fn clean(input: Input<'_>, o: &CleanOptions) -> Result<Cleaned, ScanPrepErro
         }
     };
     let is_mesh_input = matches!(input, Input::Mesh(_));
-    let track = |grid_index: &mut Option<Vec<u32>>, before: &TriMesh, after: &TriMesh| {
-        // Keeps the sample of each surviving vertex (steps that only drop vertices keep the
-        // order of the rest; positions are matched to be safe).
-        if let Some(gi) = grid_index.take() {
-            let mut out = Vec::with_capacity(after.n_vertices());
-            let mut k = 0usize;
-            for p in after.positions() {
-                while k < before.n_vertices() && before.positions()[k] != *p {
-                    k += 1;
-                }
-                if k == before.n_vertices() {
-                    return;
-                }
-                out.push(gi[k]);
-                k += 1;
-            }
-            *grid_index = Some(out);
-        }
-    };
     if let Some(r) = o.min_component_ratio {
         let (m, c, v) = timed(&mut timings, "components", || {
             remove_small_components(&mesh, r)
         })?;
-        track(&mut grid_index, &mesh, &m);
+        track_grid_index(&mut grid_index, &mesh, &m);
         mesh = m;
         report.small_components = (c, v);
     }
@@ -493,44 +493,99 @@ pub fn clean(input: Input<'_>, o: &CleanOptions) -> Result<Cleaned, ScanPrepErro
             report.gaps_closed = gaps.iter().filter(|h| h.filled).count();
         }
     }
-    if let Some(c) = &o.crop {
-        let centre = c.centre * report.units.used.mm_per_unit();
-        let (m, n) = timed(&mut timings, "crop", || {
-            crop_sphere(&mesh, centre, c.radius_mm)
-        })?;
-        track(&mut grid_index, &mesh, &m);
-        mesh = m;
-        report.cropped_vertices = n;
-        if let Some(r) = o.min_component_ratio {
-            let (m, c, v) = remove_small_components(&mesh, r)?;
-            track(&mut grid_index, &mesh, &m);
-            mesh = m;
-            report.small_components.0 += c;
-            report.small_components.1 += v;
-        }
-    }
-    if o.smoothing_iterations > 0 {
-        mesh = timed(&mut timings, "smooth", || {
-            taubin_smooth(&mesh, o.smoothing_iterations)
-        })?;
-        report.smoothing_iterations = o.smoothing_iterations;
-    }
-    if let Some(t) = o.target_edge_mm {
-        let (m, d) = timed(&mut timings, "decimate", || decimate(&mesh, t))?;
-        if d.collapses > 0 {
-            grid_index = None;
-        }
-        mesh = m;
-        report.decimation = Some(d);
-    }
-    report.output = (mesh.n_vertices(), mesh.n_faces());
-    report.mean_edge_mm = mesh.mean_edge_length();
     report.timings = timings;
-    Ok(Cleaned {
+    Ok(Uncropped {
         mesh,
         grid_index,
         report,
+        options: CleanOptions {
+            crop: None,
+            ..o.clone()
+        },
     })
+}
+
+impl Uncropped {
+    /// The mesh before the crop (mm).
+    pub fn mesh(&self) -> &TriMesh {
+        &self.mesh
+    }
+
+    /// The units the input was read in.
+    pub fn units(&self) -> Units {
+        self.report.units.used
+    }
+
+    /// The rest of [`clean`]: the crop (when given; its centre in the input's units), the
+    /// small components again after it, smoothing and decimation, with the options given to
+    /// [`clean_uncropped`]. The report covers every step, those before the crop included.
+    pub fn finish(&self, crop: Option<Crop>) -> Result<Cleaned, ScanPrepError> {
+        let o = &self.options;
+        let mut report = self.report.clone();
+        let mut timings = std::mem::take(&mut report.timings);
+        let mut grid_index = self.grid_index.clone();
+        let mut mesh = self.mesh.clone();
+        if let Some(c) = &crop {
+            crop_sphere_check(c)?;
+            let centre = c.centre * report.units.used.mm_per_unit();
+            let (m, n) = timed(&mut timings, "crop", || {
+                crop_sphere(&mesh, centre, c.radius_mm)
+            })?;
+            track_grid_index(&mut grid_index, &mesh, &m);
+            mesh = m;
+            report.cropped_vertices = n;
+            if let Some(r) = o.min_component_ratio {
+                let (m, c, v) = remove_small_components(&mesh, r)?;
+                track_grid_index(&mut grid_index, &mesh, &m);
+                mesh = m;
+                report.small_components.0 += c;
+                report.small_components.1 += v;
+            }
+        }
+        if o.smoothing_iterations > 0 {
+            mesh = timed(&mut timings, "smooth", || {
+                taubin_smooth(&mesh, o.smoothing_iterations)
+            })?;
+            report.smoothing_iterations = o.smoothing_iterations;
+        }
+        if let Some(t) = o.target_edge_mm {
+            let (m, d) = timed(&mut timings, "decimate", || decimate(&mesh, t))?;
+            if d.collapses > 0 {
+                grid_index = None;
+            }
+            mesh = m;
+            report.decimation = Some(d);
+        }
+        report.output = (mesh.n_vertices(), mesh.n_faces());
+        report.mean_edge_mm = mesh.mean_edge_length();
+        report.timings = timings;
+        Ok(Cleaned {
+            mesh,
+            grid_index,
+            report,
+        })
+    }
+}
+
+/// Keeps the grid sample of each vertex that survives a step that only drops vertices (the
+/// rest keep their order; positions are matched to be safe). Forgets the index when a vertex
+/// cannot be matched.
+fn track_grid_index(grid_index: &mut Option<Vec<u32>>, before: &TriMesh, after: &TriMesh) {
+    if let Some(gi) = grid_index.take() {
+        let mut out = Vec::with_capacity(after.n_vertices());
+        let mut k = 0usize;
+        for p in after.positions() {
+            while k < before.n_vertices() && before.positions()[k] != *p {
+                k += 1;
+            }
+            if k == before.n_vertices() {
+                return;
+            }
+            out.push(gi[k]);
+            k += 1;
+        }
+        *grid_index = Some(out);
+    }
 }
 
 fn crop_sphere_check(c: &Crop) -> Result<(), ScanPrepError> {

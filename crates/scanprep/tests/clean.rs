@@ -6,9 +6,9 @@ use meshcore::units::{detect_units, Units};
 use meshcore::{shapes, DVec3, TriMesh};
 use rangescan::{scan, Artifacts, HeadPose, ScanOptions, Spikes};
 use scanprep::{
-    check_grid, clean, close_mesh_gaps, crop_sphere, decimate, fill_grid_holes, fill_mesh_holes,
-    incidence_mask, remove_grid_spikes, remove_mesh_spikes, CleanOptions, Crop, Input,
-    ScanPrepError, SpikeOptions,
+    check_grid, clean, clean_uncropped, close_mesh_gaps, crop_sphere, decimate, fill_grid_holes,
+    fill_mesh_holes, incidence_mask, remove_grid_spikes, remove_mesh_spikes, CleanOptions, Crop,
+    Input, ScanPrepError, SpikeOptions,
 };
 
 /// The plane z = 5 over [0, 60]^2 mm.
@@ -405,6 +405,50 @@ fn the_crop_radius_is_honoured() {
     assert!(matches!(
         crop_sphere(&full, DVec3::splat(1e4), 1.0),
         Err(ScanPrepError::NothingLeft(_))
+    ));
+}
+
+#[test]
+fn an_uncropped_scan_finishes_like_clean_with_each_crop() {
+    // Spikes and a decimation: every step of `clean` runs, before and after the crop.
+    let g = scan_of(&sphere(), spiky());
+    let o = CleanOptions {
+        units: Some(Units::Millimetre),
+        target_edge_mm: Some(3.0),
+        ..CleanOptions::default()
+    };
+    let staged = clean_uncropped(Input::Grid(&g), &o).unwrap();
+    assert_eq!(staged.units(), Units::Millimetre);
+    let crops = [
+        None,
+        Some(Crop {
+            centre: DVec3::new(0.0, 0.0, R),
+            radius_mm: 30.0,
+        }),
+        Some(Crop {
+            centre: DVec3::new(10.0, -5.0, R),
+            radius_mm: 45.0,
+        }),
+    ];
+    for crop in crops {
+        let once = clean(Input::Grid(&g), &CleanOptions { crop, ..o.clone() }).unwrap();
+        let finished = staged.finish(crop).unwrap();
+        assert_eq!(finished.mesh, once.mesh, "{crop:?}");
+        assert_eq!(finished.grid_index, once.grid_index);
+        let mut a = finished.report.clone();
+        let mut b = once.report.clone();
+        (a.timings, b.timings) = (Vec::new(), Vec::new());
+        assert_eq!(a, b);
+        assert_eq!(crop.is_some(), finished.report.cropped_vertices > 0);
+    }
+    // A bad crop is the same clear error either way.
+    let bad = Some(Crop {
+        centre: DVec3::new(f64::NAN, 0.0, 0.0),
+        radius_mm: 30.0,
+    });
+    assert!(matches!(
+        staged.finish(bad),
+        Err(ScanPrepError::InvalidOption(_))
     ));
 }
 
