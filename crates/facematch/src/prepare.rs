@@ -34,7 +34,8 @@ pub struct StepTimes {
     pub detect: Duration,
     /// The cleaning with the crop around the detected nose tip.
     pub crop_clean: Duration,
-    /// Detection on the cropped scan.
+    /// Detection on the cropped scan (zero when the crop left the cleaned scan as it was and
+    /// the first detection stands).
     pub crop_detect: Duration,
 }
 
@@ -173,8 +174,13 @@ pub fn prepare_with(
     let centre = nose_mm / used.mm_per_unit();
     let cropped = staged.finish(Some(Crop { centre, radius_mm }))?;
     let t3 = Instant::now();
-    let detected = detect(&cropped.mesh, generic, scanner, p)?;
-    let t4 = Instant::now();
+    // A crop that changed nothing (a scan already cut to the face) gives the mesh the first
+    // detection ran on, and detection is deterministic: its landmarks stand.
+    let (detected, crop_detect) = if cropped.mesh == found_on {
+        (found, Duration::ZERO)
+    } else {
+        (detect(&cropped.mesh, generic, scanner, p)?, t3.elapsed())
+    };
     Ok(PreparedScan {
         mesh: cropped.mesh,
         scanner,
@@ -185,7 +191,7 @@ pub fn prepare_with(
             clean: t1 - t0,
             detect: t2 - t1,
             crop_clean: t3 - t2,
-            crop_detect: t4 - t3,
+            crop_detect,
         },
     })
 }

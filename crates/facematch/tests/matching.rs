@@ -182,3 +182,36 @@ fn a_face_before_a_wall_is_found() {
             .fold(0.0, f64::max)
     );
 }
+
+#[test]
+fn a_crop_that_changes_nothing_keeps_the_first_detection() {
+    let Some([a]) = testsupport::paper_meshes(["id2_neutral.obj"]) else {
+        return;
+    };
+    let grid = scan(&a, 0.0, 31);
+    let uncropped = MatchOptions {
+        prepare: facematch::PrepareOptions {
+            crop_radius_mm: None,
+            ..MatchOptions::default().prepare
+        },
+        ..MatchOptions::default()
+    };
+    let wide = MatchOptions {
+        prepare: facematch::PrepareOptions {
+            crop_radius_mm: Some(400.0),
+            ..MatchOptions::default().prepare
+        },
+        ..MatchOptions::default()
+    };
+    let first = prepare(ScanInput::Grid(&grid), &uncropped).unwrap();
+    let kept = prepare(ScanInput::Grid(&grid), &wide).unwrap();
+    // 400 mm around the nose tip holds the whole scan: the same mesh, the same landmarks,
+    // and no second detection.
+    assert_eq!(kept.mesh, first.mesh);
+    assert_eq!(kept.detected, first.detected);
+    assert_eq!(kept.times.crop_detect, std::time::Duration::ZERO);
+    // The default crop (100 mm) cuts the scan, and detection runs again on what is left.
+    let cut = prepare(ScanInput::Grid(&grid), &MatchOptions::default()).unwrap();
+    assert!(cut.mesh.n_vertices() < first.mesh.n_vertices());
+    assert!(cut.times.crop_detect > std::time::Duration::ZERO);
+}
