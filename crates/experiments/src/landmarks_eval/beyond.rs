@@ -65,23 +65,27 @@ pub struct BeyondFace {
     pub name: String,
     /// The face (mm).
     pub mesh: TriMesh,
-    /// Per landmark (`LandmarkName::ALL` order) the true position, or why it is not on the
-    /// surface (a scan that did not see it).
-    pub truth: [Result<DVec3, String>; 5],
+    /// Per landmark (`LandmarkName::ALL` order) the true position and, when it is not on the
+    /// surface (a scan that did not see it), why.
+    pub truth: [(DVec3, Option<String>); 5],
     /// The direction toward the scanner for a scan.
     pub toward_viewer: Option<DVec3>,
     /// What the recipe did (expression, warp size, edge length, scanner settings).
     pub label: String,
 }
 
-/// Millimetres per ICT model unit, from the model's units label (refused when it names none).
-fn mm_per_unit(ict: &FaceModel) -> Result<f64> {
-    let u: meshcore::units::Units = ict
-        .units()
+/// Millimetres per unit of the units label `units` (of `what`; refused when it names none).
+pub(super) fn mm_per(units: &str, what: &str) -> Result<f64> {
+    let u: meshcore::units::Units = units
         .trim()
         .parse()
-        .map_err(|e| anyhow::anyhow!("the ICT model's units {:?}: {e}", ict.units()))?;
+        .map_err(|e| anyhow::anyhow!("{what}'s units {units:?}: {e}"))?;
     Ok(u.factor_to(meshcore::units::Units::Millimetre))
+}
+
+/// Millimetres per ICT model unit, from the model's units label.
+fn mm_per_unit(ict: &FaceModel) -> Result<f64> {
+    mm_per(ict.units(), "the ICT model")
 }
 
 /// Seed of face `index` of `kind` in the stream of `seed`.
@@ -109,26 +113,14 @@ pub fn make(ict: &FaceModel, kind: Kind, index: usize, seed: u64) -> Result<Beyo
     let truth = ict.landmark_positions(&face)?;
     let face = face.transformed(&DAffine3::from_scale(DVec3::splat(s)));
     let truth = truth.map(|p| p * s);
-    let ok = |t: [DVec3; 5]| t.map(Ok);
     let motion = facemodel::random_rigid_motion(&mut rng, 100.0);
-    match kind {
-        Kind::StrongExpression => Ok(BeyondFace {
-            name,
-            mesh: face.transformed(&motion),
-            truth: ok(truth.map(|p| motion.transform_point3(p))),
-            toward_viewer: None,
-            label: ex_label,
-        }),
+    let (mesh, truth, label) = match kind {
+        Kind::StrongExpression => (face, truth, ex_label),
         Kind::Warp => {
             let w = facemodel::random_warp(&face, &truth, &mut rng)?;
             let moved = ict.landmark_positions(&w.mesh)?;
-            Ok(BeyondFace {
-                name,
-                mesh: w.mesh.transformed(&motion),
-                truth: ok(moved.map(|p| motion.transform_point3(p))),
-                toward_viewer: None,
-                label: format!("warp {:.1} mm: {}", w.size_mm, w.parts.join(", ")),
-            })
+            let label = format!("warp {:.1} mm: {}", w.size_mm, w.parts.join(", "));
+            (w.mesh, moved, label)
         }
         Kind::Remesh => {
             let edge = rng.random_range(1.0..5.0);
@@ -138,16 +130,17 @@ pub fn make(ict: &FaceModel, kind: Kind, index: usize, seed: u64) -> Result<Beyo
                 mesh.mean_edge_length(),
                 mesh.n_vertices()
             );
-            Ok(BeyondFace {
-                name,
-                mesh: mesh.transformed(&motion),
-                truth: ok(truth.map(|p| motion.transform_point3(p))),
-                toward_viewer: None,
-                label,
-            })
+            (mesh, truth, label)
         }
-        Kind::DepthCamera => depth_camera(name, &face, &truth, &mut rng),
-    }
+        Kind::DepthCamera => return depth_camera(name, &face, &truth, &mut rng),
+    };
+    Ok(BeyondFace {
+        name,
+        mesh: mesh.transformed(&motion),
+        truth: truth.map(|p| (motion.transform_point3(p), None)),
+        toward_viewer: None,
+        label,
+    })
 }
 
 /// A consumer depth camera's scan of `face` (mm): head yaw up to 20 degrees, 2-5 mm pitch,
@@ -212,14 +205,15 @@ fn depth_camera(
     let surface = meshcore::FaceLocator::new(&mesh);
     let truth = std::array::from_fn(|k| {
         let l = &scan.landmarks[k];
-        match surface.nearest(l.position) {
-            Ok((_, d)) if d <= crate::scans::MAX_SNAP_MM => Ok(l.position),
-            Ok((_, d)) => Err(format!(
+        let why = match surface.nearest(l.position) {
+            Ok((_, d)) if d <= crate::scans::MAX_SNAP_MM => None,
+            Ok((_, d)) => Some(format!(
                 "{} and {d:.1} mm from the cleaned surface",
                 l.visibility
             )),
-            Err(e) => Err(format!("the cleaned scan: {e}")),
-        }
+            Err(e) => Some(format!("the cleaned scan: {e}")),
+        };
+        (l.position, why)
     });
     Ok(BeyondFace {
         name,

@@ -2,10 +2,10 @@
 //! model's span) and on non-faces; per kind the faces not found, the weak detections and the
 //! errors, and per non-face whether it was refused.
 
-use super::beyond::{make, non_faces, BeyondFace, Kind};
-use super::stats::{stats, Stats};
+use super::beyond::{make, mm_per, non_faces, BeyondFace, Kind};
+use super::stats::{quantile, score, scored_stats, sorted, text, Scored};
 use crate::pipeline::bar;
-use crate::report::write_json;
+use crate::report::{write_csv, write_json};
 use anyhow::{Context, Result};
 use facemodel::FaceModel;
 use landmarks::{detect_visible, DetectOptions, GenericModel, LandmarkName, VisibleLandmarks};
@@ -17,10 +17,8 @@ struct Outcome {
     kind: Kind,
     name: String,
     label: String,
-    /// Per landmark: the error in mm (`inf`: not placed), or why the truth is not on the surface.
-    errors: [Result<f64, String>; 5],
-    /// For a landmark reported unseen whose truth is on the surface: how far its prediction is.
-    predicted_unseen: Vec<(LandmarkName, f64)>,
+    /// The detection scored against the truth.
+    scored: Scored,
     /// The detection, or the error message.
     found: Result<Found, String>,
     vertices: usize,
@@ -73,30 +71,12 @@ fn detect_one(f: BeyondFace, kind: Kind, generic: &GenericModel, dopt: &DetectOp
     let r = options_for(&f.mesh, generic, dopt, f.toward_viewer)
         .and_then(|o| detect_visible(&f.mesh, generic, &o).map(|v| (v, o)));
     let detect_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let errors = LandmarkName::ALL.map(|n| match (&f.truth[n as usize], &r) {
-        (Err(why), _) => Err(why.clone()),
-        (Ok(t), Ok((v, _))) => Ok(v
-            .get(n)
-            .map_or(f64::INFINITY, |l| (l.position - *t).length())),
-        (Ok(_), Err(_)) => Ok(f64::INFINITY),
-    });
-    let predicted_unseen = match &r {
-        Ok((v, _)) => LandmarkName::ALL
-            .iter()
-            .filter(|&&n| v.get(n).is_err())
-            .filter_map(|&n| {
-                let t = f.truth[n as usize].as_ref().ok()?;
-                Some((n, (v.predicted[n as usize] - *t).length()))
-            })
-            .collect(),
-        Err(_) => Vec::new(),
-    };
+    let scored = score(&f.truth, r.as_ref().map(|(v, _)| v));
     Outcome {
         kind,
         name: f.name,
         label: f.label,
-        errors,
-        predicted_unseen,
+        scored,
         found: r.map(|(v, o)| found(&v, &o)).map_err(|e| e.to_string()),
         vertices: f.mesh.n_vertices(),
         detect_ms,
@@ -104,15 +84,17 @@ fn detect_one(f: BeyondFace, kind: Kind, generic: &GenericModel, dopt: &DetectOp
 }
 
 /// Median and 95th percentile of `v` (NaN when empty).
-fn median_p95(v: &[f64]) -> (f64, f64) {
-    let mut v = v.to_vec();
-    v.sort_by(f64::total_cmp);
-    let q = |p: f64| {
-        v.get(((v.len().max(1) - 1) as f64 * p).round() as usize)
-            .copied()
-            .unwrap_or(f64::NAN)
-    };
-    (q(0.5), q(0.95))
+fn median_p95(v: Vec<f64>) -> (f64, f64) {
+    let v = sorted(v);
+    (quantile(&v, 0.5), quantile(&v, 0.95))
+}
+
+/// Prints one row of the table of kinds (13 cells).
+fn print_row(c: [&str; 13]) {
+    println!(
+        "{:<18} {:>4} {:>5} {:>5} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>4} {:>12} {:>7}",
+        c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8], c[9], c[10], c[11], c[12]
+    );
 }
 
 /// Prints and returns the table row of one kind.
@@ -123,53 +105,43 @@ fn kind_summary(kind: Kind, rows: &[&Outcome]) -> serde_json::Value {
         .iter()
         .filter(|o| o.found.as_ref().is_ok_and(|f| !f.weak.is_empty()))
         .count();
-    let per: Vec<Stats> = LandmarkName::ALL
-        .iter()
-        .map(|&l| {
-            let e: Vec<f64> = rows
-                .iter()
-                .filter_map(|o| o.errors[l as usize].as_ref().ok().copied())
-                .collect();
-            stats(l.key(), &e)
-        })
-        .collect();
-    let outer: Vec<f64> = rows
-        .iter()
-        .flat_map(|o| [&o.errors[0], &o.errors[3]])
-        .filter_map(|e| e.as_ref().ok().copied())
-        .collect();
-    let (om, op) = median_p95(&outer);
+    let scored: Vec<&Scored> = rows.iter().map(|o| &o.scored).collect();
+    let per = scored_stats(&scored);
+    let outer = scored.iter().flat_map(|o| [&o.errors[0], &o.errors[3]]);
+    let (om, op) = median_p95(outer.filter_map(|e| e.as_ref().ok().copied()).collect());
     let silent = rows
         .iter()
         .filter(|o| o.found.is_ok())
-        .flat_map(|o| o.errors.iter())
+        .flat_map(|o| o.scored.errors.iter())
         .filter(|e| matches!(e, Ok(x) if x.is_finite() && *x > 10.0))
         .count();
-    let pred: Vec<f64> = rows
+    // The outer eye corners reported unseen whose truth is on the surface.
+    let pred: Vec<f64> = scored
         .iter()
         .flat_map(|o| o.predicted_unseen.iter())
-        .filter(|(l, _)| matches!(l, LandmarkName::OuterEyeRight | LandmarkName::OuterEyeLeft))
+        .filter(|(l, _, on)| {
+            *on && matches!(l, LandmarkName::OuterEyeRight | LandmarkName::OuterEyeLeft)
+        })
         .map(|x| x.1)
         .collect();
-    let (pm, pp) = median_p95(&pred);
-    let ms: Vec<f64> = rows.iter().map(|o| o.detect_ms).collect();
-    let (tm, _) = median_p95(&ms);
-    println!(
-        "{:<18} {:>4} {:>5} {:>5} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>7} {:>4} {:>12} {:>7.0}",
+    let (pm, pp) = median_p95(pred.clone());
+    let (tm, _) = median_p95(rows.iter().map(|o| o.detect_ms).collect());
+    let f2 = |x: f64| format!("{x:.2}");
+    print_row([
         kind.name(),
-        n,
-        not_found.len(),
-        weak,
-        om,
-        op,
-        per[4].median_mm,
-        per[1].median_mm.max(per[2].median_mm),
-        per[0].max_mm.max(per[3].max_mm),
-        silent,
-        pred.len(),
-        format!("{pm:.2}/{pp:.2}"),
-        tm
-    );
+        &n.to_string(),
+        &not_found.len().to_string(),
+        &weak.to_string(),
+        &f2(om),
+        &f2(op),
+        &f2(per[4].median_mm),
+        &f2(per[1].median_mm.max(per[2].median_mm)),
+        &f2(per[0].max_mm.max(per[3].max_mm)),
+        &silent.to_string(),
+        &pred.len().to_string(),
+        &format!("{pm:.2}/{pp:.2}"),
+        &format!("{tm:.0}"),
+    ]);
     for o in not_found.iter().take(6) {
         println!(
             "    {}: {}",
@@ -224,8 +196,7 @@ pub(super) fn run_beyond(
         "faces beyond the ICT model (seed {}, {} per kind); errors in mm; a landmark not placed counts as infinite",
         args.seed, args.beyond_faces
     );
-    println!(
-        "{:<18} {:>4} {:>5} {:>5} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>4} {:>12} {:>7}",
+    print_row([
         "kind",
         "n",
         "n.f.",
@@ -238,10 +209,9 @@ pub(super) fn run_beyond(
         ">10mm",
         "uns.",
         "predicted",
-        "detect"
-    );
-    println!(
-        "{:<18} {:>4} {:>5} {:>5} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>4} {:>12} {:>7}",
+        "detect",
+    ]);
+    print_row([
         "",
         "",
         "",
@@ -254,15 +224,15 @@ pub(super) fn run_beyond(
         "placed",
         "out.",
         "median/p95",
-        "ms"
-    );
+        "ms",
+    ]);
     let mut kinds_json = Vec::new();
     for &k in &kinds {
         let rows: Vec<&Outcome> = outcomes.iter().filter(|o| o.kind == k).collect();
         kinds_json.push(kind_summary(k, &rows));
     }
     let refused = run_non_faces(ict, generic, dopt, args.seed)?;
-    write_csv(&outcomes, &out.join("per-face.csv"))?;
+    write_per_face(&outcomes, &out.join("per-face.csv"))?;
     let summary = serde_json::json!({
         "seed": args.seed, "faces_per_kind": args.beyond_faces, "kinds": kinds_json,
         "non_faces": refused, "seconds": t0.elapsed().as_secs_f64(),
@@ -284,7 +254,7 @@ fn run_non_faces(
     for (name, mesh) in non_faces(ict, seed)? {
         // In mm, given: what is tested is the face check, not the units check.
         let o = DetectOptions {
-            mesh_units_per_model_unit: generic_mm_factor(generic)?,
+            mesh_units_per_model_unit: mm_per(&generic.units, "the generic model")?,
             ..*dopt
         };
         let r = detect_visible(&mesh, generic, &o);
@@ -301,59 +271,41 @@ fn run_non_faces(
     Ok(out)
 }
 
-/// Millimetres per unit of the generic model (its units label read, or refused).
-fn generic_mm_factor(generic: &GenericModel) -> Result<f64> {
-    let u: meshcore::units::Units = generic
-        .units
-        .trim()
-        .parse()
-        .map_err(|e| anyhow::anyhow!("the generic model's units {:?}: {e}", generic.units))?;
-    Ok(u.factor_to(meshcore::units::Units::Millimetre))
-}
-
 /// One row per face.
-fn write_csv(outcomes: &[Outcome], path: &Path) -> Result<()> {
-    let names: Vec<&str> = LandmarkName::ALL.iter().map(|n| n.key()).collect();
-    let mut csv = format!(
-        "face,kind,{},confidence,symmetry,weakest_agreement,weak,vertices,detect_ms,error,label\n",
-        names.join(",")
-    );
-    for o in outcomes {
-        let e: Vec<String> = o
-            .errors
-            .iter()
-            .map(|e| match e {
+fn write_per_face(outcomes: &[Outcome], path: &Path) -> Result<()> {
+    let header: Vec<&str> = ["face", "kind"]
+        .into_iter()
+        .chain(LandmarkName::ALL.iter().map(|n| n.key()))
+        .chain([
+            "confidence",
+            "symmetry",
+            "weakest_agreement",
+            "weak",
+            "vertices",
+        ])
+        .chain(["detect_ms", "error", "label"])
+        .collect();
+    let rows: Vec<Vec<String>> = outcomes
+        .iter()
+        .map(|o| {
+            let e = o.scored.errors.iter().map(|e| match e {
                 Ok(x) => format!("{x:.3}"),
-                Err(w) => format!("truth not on the surface: {w}").replace(',', ";"),
-            })
-            .collect();
-        let (c, s, w, weak, err) = match &o.found {
-            Ok(f) => (
-                f.confidence.to_string(),
-                f.symmetry.to_string(),
-                f.weakest.to_string(),
-                f.weak.join("; "),
-                String::new(),
-            ),
-            Err(e) => (
-                String::new(),
-                String::new(),
-                String::new(),
-                String::new(),
-                e.clone(),
-            ),
-        };
-        csv += &format!(
-            "{},{},{},{c},{s},{w},{},{},{:.0},{},{}\n",
-            o.name,
-            o.kind.name(),
-            e.join(","),
-            weak.replace(',', ";"),
-            o.vertices,
-            o.detect_ms,
-            err.replace(',', ";"),
-            o.label.replace(',', ";")
-        );
-    }
-    std::fs::write(path, csv).with_context(|| format!("writing {}", path.display()))
+                Err(w) => text(&format!("truth not on the surface: {w}")),
+            });
+            let (found, error) = match &o.found {
+                Ok(f) => {
+                    let numbers = [f.confidence, f.symmetry, f.weakest].map(|x| x.to_string());
+                    let weak = text(&f.weak.join("; "));
+                    (numbers.into_iter().chain([weak]).collect(), String::new())
+                }
+                Err(e) => (vec![String::new(); 4], text(e)),
+            };
+            let mut row: Vec<String> = vec![o.name.clone(), o.kind.name().into()];
+            row.extend(e.chain(found));
+            row.extend([o.vertices.to_string(), format!("{:.0}", o.detect_ms)]);
+            row.extend([error, text(&o.label)]);
+            row
+        })
+        .collect();
+    write_csv(path, &header, &rows)
 }

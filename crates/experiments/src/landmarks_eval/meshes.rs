@@ -1,10 +1,10 @@
 //! `landmarks-eval` on meshes: detection on faces sampled from the ICT model against its
 //! landmark vertices (errors, outcomes, the scores of correct detections, per-face rows).
 
-use super::stats::{error_histogram, stats, Stats};
+use super::stats::{error_histogram, print_table, quantile, sorted, stats, text, Stats};
 use super::{sample_faces, test_seed, training_seed, Args};
 use crate::pipeline::bar;
-use crate::report::write_json;
+use crate::report::{write_csv, write_json};
 use anyhow::Result;
 use facemodel::{FaceModel, LANDMARK_NAMES};
 use landmarks::{detect_with, DetectOptions, GenericModel, LandmarkName, Landmarks};
@@ -26,9 +26,9 @@ struct Outcome {
     symmetry: f64,
     /// The weakest local template agreement of a landmark.
     local: f64,
-    /// The per-face CSV columns of a detection (empty when not found): pose-only errors,
+    /// The 12 per-face CSV columns of a detection (empty when not found): pose-only errors,
     /// outer-eye distances, canonical error vectors.
-    row: String,
+    row: Vec<String>,
 }
 
 impl Outcome {
@@ -78,7 +78,7 @@ fn detect_face(
             confidence: 0.0,
             symmetry: 0.0,
             local: 0.0,
-            row: String::new(),
+            row: vec![String::new(); 12],
         },
     }
 }
@@ -87,7 +87,12 @@ fn detect_face(
 /// alone (before the local refinement), the true and detected outer-eye distances, and the
 /// error vectors in the canonical frame of the model (x: right to left eye, y: up, z: out of
 /// the face).
-fn detection_row(lm: &Landmarks, gt: &[DVec3; 5], generic: &GenericModel, unit_mm: f64) -> String {
+fn detection_row(
+    lm: &Landmarks,
+    gt: &[DVec3; 5],
+    generic: &GenericModel,
+    unit_mm: f64,
+) -> Vec<String> {
     let pose = lm.model_to_mesh;
     let inv = pose.inverse();
     let mut row = Vec::new();
@@ -95,18 +100,13 @@ fn detection_row(lm: &Landmarks, gt: &[DVec3; 5], generic: &GenericModel, unit_m
         let pred = pose.transform_point3(generic.landmark(n));
         row.push(format!("{:.2}", (pred - gt[n as usize]).length() * unit_mm));
     }
-    let od = |p: [DVec3; 5]| (p[3] - p[0]).length() * unit_mm;
-    row.push(format!("{:.2},{:.2}", od(*gt), od(lm.positions())));
+    let od = |p: [DVec3; 5]| format!("{:.2}", (p[3] - p[0]).length() * unit_mm);
+    row.extend([od(*gt), od(lm.positions())]);
     for &n in &LandmarkName::ALL {
-        let dv = inv.transform_vector3(lm.get(n).position - gt[n as usize]);
-        row.push(format!(
-            "{:.2} {:.2} {:.2}",
-            dv.x * unit_mm,
-            dv.y * unit_mm,
-            dv.z * unit_mm
-        ));
+        let dv = inv.transform_vector3(lm.get(n).position - gt[n as usize]) * unit_mm;
+        row.push(format!("{:.2} {:.2} {:.2}", dv.x, dv.y, dv.z));
     }
-    row.join(",")
+    row
 }
 
 /// The evaluation on meshes: detects the landmarks of the test faces (or the training faces
@@ -153,7 +153,7 @@ pub(super) fn run_meshes(
     let st: Vec<Stats> = names.iter().zip(&per).map(|(n, e)| stats(n, e)).collect();
     let summary = print_summary(args, generic, &results, &st);
     write_json(&out.join("summary.json"), &summary)?;
-    write_csv(&out.join("per-face.csv"), &results, &face_ids, &labels)?;
+    write_per_face(&out.join("per-face.csv"), &results, &face_ids, &labels)?;
     error_histogram(
         &out.join("errors-histogram.svg"),
         "Landmark errors on sampled ICT faces",
@@ -175,8 +175,7 @@ fn print_summary(
     results: &[Outcome],
     st: &[Stats],
 ) -> serde_json::Value {
-    let mut times: Vec<f64> = results.iter().map(|r| r.cpu_ms).collect();
-    times.sort_by(f64::total_cmp);
+    let times = sorted(results.iter().map(|r| r.cpu_ms).collect());
     let failures: Vec<(usize, String)> = results
         .iter()
         .enumerate()
@@ -192,24 +191,8 @@ fn print_summary(
         },
         generic.n_training
     );
-    println!(
-        "{:<16} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7}",
-        "landmark", "mean", "median", "p95", "max", "<2.5", "<5", "<10"
-    );
-    for s in st {
-        println!(
-            "{:<16} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>6.1}% {:>6.1}% {:>6.1}%",
-            s.landmark,
-            s.mean_mm,
-            s.median_mm,
-            s.p95_mm,
-            s.max_mm,
-            100.0 * s.within_2_5mm,
-            100.0 * s.within_5mm,
-            100.0 * s.within_10mm
-        );
-    }
-    let tmed = times[times.len() / 2];
+    print_table(st, false, None);
+    let tmed = quantile(&times, 0.5);
     let tp95 = times[((times.len() - 1) as f64 * 0.95) as usize];
     println!("CPU time per face (thread CPU time, release): median {tmed:.1} ms, p95 {tp95:.1} ms");
     for (i, e) in failures.iter().take(20) {
@@ -257,15 +240,11 @@ fn print_scores_and_worst(results: &[Outcome]) {
         ("symmetry", |r| r.symmetry),
         ("local template agreement", |r| r.local),
     ] {
-        let mut v: Vec<f64> = results.iter().filter(|r| r.correct()).map(get).collect();
-        v.sort_by(f64::total_cmp);
+        let v = sorted(results.iter().filter(|r| r.correct()).map(get).collect());
         if !v.is_empty() {
+            let [a, b, c, d] = [0.0, 0.01, 0.05, 0.5].map(|p| quantile(&v, p));
             println!(
-                "{what} of correct detections: min {:.3}, p1 {:.3}, p5 {:.3}, median {:.3}",
-                v[0],
-                v[((v.len() - 1) as f64 * 0.01).round() as usize],
-                v[((v.len() - 1) as f64 * 0.05).round() as usize],
-                v[v.len() / 2]
+                "{what} of correct detections: min {a:.3}, p1 {b:.3}, p5 {c:.3}, median {d:.3}"
             );
         }
     }
@@ -292,46 +271,45 @@ fn print_scores_and_worst(results: &[Outcome]) {
 }
 
 /// One row per face: errors, pose-only errors, canonical error vectors, expression.
-fn write_csv(
+fn write_per_face(
     path: &Path,
     results: &[Outcome],
     face_ids: &[usize],
     labels: &[String],
 ) -> Result<()> {
     let names: Vec<&str> = LandmarkName::ALL.iter().map(|n| n.key()).collect();
-    let mut csv = String::from("face");
-    for n in &names {
-        csv += &format!(",{n}");
-    }
-    for n in &names {
-        csv += &format!(",{n}_pose_only");
-    }
-    csv += ",outer_eye_distance_true,outer_eye_distance_detected";
-    for n in &names {
-        csv += &format!(",{n}_xyz");
-    }
-    csv += ",cpu_ms,confidence,symmetry,local,error,expression\n";
-    for (k, r) in results.iter().enumerate() {
-        let errs: Vec<String> = r.errors.iter().map(|x| format!("{x:.2}")).collect();
-        let row = if r.row.is_empty() {
-            vec![String::new(); 12].join(",")
-        } else {
-            r.row.clone()
-        };
-        csv += &format!(
-            "{},{},{row},{:.1},{:.3},{:.3},{:.3},{},{}\n",
-            face_ids[k],
-            errs.join(","),
-            r.cpu_ms,
-            r.confidence,
-            r.symmetry,
-            r.local,
-            r.error.as_deref().unwrap_or("").replace(',', ";"),
-            labels[k]
-        );
-    }
-    std::fs::write(path, csv)?;
-    Ok(())
+    let suffixed = |s: &'static str| names.iter().map(move |n| format!("{n}{s}"));
+    let header: Vec<String> = std::iter::once("face".to_string())
+        .chain(suffixed(""))
+        .chain(suffixed("_pose_only"))
+        .chain(["outer_eye_distance_true", "outer_eye_distance_detected"].map(String::from))
+        .chain(suffixed("_xyz"))
+        .chain(
+            [
+                "cpu_ms",
+                "confidence",
+                "symmetry",
+                "local",
+                "error",
+                "expression",
+            ]
+            .map(String::from),
+        )
+        .collect();
+    let rows: Vec<Vec<String>> = results
+        .iter()
+        .zip(face_ids.iter().zip(labels))
+        .map(|(r, (id, label))| {
+            let mut row = vec![id.to_string()];
+            row.extend(r.errors.iter().map(|x| format!("{x:.2}")));
+            row.extend(r.row.iter().cloned());
+            row.push(format!("{:.1}", r.cpu_ms));
+            row.extend([r.confidence, r.symmetry, r.local].map(|x| format!("{x:.3}")));
+            row.extend([text(r.error.as_deref().unwrap_or("")), label.clone()]);
+            row
+        })
+        .collect();
+    write_csv(path, &header, &rows)
 }
 
 /// CPU time consumed by the calling thread so far (ns), from `/proc/thread-self/schedstat`.

@@ -242,18 +242,10 @@ fn generic_model(args: &Args, ict: &FaceModel) -> Result<GenericModel> {
     };
     if let Some(n) = args.fit_regressor {
         let mut ro = RegressorOptions::default();
-        if let Some(x) = args.regressor_radius {
-            ro.radius = x;
-        }
-        if let Some(x) = args.regressor_spacing {
-            ro.spacing = x;
-        }
-        if let Some(x) = args.regressor_ridge {
-            ro.ridge = x;
-        }
-        if let Some(x) = args.regressor_perturbations {
-            ro.perturbations = x;
-        }
+        ro.radius = args.regressor_radius.unwrap_or(ro.radius);
+        ro.spacing = args.regressor_spacing.unwrap_or(ro.spacing);
+        ro.ridge = args.regressor_ridge.unwrap_or(ro.ridge);
+        ro.perturbations = args.regressor_perturbations.unwrap_or(ro.perturbations);
         generic.regressor = Some(fit_regressor(ict, &generic, n, args.regressor_seed, &ro)?);
     }
     Ok(generic)
@@ -262,19 +254,13 @@ fn generic_model(args: &Args, ict: &FaceModel) -> Result<GenericModel> {
 /// The detection options: the defaults with the overrides of the command line.
 fn detect_options(args: &Args) -> DetectOptions {
     let mut dopt = DetectOptions::default();
-    if let Some(x) = args.min_symmetry {
-        dopt.min_symmetry = x;
-    }
-    if let Some(x) = args.min_confidence {
-        dopt.min_confidence = x;
-    }
+    dopt.min_symmetry = args.min_symmetry.unwrap_or(dopt.min_symmetry);
+    dopt.min_confidence = args.min_confidence.unwrap_or(dopt.min_confidence);
     dopt.use_regressor = !args.no_regressor;
     dopt.trace = args.trace;
-    if let Some(x) = args.refuse_local_agreement {
-        dopt.refuse_local_agreement = x;
-    }
-    if let Some(x) = args.comparable_fit_cost {
-        dopt.comparable_fit_cost = x;
-    }
+    dopt.refuse_local_agreement = args
+        .refuse_local_agreement
+        .unwrap_or(dopt.refuse_local_agreement);
+    dopt.comparable_fit_cost = args.comparable_fit_cost.unwrap_or(dopt.comparable_fit_cost);
     dopt
 }

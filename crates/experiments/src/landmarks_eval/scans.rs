@@ -1,10 +1,12 @@
 //! `landmarks-eval --scans`: detection on range scans of sampled ICT faces against the ground
 //! truth the scanner projected.
 
-use super::stats::{error_histogram, stats, Stats};
+use super::stats::{print_table, quantile, score, scored_histogram, scored_stats, sorted};
+use super::stats::{text, Scored, Stats};
+
 use super::{test_seed, Args};
 use crate::pipeline::bar;
-use crate::report::write_json;
+use crate::report::{write_csv, write_json};
 use crate::scans::{sample_weights, scan_faces, scan_seed, FaceSpec, ScanSetOptions, ScanSettings};
 use anyhow::{Context, Result};
 use facemodel::FaceModel;
@@ -13,16 +15,12 @@ use meshcore::DVec3;
 use std::path::Path;
 use std::time::Instant;
 
-/// Outcome of one scanned test face: per landmark the error in mm (`inf`: not found, the face
-/// or the landmark), or why the truth is not on the cleaned scan; why the detector reported a
-/// landmark unseen; the detector's error message.
+/// Outcome of one scanned test face: the detection scored against the truth the scanner
+/// projected (only the outer eye corners' predictions are kept), the detector's error message,
+/// the scan's size and the detection time.
 struct ScanOutcome {
     name: String,
-    errors: [Result<f64, String>; 5],
-    unseen: [Option<String>; 5],
-    /// Per outer eye corner reported unseen: how far the detector's prediction is from the
-    /// true corner (on the scan or not), mm.
-    predicted_unseen: Vec<f64>,
+    scored: Scored,
     not_found: Option<String>,
     valid_samples: usize,
     vertices: usize,
@@ -78,23 +76,12 @@ pub(super) fn run_scans(
         "seconds": secs,
     });
     write_json(&out.join("summary.json"), &summary)?;
-    write_csv(&out.join("per-face.csv"), &outcomes)?;
-    let series = LandmarkName::ALL
-        .iter()
-        .map(|&n| {
-            (
-                n.key().to_string(),
-                outcomes
-                    .iter()
-                    .filter_map(|o| o.errors[n as usize].as_ref().ok().copied())
-                    .collect(),
-            )
-        })
-        .collect();
-    error_histogram(
+    write_per_face(&out.join("per-face.csv"), &outcomes)?;
+    let scored: Vec<&Scored> = outcomes.iter().map(|o| &o.scored).collect();
+    scored_histogram(
         &out.join("errors-histogram.svg"),
         &format!("Landmark errors on range scans ({})", settings.label()),
-        series,
+        &scored,
     )?;
     println!("{}", out.display());
     Ok(())
@@ -164,36 +151,16 @@ fn scan_and_detect(
                 continue;
             }
         };
-        let errors = LandmarkName::ALL.map(|n| {
-            let t = &f.truth[n as usize];
-            match (&t.vertex, &f.detected) {
-                (Err(why), _) => Err(why.clone()),
-                (Ok(_), Ok(d)) => Ok(d
-                    .get(n)
-                    .map_or(f64::INFINITY, |l| (l.position - t.position).length())),
-                (Ok(_), Err(_)) => Ok(f64::INFINITY),
-            }
+        let truth = f.truth.each_ref().map(|t| {
+            let why = t.vertex.as_ref().err().cloned();
+            (t.position, why)
         });
-        let unseen = LandmarkName::ALL.map(|n| {
-            f.detected
-                .as_ref()
-                .ok()
-                .and_then(|d| d.get(n).err())
-                .map(|u| u.to_string())
-        });
-        let predicted_unseen = match &f.detected {
-            Ok(d) => [LandmarkName::OuterEyeRight, LandmarkName::OuterEyeLeft]
-                .iter()
-                .filter(|&&n| d.get(n).is_err())
-                .map(|&n| (d.predicted[n as usize] - f.truth[n as usize].position).length())
-                .collect(),
-            Err(_) => Vec::new(),
-        };
+        let mut scored = score(&truth, f.detected.as_ref());
+        let outer = [LandmarkName::OuterEyeRight, LandmarkName::OuterEyeLeft];
+        scored.predicted_unseen.retain(|p| outer.contains(&p.0));
         outcomes.push(ScanOutcome {
             name: spec.name.clone(),
-            errors,
-            unseen,
-            predicted_unseen,
+            scored,
             not_found: f.detected.as_ref().err().cloned(),
             valid_samples: f.valid_samples,
             vertices: f.mesh.n_vertices(),
@@ -238,32 +205,22 @@ impl<'a> Summary<'a> {
     /// eye corner).
     fn predicted_quantiles(&self) -> Option<[f64; 3]> {
         let v = &self.predicted;
-        let q = |p: f64| v[((v.len() - 1) as f64 * p).round() as usize];
-        (!v.is_empty()).then(|| [q(0.5), q(0.95), q(1.0)])
+        (!v.is_empty()).then(|| [0.5, 0.95, 1.0].map(|p| quantile(v, p)))
     }
 
     fn of(outcomes: &'a [ScanOutcome]) -> Self {
-        // Errors of the landmarks whose truth is on the cleaned scan (inf: not found).
-        let st: Vec<Stats> = LandmarkName::ALL
-            .iter()
-            .map(|&n| {
-                let e: Vec<f64> = outcomes
-                    .iter()
-                    .filter_map(|o| o.errors[n as usize].as_ref().ok().copied())
-                    .collect();
-                stats(n.key(), &e)
-            })
-            .collect();
+        let scored: Vec<&Scored> = outcomes.iter().map(|o| &o.scored).collect();
         // Silent wrong landmarks: reported more than 10 mm off, or reported where the truth is
         // not on the cleaned scan (occluded, outside the grid or the crop).
         let silent: Vec<(String, String)> = outcomes
             .iter()
             .filter(|o| o.not_found.is_none())
             .flat_map(|o| {
+                let s = &o.scored;
                 LandmarkName::ALL
                     .iter()
-                    .filter(|&&n| o.unseen[n as usize].is_none())
-                    .filter_map(|&n| match &o.errors[n as usize] {
+                    .filter(|&&n| s.unseen[n as usize].is_none())
+                    .filter_map(|&n| match &s.errors[n as usize] {
                         Ok(e) if *e > 10.0 => Some((o.name.clone(), format!("{n} {e:.1} mm off"))),
                         Err(why) => Some((o.name.clone(), format!("{n} reported but {why}"))),
                         _ => None,
@@ -276,50 +233,33 @@ impl<'a> Summary<'a> {
             .filter_map(|o| o.not_found.as_deref().map(|e| (o.name.as_str(), e)))
             .collect();
         let n = outcomes.len();
-        let nf_rate = not_found.len() as f64 / n as f64;
         // Landmarks of found faces reported unseen: where the truth is not on the cleaned scan
         // (right) and where it is (a landmark not found).
-        let reported_unseen = |truth_on_scan: bool| -> usize {
-            outcomes
+        let count = |f: &dyn Fn(&Scored, usize) -> bool| -> usize {
+            scored
                 .iter()
-                .map(|o| {
-                    (0..5)
-                        .filter(|&k| o.unseen[k].is_some() && o.errors[k].is_ok() == truth_on_scan)
-                        .count()
-                })
+                .map(|o| (0..5).filter(|&k| f(o, k)).count())
                 .sum()
         };
-        let unseen: usize = outcomes
+        let reported = |on: bool| count(&|o, k| o.unseen[k].is_some() && o.errors[k].is_ok() == on);
+        let med =
+            |f: fn(&ScanOutcome) -> f64| quantile(&sorted(outcomes.iter().map(f).collect()), 0.5);
+        let predicted = scored
             .iter()
-            .map(|o| o.errors.iter().filter(|e| e.is_err()).count())
-            .sum();
-        let med = |v: &mut Vec<f64>| {
-            v.sort_by(f64::total_cmp);
-            v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
-        };
-        let mut vs: Vec<f64> = outcomes.iter().map(|o| o.valid_samples as f64).collect();
-        let mut vv: Vec<f64> = outcomes.iter().map(|o| o.vertices as f64).collect();
-        let mut dt: Vec<f64> = outcomes.iter().map(|o| o.detect_ms).collect();
+            .flat_map(|o| o.predicted_unseen.iter().map(|p| p.1));
         Summary {
             n,
-            st,
+            st: scored_stats(&scored),
             silent,
+            nf_rate: not_found.len() as f64 / n as f64,
             not_found,
-            nf_rate,
-            unseen_right: reported_unseen(false),
-            unseen_missed: reported_unseen(true),
-            unseen,
-            med_valid: med(&mut vs),
-            med_vertices: med(&mut vv),
-            med_detect: med(&mut dt),
-            predicted: {
-                let mut v: Vec<f64> = outcomes
-                    .iter()
-                    .flat_map(|o| o.predicted_unseen.iter().copied())
-                    .collect();
-                v.sort_by(f64::total_cmp);
-                v
-            },
+            unseen_right: reported(false),
+            unseen_missed: reported(true),
+            unseen: count(&|o, k| o.errors[k].is_err()),
+            med_valid: med(|o| o.valid_samples as f64),
+            med_vertices: med(|o| o.vertices as f64),
+            med_detect: med(|o| o.detect_ms),
+            predicted: sorted(predicted.collect()),
         }
     }
 
@@ -390,25 +330,8 @@ fn print_summary(
         "median {:.0} valid samples, {:.0} vertices after cleaning; detection wall time median {:.0} ms",
         s.med_valid, s.med_vertices, s.med_detect
     );
-    println!(
-        "{:<16} {:>5} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7}",
-        "landmark", "n", "mean", "median", "p95", "max", "<2.5", "<5", "<10", ">10 silent"
-    );
-    for (st, &nm) in s.st.iter().zip(&LandmarkName::ALL) {
-        println!(
-            "{:<16} {:>5} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>6.1}% {:>6.1}% {:>6.1}% {:>7}",
-            st.landmark,
-            st.n,
-            st.mean_mm,
-            st.median_mm,
-            st.p95_mm,
-            st.max_mm,
-            100.0 * st.within_2_5mm,
-            100.0 * st.within_5mm,
-            100.0 * st.within_10mm,
-            s.silent_of(nm)
-        );
-    }
+    let silent = LandmarkName::ALL.map(|n| s.silent_of(n));
+    print_table(&s.st, true, Some((">10 silent", &silent)));
     println!(
         "not found: {} of {n} faces ({:.1} %); ground-truth landmarks not on the cleaned scan: {}; scans that failed: {}",
         s.not_found.len(),
@@ -443,38 +366,33 @@ fn print_summary(
 
 /// One row per scanned face: the errors (or why the truth is not on the scan, and why a
 /// landmark was reported unseen), the scan's size, the detection time and its error.
-fn write_csv(path: &Path, outcomes: &[ScanOutcome]) -> Result<()> {
-    let names: Vec<&str> = LandmarkName::ALL.iter().map(|n| n.key()).collect();
-    let mut csv = format!(
-        "face,{},valid_samples,vertices,detect_ms,error\n",
-        names.join(",")
-    );
-    for o in outcomes {
-        let e: Vec<String> = o
-            .errors
-            .iter()
-            .zip(&o.unseen)
-            .map(|(e, u)| {
+fn write_per_face(path: &Path, outcomes: &[ScanOutcome]) -> Result<()> {
+    let names = LandmarkName::ALL.iter().map(|n| n.key());
+    let header: Vec<&str> = std::iter::once("face")
+        .chain(names)
+        .chain(["valid_samples", "vertices", "detect_ms", "error"])
+        .collect();
+    let rows: Vec<Vec<String>> = outcomes
+        .iter()
+        .map(|o| {
+            let s = &o.scored;
+            let e = s.errors.iter().zip(&s.unseen).map(|(e, u)| {
                 let reported = u
                     .as_deref()
                     .map(|u| format!(" (reported unseen: {u})"))
                     .unwrap_or_default();
-                match e {
+                text(&match e {
                     Ok(x) => format!("{x:.2}{reported}"),
-                    Err(why) => format!("unseen: {why}{reported}").replace(',', ";"),
-                }
-            })
-            .collect();
-        csv += &format!(
-            "{},{},{},{},{:.0},{}\n",
-            o.name,
-            e.join(","),
-            o.valid_samples,
-            o.vertices,
-            o.detect_ms,
-            o.not_found.as_deref().unwrap_or("").replace(',', ";")
-        );
-    }
-    std::fs::write(path, csv)?;
-    Ok(())
+                    Err(why) => format!("unseen: {why}{reported}"),
+                })
+            });
+            std::iter::once(o.name.clone())
+                .chain(e)
+                .chain([o.valid_samples.to_string(), o.vertices.to_string()])
+                .chain([format!("{:.0}", o.detect_ms)])
+                .chain([text(o.not_found.as_deref().unwrap_or(""))])
+                .collect()
+        })
+        .collect();
+    write_csv(path, &header, &rows)
 }

@@ -1,7 +1,9 @@
-//! Per-landmark error statistics and the error histogram shared by the evaluations on
-//! meshes, on range scans and beyond the model.
+//! Per-landmark error statistics, the error histogram and the scoring of a detection against
+//! the truth, shared by the evaluations on meshes, on range scans and beyond the model.
 
 use anyhow::Result;
+use landmarks::{LandmarkName, VisibleLandmarks};
+use meshcore::DVec3;
 use std::path::Path;
 
 /// Statistics of one landmark's errors (mm).
@@ -29,18 +31,23 @@ pub(super) struct Stats {
     pub within_10mm: f64,
 }
 
+/// The value at fraction `p` of the sorted values `v` (the nearest rank, rounded; NaN when
+/// empty).
+pub(super) fn quantile(v: &[f64], p: f64) -> f64 {
+    let k = ((v.len().max(1) - 1) as f64 * p).round() as usize;
+    v.get(k).copied().unwrap_or(f64::NAN)
+}
+
+/// `v` sorted.
+pub(super) fn sorted(mut v: Vec<f64>) -> Vec<f64> {
+    v.sort_by(f64::total_cmp);
+    v
+}
+
 /// The statistics of one landmark's errors `errs` (mm; infinite: not found).
 pub(super) fn stats(name: &str, errs: &[f64]) -> Stats {
-    let mut v = errs.to_vec();
-    v.sort_by(f64::total_cmp);
+    let v = sorted(errs.to_vec());
     let n = v.len();
-    let q = |p: f64| {
-        if n == 0 {
-            f64::NAN
-        } else {
-            v[((n - 1) as f64 * p).round() as usize]
-        }
-    };
     let finite: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
     let share = |t: f64| v.iter().filter(|&&x| x <= t).count() as f64 / n.max(1) as f64;
     Stats {
@@ -48,12 +55,53 @@ pub(super) fn stats(name: &str, errs: &[f64]) -> Stats {
         n,
         failures: n - finite.len(),
         mean_mm: finite.iter().sum::<f64>() / finite.len().max(1) as f64,
-        median_mm: q(0.5),
-        p95_mm: q(0.95),
-        max_mm: q(1.0),
+        median_mm: quantile(&v, 0.5),
+        p95_mm: quantile(&v, 0.95),
+        max_mm: quantile(&v, 1.0),
         within_2_5mm: share(2.5),
         within_5mm: share(5.0),
         within_10mm: share(10.0),
+    }
+}
+
+/// Prints the per-landmark table of `st`: with each landmark's count when `counts`, and the
+/// column `extra` (header, one value per landmark) last when given.
+pub(super) fn print_table(st: &[Stats], counts: bool, extra: Option<(&str, &[usize])>) {
+    let n = |s: &str| {
+        if counts {
+            format!(" {s:>5}")
+        } else {
+            String::new()
+        }
+    };
+    let x = |s: &str| extra.map_or(String::new(), |_| format!(" {s:>7}"));
+    println!(
+        "{:<16}{} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7}{}",
+        "landmark",
+        n("n"),
+        "mean",
+        "median",
+        "p95",
+        "max",
+        "<2.5",
+        "<5",
+        "<10",
+        x(extra.map_or("", |e| e.0))
+    );
+    for (k, s) in st.iter().enumerate() {
+        println!(
+            "{:<16}{} {:>7.2} {:>7.2} {:>7.2} {:>7.2} {:>6.1}% {:>6.1}% {:>6.1}%{}",
+            s.landmark,
+            n(&s.n.to_string()),
+            s.mean_mm,
+            s.median_mm,
+            s.p95_mm,
+            s.max_mm,
+            100.0 * s.within_2_5mm,
+            100.0 * s.within_5mm,
+            100.0 * s.within_10mm,
+            x(&extra.map_or(0, |e| e.1[k]).to_string())
+        );
     }
 }
 
@@ -70,4 +118,77 @@ pub(super) fn error_histogram(
         .collect();
     viz::histogram(path, title, "error (mm, clipped at 15)", &clipped, 30)?;
     Ok(())
+}
+
+/// The histogram of the errors of the landmarks whose truth is on the surface.
+pub(super) fn scored_histogram(path: &Path, title: &str, scored: &[&Scored]) -> Result<()> {
+    let series = LandmarkName::ALL
+        .iter()
+        .map(|&n| (n.key().to_string(), scored_errors(scored, n)))
+        .collect();
+    error_histogram(path, title, series)
+}
+
+/// A detection scored against the truth: per landmark the error in mm (`inf`: not placed, the
+/// face not found) or why the truth is not on the surface; why the detector reported a
+/// landmark unseen; per landmark reported unseen, how far its prediction is from the truth and
+/// whether the truth is on the surface.
+#[derive(Debug)]
+pub(super) struct Scored {
+    pub errors: [Result<f64, String>; 5],
+    pub unseen: [Option<String>; 5],
+    pub predicted_unseen: Vec<(LandmarkName, f64, bool)>,
+}
+
+/// Scores `detected` against `truth` (per landmark the true position and, when it is not on
+/// the surface, why).
+pub(super) fn score<E>(
+    truth: &[(DVec3, Option<String>); 5],
+    detected: Result<&VisibleLandmarks, E>,
+) -> Scored {
+    let errors = LandmarkName::ALL.map(|n| match (&truth[n as usize], &detected) {
+        ((_, Some(why)), _) => Err(why.clone()),
+        ((t, None), Ok(d)) => Ok(d
+            .get(n)
+            .map_or(f64::INFINITY, |l| (l.position - *t).length())),
+        (_, Err(_)) => Ok(f64::INFINITY),
+    });
+    let d = detected.ok();
+    let unseen = LandmarkName::ALL.map(|n| d.and_then(|d| d.get(n).err()).map(|u| u.to_string()));
+    let predicted_unseen = d.map_or_else(Vec::new, |d| {
+        LandmarkName::ALL
+            .iter()
+            .filter(|&&n| d.get(n).is_err())
+            .map(|&n| {
+                let (t, why) = &truth[n as usize];
+                (n, (d.predicted[n as usize] - *t).length(), why.is_none())
+            })
+            .collect()
+    });
+    Scored {
+        errors,
+        unseen,
+        predicted_unseen,
+    }
+}
+
+/// The errors of landmark `n` whose truth is on the surface.
+pub(super) fn scored_errors(scored: &[&Scored], n: LandmarkName) -> Vec<f64> {
+    scored
+        .iter()
+        .filter_map(|o| o.errors[n as usize].as_ref().ok().copied())
+        .collect()
+}
+
+/// The per-landmark statistics of the errors whose truth is on the surface.
+pub(super) fn scored_stats(scored: &[&Scored]) -> Vec<Stats> {
+    LandmarkName::ALL
+        .iter()
+        .map(|&n| stats(n.key(), &scored_errors(scored, n)))
+        .collect()
+}
+
+/// A CSV cell of free text: commas become semicolons.
+pub(super) fn text(s: &str) -> String {
+    s.replace(',', ";")
 }
