@@ -79,6 +79,15 @@ impl Report {
         self.csv(name, header, rows)
     }
 
+    /// Writes the matrix `m` as the CSV file `name`, rows and columns labelled by `labels`
+    /// (the header's first cell `face`).
+    pub fn matrix_csv(&self, name: &str, labels: &[impl AsRef<str>], m: &[Vec<f64>]) -> Result<()> {
+        let header: Vec<&str> = std::iter::once("face")
+            .chain(labels.iter().map(AsRef::as_ref))
+            .collect();
+        self.csv(name, &header, &labelled_rows(labels, m))
+    }
+
     /// Draws a line plot into `file` ([`line_plot`]) and appends it as a figure with `caption`.
     pub fn plot(
         &mut self,

@@ -189,7 +189,7 @@ pub(super) fn run(ctx: &Ctx<'_>, prep: &[FacePrep], res: &mut MethodResults) -> 
             )
         })
         .collect::<Result<_>>()?;
-    res.m_polar = ctx.matrix_pole(&polar, "single pole");
+    res.m_polar = ctx.matrix(&polar, "single pole");
     Ok(Base {
         sweep,
         static_,

@@ -77,7 +77,7 @@ pub(super) fn run(
         let dp = if g.cut_nose {
             f64::NAN
         } else {
-            ctx.dist_pole(&base.polar[test], &g.polar, || {
+            ctx.dist(&base.polar[test], &g.polar, || {
                 format!(
                     "{} (nose tip moved {} % at {:.1} deg)",
                     tf.name,

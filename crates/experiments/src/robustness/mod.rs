@@ -18,7 +18,7 @@ pub(crate) mod stats;
 
 use crate::paths::FaceSetArgs;
 use crate::pipeline::{
-    bipolar, dist, field, field_at, perturb, resolve_methods, DescriptorRule, Refs, Region,
+    bipolar, dist, field, field_at, perturb, resolve_methods, DescriptorRule, Keyed, Refs, Region,
 };
 use crate::polar::PolarOptions;
 use crate::report::Failures;
@@ -174,26 +174,13 @@ impl Ctx<'_> {
         }
     }
 
-    /// Distance of two face descriptors (NaN when either was refused or the distance failed).
-    fn dist(&self, a: &Desc, b: &Desc, what: impl FnOnce() -> String) -> f64 {
-        match (a, b) {
-            (Some(a), Some(b)) => self.score(dist(a, b), what),
-            _ => f64::NAN,
-        }
-    }
-
-    /// Distance of two single-pole descriptors.
-    fn dist_pole(
-        &self,
-        a: &PolarDescriptor,
-        b: &PolarDescriptor,
-        what: impl FnOnce() -> String,
-    ) -> f64 {
-        self.score(dist(a, b), what)
-    }
-
-    fn score(&self, r: Result<f64, ShapeDistError>, what: impl FnOnce() -> String) -> f64 {
-        match r {
+    /// Distance of two descriptors (NaN when either was refused or the distance failed; a
+    /// failure is listed under `what`, a pair with too few shared keys counted).
+    fn dist<T: AsKeyed>(&self, a: &T, b: &T, what: impl FnOnce() -> String) -> f64 {
+        let (Some(a), Some(b)) = (a.keyed(), b.keyed()) else {
+            return f64::NAN;
+        };
+        match dist(a, b) {
             Ok(d) => d,
             Err(ShapeDistError::TooFewPairs { .. }) => {
                 self.failures.too_few();
@@ -207,24 +194,9 @@ impl Ctx<'_> {
         }
     }
 
-    /// The pairwise matrix of face descriptors (failed cells NaN).
-    fn matrix(&self, descs: &[Desc], label: &str) -> Vec<Vec<f64>> {
-        self.pairwise(descs, label, |a, b, what| self.dist(a, b, what))
-    }
-
-    /// The pairwise matrix of single-pole descriptors.
-    fn matrix_pole(&self, descs: &[PolarDescriptor], label: &str) -> Vec<Vec<f64>> {
-        self.pairwise(descs, label, |a, b, what| self.dist_pole(a, b, what))
-    }
-
-    /// The matrix of `dist` over the pairs of `descs` (one per face, in face order) by
-    /// `shapedist::pairwise_matrix`; `dist` gets the pair's name for its failure message.
-    fn pairwise<T: Sync>(
-        &self,
-        descs: &[T],
-        label: &str,
-        dist: impl Fn(&T, &T, &dyn Fn() -> String) -> f64 + Sync,
-    ) -> Vec<Vec<f64>> {
+    /// The matrix of [`Ctx::dist`] over the pairs of `descs` (one per face, in face order) by
+    /// `shapedist::pairwise_matrix`, failures named by `label` and the pair.
+    fn matrix<T: AsKeyed>(&self, descs: &[T], label: &str) -> Vec<Vec<f64>> {
         let items: Vec<(&str, &T)> = self
             .faces
             .iter()
@@ -232,9 +204,8 @@ impl Ctx<'_> {
             .zip(descs)
             .collect();
         let m = shapedist::pairwise_matrix(&items, |a, b| {
-            Ok::<f64, std::convert::Infallible>(dist(a.1, b.1, &|| {
-                format!("{label}: {} vs {}", a.0, b.0)
-            }))
+            let what = || format!("{label}: {} vs {}", a.0, b.0);
+            Ok::<f64, std::convert::Infallible>(self.dist(a.1, b.1, what))
         });
         match m {
             Ok(m) => m,
@@ -249,6 +220,28 @@ impl Ctx<'_> {
             levels: self.args.set.res.levels,
             sectors: self.args.set.res.sectors,
         }
+    }
+}
+
+/// A descriptor as the distances take it: absent where `bipolar` refused it.
+trait AsKeyed: Sync {
+    /// The keyed point set.
+    type K: Keyed;
+    /// The descriptor, if any.
+    fn keyed(&self) -> Option<&Self::K>;
+}
+
+impl AsKeyed for Desc {
+    type K = bipolar::Descriptor;
+    fn keyed(&self) -> Option<&Self::K> {
+        self.as_ref()
+    }
+}
+
+impl AsKeyed for PolarDescriptor {
+    type K = PolarDescriptor;
+    fn keyed(&self) -> Option<&Self::K> {
+        Some(self)
     }
 }
 

@@ -112,6 +112,6 @@ pub(super) fn run(ctx: &Ctx<'_>, prep: &[FacePrep], res: &mut MethodResults) -> 
     }
     res.m_rand_one = ctx.matrix(&one, "random error on q");
     res.m_rand_both = ctx.matrix(&both, "random errors on r and q");
-    res.m_rand_nose = ctx.matrix_pole(&nose, "single pole, random error on the nose tip");
+    res.m_rand_nose = ctx.matrix(&nose, "single pole, random error on the nose tip");
     Ok(())
 }

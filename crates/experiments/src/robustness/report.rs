@@ -60,14 +60,7 @@ impl Input<'_> {
     ) -> Result<()> {
         let fname = format!("{stem}.svg");
         viz::heatmap(rep.path(&fname), title, &self.labels, m, "distance")?;
-        let header: Vec<&str> = std::iter::once("face")
-            .chain(self.labels.iter().map(String::as_str))
-            .collect();
-        rep.csv(
-            &format!("{stem}.csv"),
-            &header,
-            &labelled_rows(&self.labels, m),
-        )?;
+        rep.matrix_csv(&format!("{stem}.csv"), &self.labels, m)?;
         rep.figure(&fname, caption);
         Ok(())
     }
