@@ -37,15 +37,6 @@ pub(super) struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
-    /// `r`'s value, or `None` with its error listed (described by `what`).
-    fn ok<T, E: std::fmt::Display>(
-        &self,
-        r: Result<T, E>,
-        what: impl FnOnce() -> String,
-    ) -> Option<T> {
-        self.failures.ok(r, what)
-    }
-
     /// The static-area bipolar descriptor of `refs` (`None`: refused, listed).
     pub(super) fn bipolar(
         &self,
@@ -64,7 +55,8 @@ impl Ctx<'_> {
             None,
             None,
         );
-        self.ok(d, || format!("bipolar descriptor of {name}"))
+        self.failures
+            .ok(d, || format!("bipolar descriptor of {name}"))
     }
 
     /// Single pole, facial curves and iso-curvature (region of radius D) from the nose field
@@ -84,15 +76,19 @@ impl Ctx<'_> {
             sectors: self.args.set.res.sectors,
         };
         let polar = polar_descriptor(walker, un, nose, 0.5 * (refs.r + refs.q), &popts);
-        let polar = self.ok(polar, || format!("single pole of {name}"));
+        let polar = self.failures.ok(polar, || format!("single pole of {name}"));
         let surface = Surface::new(mesh.clone());
         let facial = facial_curves(&surface, un, refs.d, n);
         let iso = iso_curves(&surface, un, refs.d, &self.iso_levels);
         Descs {
             bipolar: None,
             polar: Some(polar.unwrap_or_else(|| polar::empty(&popts))),
-            facial: self.ok(facial, || format!("facial curves of {name}")),
-            iso: self.ok(iso, || format!("iso-curvature curves of {name}")),
+            facial: self
+                .failures
+                .ok(facial, || format!("facial curves of {name}")),
+            iso: self
+                .failures
+                .ok(iso, || format!("iso-curvature curves of {name}")),
         }
     }
 
@@ -127,6 +123,7 @@ impl Ctx<'_> {
             let r = facial_distance(x, y, &ElasticOptions::default());
             t[2] = t0.elapsed();
             d[2] = self
+                .failures
                 .ok(r, || format!("facial distance {what}"))
                 .unwrap_or(f64::NAN);
         }
@@ -135,6 +132,7 @@ impl Ctx<'_> {
             let r = iso_distance(x, y);
             t[3] = t0.elapsed();
             d[3] = self
+                .failures
                 .ok(r, || format!("iso-curvature distance {what}"))
                 .unwrap_or(f64::NAN);
         }

@@ -114,7 +114,7 @@ pub fn run(args: Args) -> Result<()> {
     };
     let base = describe_all(&ctx, &faces, &preps, &walkers);
     // Renders of the two curve representations on the test face.
-    write::renders(&out, tf, &base[test])?;
+    write::renders(&out, tf, &tp.refs.frame, &base[test])?;
     let set = Set {
         faces: &faces,
         preps: &preps,

@@ -12,10 +12,10 @@ use crate::robustness::pole::ROTATED;
 use crate::robustness::stats::{max, mean, verdict};
 use anyhow::Result;
 use facecurves::PrincipalField;
-use facemodel::{face_frame, Face};
+use facemodel::{Face, FaceFrame};
 use std::path::Path;
 use std::time::Instant;
-use viz::{Polyline, Scene};
+use viz::Scene;
 
 /// Colour of the k1 iso-curvature curves.
 const RED: [u8; 3] = [0xc0, 0x39, 0x2b];
@@ -24,33 +24,25 @@ const BLUE: [u8; 3] = [0x24, 0x71, 0xa3];
 /// Colour of the facial curves.
 const GREEN: [u8; 3] = [0x27, 0xae, 0x60];
 
-/// Renders `lines` on `face` into `path`, seen from the front of its landmark frame.
-fn render(path: &Path, face: &Face, lines: Vec<Polyline>) -> Result<()> {
-    let lm = face.landmarks;
-    let frame = face_frame(
-        &face.mesh,
-        face.mesh.position(lm.right_eye_outer),
-        face.mesh.position(lm.left_eye_outer),
-        face.mesh.position(lm.nose_tip),
-    );
-    let mut scene = Scene::new(&face.mesh);
-    scene.polylines = lines;
-    render_face(path, &scene, frame.up, frame.forward)
-}
-
-/// Figure 14 style: the iso-curvature network (k1 red, k2 blue); the facial curves (green).
-pub(super) fn renders(out: &Path, face: &Face, d: &Descs) -> Result<()> {
+/// Figure 14 style on `face` seen from the front of its landmark `frame`: the iso-curvature
+/// network (k1 red, k2 blue); the facial curves (green).
+pub(super) fn renders(out: &Path, face: &Face, frame: &FaceFrame, d: &Descs) -> Result<()> {
+    let render = |file: &str, lines| {
+        let mut scene = Scene::new(&face.mesh);
+        scene.polylines = lines;
+        render_face(&out.join(file), &scene, frame.up, frame.forward)
+    };
     if let Some(iso) = &d.iso {
         let color = |f| if f == PrincipalField::K1 { RED } else { BLUE };
         let lines = iso
             .curves
             .iter()
             .map(|c| (c.points.clone(), c.closed, color(c.field)));
-        render(&out.join("iso_curvature.svg"), face, polylines(lines, 1.4))?;
+        render("iso_curvature.svg", polylines(lines, 1.4))?;
     }
     if let Some(f) = &d.facial {
         let lines = f.curves.iter().map(|c| (c.points.clone(), c.closed, GREEN));
-        render(&out.join("facial_curves.svg"), face, polylines(lines, 1.6))?;
+        render("facial_curves.svg", polylines(lines, 1.6))?;
     }
     Ok(())
 }
@@ -222,13 +214,8 @@ fn between_section(rep: &mut Report, r: &Results<'_>) -> Result<()> {
     );
     for (k, m) in mats.iter().enumerate() {
         let name = format!("matrix_{}.csv", REPS[k].replace(' ', "_"));
-        let mut header = vec!["face"];
-        header.extend(faces.iter().map(|f| f.name.as_str()));
-        rep.csv(
-            &name,
-            &header,
-            &crate::report::labelled_rows(&header[1..], m),
-        )?;
+        let labels: Vec<&str> = faces.iter().map(|f| f.name.as_str()).collect();
+        rep.matrix_csv(&name, &labels, m)?;
     }
     rep.para(&format!("Times: median wall time of one comparison on one thread (a one-thread pool), over the test face's {n_timed} comparisons, on a shared machine (compare them as ratios)."));
     Ok(())
