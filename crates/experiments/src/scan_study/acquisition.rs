@@ -4,53 +4,44 @@
 use anyhow::{bail, Result};
 use facemodel::Face;
 use meshcore::{DVec3, FaceLocator, SurfacePoint, TriMesh};
-use rangescan::{Artifacts, DepthNoise, HeadPose, Quantisation, ScanOptions};
+use rangescan::ScanSettings;
 use scanprep::{CleanOptions, Crop, Input};
 
 /// One way of acquiring a face.
 #[derive(Debug, Clone)]
 pub(super) struct Setting {
     pub(super) name: &'static str,
-    /// `None`: the face mesh itself, scaled to mm (no scanner).
-    pub(super) scan: Option<ScanSpec>,
+    /// The scanner settings and the scan's seed; `None`: the face mesh itself, scaled to mm (no
+    /// scanner).
+    pub(super) scan: Option<(ScanSettings, u64)>,
 }
 
-#[derive(Debug, Clone, Copy)]
-pub(super) struct ScanSpec {
-    pitch_mm: f64,
-    noise_mm: f64,
-    pub(super) quant_mm: Option<f64>,
-    yaw_deg: f64,
-    pitch_deg: f64,
-    seed: u64,
-}
-
-/// The fixed list of settings: seven scans (name, pitch mm, noise mm, quantisation mm, yaw and
-/// pitch degrees; seeds 1-7) and the face mesh itself, last.
+/// The fixed list of settings: seven scans with the structured-light artifacts (name, pitch
+/// mm, noise mm, quantisation mm, yaw and pitch degrees; seeds 1-7) and the face mesh itself,
+/// last.
 pub(super) fn settings() -> Vec<Setting> {
-    type Scan = (&'static str, f64, f64, Option<f64>, f64, f64);
-    const SCANS: [Scan; 7] = [
-        ("p0.75 n0.1", 0.75, 0.1, None, 0.0, 0.0),
-        ("p0.5 n0.1", 0.5, 0.1, None, 0.0, 0.0),
-        ("p1.0 n0.1", 1.0, 0.1, None, 0.0, 0.0),
-        ("p0.75 n0.2", 0.75, 0.2, None, 0.0, 0.0),
-        ("p0.75 yaw20", 0.75, 0.1, None, 20.0, 0.0),
-        ("p0.75 pitch10", 0.75, 0.1, None, 0.0, 10.0),
-        ("p0.75 q2mm", 0.75, 0.1, Some(2.0), 0.0, 0.0),
+    const SCANS: [(&str, f64, f64, f64, f64, f64); 7] = [
+        ("p0.75 n0.1", 0.75, 0.1, 0.0, 0.0, 0.0),
+        ("p0.5 n0.1", 0.5, 0.1, 0.0, 0.0, 0.0),
+        ("p1.0 n0.1", 1.0, 0.1, 0.0, 0.0, 0.0),
+        ("p0.75 n0.2", 0.75, 0.2, 0.0, 0.0, 0.0),
+        ("p0.75 yaw20", 0.75, 0.1, 0.0, 20.0, 0.0),
+        ("p0.75 pitch10", 0.75, 0.1, 0.0, 0.0, 10.0),
+        ("p0.75 q2mm", 0.75, 0.1, 2.0, 0.0, 0.0),
     ];
     let scans = SCANS.iter().zip(1..).map(|(s, seed)| {
-        let &(name, pitch_mm, noise_mm, quant_mm, yaw_deg, pitch_deg) = s;
-        let spec = ScanSpec {
+        let &(name, pitch_mm, noise_mm, quantisation_mm, yaw_deg, pitch_deg) = s;
+        let settings = ScanSettings {
             pitch_mm,
             noise_mm,
-            quant_mm,
+            quantisation_mm,
             yaw_deg,
             pitch_deg,
-            seed,
+            ..ScanSettings::default()
         };
         Setting {
             name,
-            scan: Some(spec),
+            scan: Some((settings, seed)),
         }
     });
     let mesh = Setting {
@@ -72,35 +63,13 @@ pub(super) fn acquire(
 ) -> Result<(TriMesh, [DVec3; 3], Vec<String>)> {
     let lm = face.landmarks;
     let truth = [lm.right_eye_outer, lm.left_eye_outer, lm.nose_tip].map(|v| face.mesh.position(v));
-    let Some(spec) = setting.scan else {
-        let mesh = TriMesh::new(
-            face.mesh
-                .positions()
-                .iter()
-                .map(|p| *p * MM_PER_CM)
-                .collect(),
-            face.mesh.triangles().to_vec(),
-        )?;
+    let Some((settings, seed)) = setting.scan else {
+        let mesh = face
+            .mesh
+            .transformed(&meshcore::DAffine3::from_scale(DVec3::splat(MM_PER_CM)));
         return Ok((mesh, truth.map(|p| p * MM_PER_CM), Vec::new()));
     };
-    let artifacts = Artifacts {
-        noise: Some(DepthNoise {
-            sigma_mm: spec.noise_mm,
-        }),
-        quantisation: spec.quant_mm.map(|step_mm| Quantisation { step_mm }),
-        ..Artifacts::structured_light()
-    };
-    let opts = ScanOptions {
-        input_mm_per_unit: MM_PER_CM,
-        pitch_mm: spec.pitch_mm,
-        pose: HeadPose {
-            yaw_deg: spec.yaw_deg,
-            pitch_deg: spec.pitch_deg,
-        },
-        artifacts,
-        seed: spec.seed,
-        ..ScanOptions::default()
-    };
+    let opts = settings.options(MM_PER_CM, seed);
     let names = ["right_eye_outer", "left_eye_outer", "nose_tip"];
     let marks: Vec<(String, DVec3)> = names
         .iter()

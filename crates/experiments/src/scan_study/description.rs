@@ -78,12 +78,7 @@ fn landmark_fields(
     sp: &[SurfacePoint; 3],
     pos: &[DVec3; 3],
 ) -> Result<Fields> {
-    let max_edge = (0..mesh.n_faces() as u32)
-        .flat_map(|f| {
-            let [a, b, c] = mesh.face_corners(f);
-            [(a - b).length(), (b - c).length(), (c - a).length()]
-        })
-        .fold(0.0f64, f64::max);
+    let max_edge = mesh.longest_edge();
     let cut = 1.4 * (pos[0] - pos[1]).length() + max_edge;
     let solve = |s: SurfacePoint| -> Result<Vec<f64>> {
         Ok(solver.distances(

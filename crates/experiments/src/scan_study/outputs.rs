@@ -245,7 +245,7 @@ impl Study<'_> {
         let rescan = |p: &ScanPair| {
             [p.a, p.b]
                 .iter()
-                .all(|&i| scanned(i).is_some_and(|s| s.quant_mm.is_none()))
+                .all(|&i| scanned(i).is_some_and(|s| s.0.quantisation_mm == 0.0))
                 && (p.rel != Relation::SameFace || faces[scans[p.a].face].expression == "neutral")
         };
         let (mut rows, mut ratios) = (Vec::new(), Vec::new());
