@@ -189,24 +189,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     std::fs::create_dir_all(&out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
     let meshes = meshes()?;
     let m = measure(&meshes)?;
-    let header = "mesh,vertices,mean_edge,levels,rule,method,points,analytic_points,common_keys,shape_distance,mean_position_error,mean_cos_error,max_cos_error,describe_ms";
-    let rows: Vec<Vec<String>> = m.rows.iter().map(|r| r.cells(true)).collect();
-    crate::report::write_csv(
-        &out_dir.join("results.csv"),
-        &header.split(',').collect::<Vec<_>>(),
-        &rows,
-    )?;
     let plots = output::write_plots(&out_dir, &m.rows, &meshes)?;
     let renders = output::write_renders(&out_dir, &meshes[1])?;
-    let inputs = output::ReportInputs {
-        meshes: &meshes,
-        solver_name: m.solver_name,
-        geodesic_ms: &m.geodesic_ms,
-        plots: &plots,
-        renders: &renders,
-        t_start,
-    };
-    let md = output::write_report(&out_dir, &m.rows, &inputs)?;
+    let md = output::write_report(&out_dir, &m, &meshes, (&plots, &renders), t_start)?;
     println!("{}", md.lines().take(12).collect::<Vec<_>>().join("\n"));
     println!("wrote {}", out_dir.display());
     Ok(())
@@ -217,6 +202,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 struct Measured {
     rows: Vec<Row>,
     solver_name: &'static str,
+    /// Time of both pole fields per mesh (name, ms).
     geodesic_ms: Vec<(String, f64)>,
 }
 

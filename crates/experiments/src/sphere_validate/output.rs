@@ -1,7 +1,7 @@
 //! What `sphere-validate` writes besides `results.csv`: the line plots, the renders on ico4
 //! and `report.md` with the verdict on the paper's claim.
 
-use super::{truth, Row, SphereMesh, ALPHA, K, LEVELS, METHODS};
+use super::{truth, Measured, Row, SphereMesh, ALPHA, K, LEVELS, METHODS};
 use crate::report::{joined, markers, polylines, Report};
 use bipolar::SelectionRule;
 use glam::DVec3;
@@ -195,39 +195,34 @@ fn verdict(rows: &[Row], meshes: &[SphereMesh]) -> String {
     .join("\n")
 }
 
-/// What the report is written from besides the rows.
-pub(super) struct ReportInputs<'a> {
-    /// The sphere meshes.
-    pub meshes: &'a [SphereMesh],
-    /// The geodesic solver used.
-    pub solver_name: &'a str,
-    /// Time of both pole fields per mesh (name, ms).
-    pub geodesic_ms: &'a [(String, f64)],
-    /// Plot files.
-    pub plots: &'a [String],
-    /// Render files.
-    pub renders: &'a [String],
-    /// Start of the run (for the total time).
-    pub t_start: Instant,
-}
-
-/// Writes `report.md` (method, verdict, a table per rule, the files) and returns its text.
+/// Writes `results.csv` (every row) and `report.md` (method, verdict, a table per rule, the
+/// files: `plots` and `renders`) and returns the report's text; `t_start`: the run's start.
 pub(super) fn write_report(
     out_dir: &Path,
-    rows: &[Row],
-    inp: &ReportInputs<'_>,
+    m: &Measured,
+    meshes: &[SphereMesh],
+    (plots, renders): (&[String], &[String]),
+    t_start: Instant,
 ) -> anyhow::Result<String> {
+    let rows = &m.rows;
     let mut rep = Report::new(out_dir, "Sphere validation (the paper's section 3)")?;
+    let header = "mesh,vertices,mean_edge,levels,rule,method,points,analytic_points,common_keys,shape_distance,mean_position_error,mean_cos_error,max_cos_error,describe_ms";
+    let cells: Vec<Vec<String>> = rows.iter().map(|r| r.cells(true)).collect();
+    rep.csv(
+        "results.csv",
+        &header.split(',').collect::<Vec<_>>(),
+        &cells,
+    )?;
     rep.para(&format!(
         "Unit sphere, poles r = +Z and q = +X (orthogonal, d = pi/2), geodesic fields from the **{}** solver, step = d/N, levels 1..2N-1 of both fields, K = {K}, alpha = {ALPHA}. Shape distance: normalised keyed L2 after centring and the best rotation, over keys present (and unambiguous) in both the mesh descriptor and the analytic one (`shapedist::align_pairs`, Kabsch with the reflection guard). Position error: mean |P_mesh - P_exact| over those keys. Cos error: mean |cos_mesh - cos_exact(P_mesh)|, where cos_exact is the spherical law of cosines at the mesh point (for iso-angle points cos is the target by construction, so their error shows in the positions).",
-        inp.solver_name
+        m.solver_name
     ));
     rep.para(&format!(
         "Geodesic time per mesh (both fields): {}",
-        joined(inp.geodesic_ms, ", ", |(n, t)| format!("{n}: {t:.0} ms"))
+        joined(&m.geodesic_ms, ", ", |(n, t)| format!("{n}: {t:.0} ms"))
     ));
     rep.heading(2, "Verdict");
-    rep.para(&verdict(rows, inp.meshes));
+    rep.para(&verdict(rows, meshes));
     let header = [
         "mesh",
         "N",
@@ -252,12 +247,12 @@ pub(super) fn write_report(
     }
     rep.heading(2, "Files");
     let files = std::iter::once("* `results.csv`: every row above.".to_string())
-        .chain(inp.plots.iter().map(|p| format!("* `{p}`")))
-        .chain(inp.renders.iter().map(|p| format!("* `{p}`: level curves of r (red) and q (blue) on ico4, N = 8; analytic iso-angle points black, mesh descriptor points yellow.")));
+        .chain(plots.iter().map(|p| format!("* `{p}`")))
+        .chain(renders.iter().map(|p| format!("* `{p}`: level curves of r (red) and q (blue) on ico4, N = 8; analytic iso-angle points black, mesh descriptor points yellow.")));
     rep.para(&files.collect::<Vec<_>>().join("\n"));
     rep.para(&format!(
         "Total time: {:.1} s.",
-        inp.t_start.elapsed().as_secs_f64()
+        t_start.elapsed().as_secs_f64()
     ));
     rep.finish()?;
     Ok(rep.markdown().to_string())
