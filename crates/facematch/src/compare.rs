@@ -30,6 +30,19 @@ pub enum ViewUse {
     },
 }
 
+impl ViewUse {
+    /// The view used in a word or two: `off`, `own`, `view +15` (the matched view's turn) or
+    /// `own (fallback)`.
+    pub fn label(&self) -> String {
+        match self {
+            ViewUse::Off => "off".into(),
+            ViewUse::Own { .. } => "own".into(),
+            ViewUse::Matched { yaw_deg, .. } => format!("view {yaw_deg:+}"),
+            ViewUse::Fallback { .. } => "own (fallback)".into(),
+        }
+    }
+}
+
 /// What one pair's distance used.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PairUse {

@@ -28,6 +28,7 @@
 mod compare;
 mod describe;
 mod error;
+mod evaluate;
 mod fields;
 pub mod fixture;
 mod gallery;
@@ -42,6 +43,7 @@ mod view;
 pub use compare::{compare, pair_score, Comparison, PairUse, ViewUse};
 pub use describe::{describe, describe_with_fields, kept_vertices, Description, FaceFields};
 pub use error::MatchError;
+pub use evaluate::{evaluate, Evaluation, FallbackCount};
 pub use fields::{description_fields, face_fields};
 pub use gallery::{rank, Gallery, Ranked};
 pub use keyed::KeyedSet;

@@ -265,6 +265,30 @@ impl FaceModel {
         w
     }
 
+    /// The weights of `identities` x `expressions` faces drawn from `rng` identity by identity:
+    /// its [`FaceModel::random_identity`], then per face after the first (which is neutral:
+    /// no weights) a [`FaceModel::random_expression`]; as `(identity weights, expression
+    /// weights per face)`.
+    pub fn random_faces<R: Rng>(
+        &self,
+        rng: &mut R,
+        identities: usize,
+        expressions: usize,
+    ) -> Vec<(Vec<f64>, Vec<Vec<f64>>)> {
+        (0..identities)
+            .map(|_| {
+                let w = self.random_identity(rng);
+                let ex = (0..expressions)
+                    .map(|e| match e {
+                        0 => Vec::new(),
+                        _ => self.random_expression(rng),
+                    })
+                    .collect();
+                (w, ex)
+            })
+            .collect()
+    }
+
     /// Positions of the named landmarks on a sampled (possibly moved) face, in
     /// [`LANDMARK_NAMES`] order.
     pub fn landmark_positions(&self, mesh: &TriMesh) -> Result<[DVec3; 5], FaceModelError> {
@@ -455,6 +479,23 @@ mod tests {
             let (_, ex, _, _) = draw(seed);
             assert!(ex.iter().all(|w| (0.0..=1.0).contains(w)), "{ex:?}");
         }
+    }
+
+    #[test]
+    fn random_faces_draw_identity_then_expressions_first_neutral() {
+        let m = FaceModel::load(&write_model("faces")).unwrap();
+        let faces = m.random_faces(&mut ChaCha8Rng::seed_from_u64(3), 2, 3);
+        // The same stream drawn by hand, in the same order.
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        for (w, ex) in &faces {
+            assert_eq!(*w, m.random_identity(&mut rng));
+            assert!(ex[0].is_empty() && ex.len() == 3);
+            for e in &ex[1..] {
+                assert_eq!(*e, m.random_expression(&mut rng));
+            }
+        }
+        assert_eq!(faces.len(), 2);
+        assert_ne!(faces[0].0, faces[1].0);
     }
 
     #[test]

@@ -130,6 +130,28 @@ pub fn new_solver(
     })
 }
 
+/// The method a solver can be prepared with on `mesh` when `requested` is asked for:
+/// `requested` itself or, for [`Method::Exact`] when it cannot be prepared, [`Method::Fmm`],
+/// then [`Method::Heat`]. Returns the method used (`None`: none could be prepared) and each
+/// method tried before it that could not be, with its error.
+pub fn usable_method(
+    mesh: &TriMesh,
+    requested: Method,
+) -> (Option<Method>, Vec<(Method, GeodesicError)>) {
+    let chain = match requested {
+        Method::Exact => vec![Method::Exact, Method::Fmm, Method::Heat],
+        other => vec![other],
+    };
+    let mut failed = Vec::new();
+    for m in chain {
+        match new_solver(mesh, m) {
+            Ok(_) => return (Some(m), failed),
+            Err(e) => failed.push((m, e)),
+        }
+    }
+    (None, failed)
+}
+
 /// One distance field per entry of `sources`, computed in parallel (rayon) with the same solver
 /// and options: [`GeodesicSolver::distances_many`]. Equivalent to calling
 /// [`GeodesicSolver::distances`] for each entry in turn; the first error (in input order) is
@@ -140,4 +162,26 @@ pub fn distances_many(
     opts: &SolveOptions,
 ) -> Result<Vec<Vec<f64>>, GeodesicError> {
     solver.distances_many(sources, opts)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_usable_method_is_the_requested_one_where_it_can_be_prepared() {
+        let sphere = meshcore::shapes::icosphere(1);
+        for m in [Method::Exact, Method::Fmm, Method::Heat, Method::Dijkstra] {
+            let (used, failed) = usable_method(&sphere, m);
+            assert_eq!(used, Some(m));
+            assert!(failed.is_empty());
+        }
+        // A degenerate mesh (one point): whatever is used, the methods tried before it are
+        // named in order, and the exact request never goes past heat.
+        let point = TriMesh::new(vec![meshcore::DVec3::ZERO; 3], vec![[0, 1, 2]]).unwrap();
+        let (used, failed) = usable_method(&point, Method::Exact);
+        let chain = [Method::Exact, Method::Fmm, Method::Heat];
+        let tried: Vec<Method> = failed.iter().map(|f| f.0).chain(used).collect();
+        assert_eq!(tried, chain[..tried.len()]);
+    }
 }

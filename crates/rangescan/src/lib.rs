@@ -44,7 +44,7 @@ pub use artifacts::{
 };
 pub use camera::{HeadPose, Projection};
 pub use flying::{add_flying_pixels, FlyingPixels};
-pub use settings::{scan_seed, ScanSettings};
+pub use settings::{random_scanner, scan_seed, ScanSettings, PROBE_NOISE_MM};
 pub use visibility::visible_faces;
 
 use camera::Camera;

@@ -2,7 +2,8 @@
 //! the structured-light artifacts switched on or off, head pose), the [`ScanOptions`] they
 //! give, and the seeds of the scans of a set.
 
-use crate::{Artifacts, DepthNoise, HeadPose, Quantisation, ScanOptions};
+use crate::{Artifacts, DepthNoise, HeadPose, Holes, Quantisation, ScanOptions, Spikes};
+use rand::Rng;
 
 /// The scanner settings of one scan: [`Artifacts::structured_light`] with its noise and
 /// quantisation given here and its spikes and holes switched on or off.
@@ -78,6 +79,18 @@ impl ScanSettings {
         }
     }
 
+    /// A probe of the scan benchmark drawn from `rng`: these settings with a head yaw of 0-45
+    /// whole degrees to either side and one of the [`PROBE_NOISE_MM`] noise levels.
+    pub fn random_probe<R: Rng>(&self, rng: &mut R) -> ScanSettings {
+        let yaw = rng.random_range(0..=45) as f64 * if rng.random::<bool>() { 1.0 } else { -1.0 };
+        let noise = PROBE_NOISE_MM[rng.random_range(0..PROBE_NOISE_MM.len())];
+        ScanSettings {
+            yaw_deg: yaw,
+            noise_mm: noise,
+            ..*self
+        }
+    }
+
     /// A short label (`pitch 0.5 mm, noise 0.1 mm, holes, spikes, yaw 30`).
     pub fn label(&self) -> String {
         let mut s = format!("pitch {} mm, noise {} mm", self.pitch_mm, self.noise_mm);
@@ -111,6 +124,46 @@ pub fn scan_seed(seed: u64, index: u64) -> u64 {
     z ^ (z >> 31)
 }
 
+/// Depth noise levels of the scan benchmark's probes ([`ScanSettings::random_probe`]), mm.
+pub const PROBE_NOISE_MM: [f64; 3] = [0.1, 0.2, 0.4];
+
+/// A scanner unlike the benchmark's [`ScanSettings`], drawn from `rng` (one draw per scan):
+/// pitch 0.4-0.8 mm, head yaw up to 20 and pitch up to 10 degrees either way, depth noise
+/// 0.05-0.3 mm, spikes of 3-15 mm on 0.05-0.3 % of the samples, 2-8 holes of 1-6 mm radius
+/// anywhere, the other artifacts [`Artifacts::structured_light`]'s; for a mesh in units of
+/// `input_mm_per_unit` mm, with the artifacts' `seed`.
+pub fn random_scanner<R: Rng>(rng: &mut R, input_mm_per_unit: f64, seed: u64) -> ScanOptions {
+    let sl = Artifacts::structured_light();
+    let spike_min = rng.random_range(3.0..8.0);
+    let hole_min = rng.random_range(1.0..3.0);
+    ScanOptions {
+        input_mm_per_unit,
+        pitch_mm: rng.random_range(0.4..=0.8),
+        pose: HeadPose {
+            yaw_deg: rng.random_range(-20.0..=20.0),
+            pitch_deg: rng.random_range(-10.0..=10.0),
+        },
+        artifacts: Artifacts {
+            noise: Some(DepthNoise {
+                sigma_mm: rng.random_range(0.05..0.3),
+            }),
+            spikes: Some(Spikes {
+                fraction: rng.random_range(0.0005..0.003),
+                min_mm: spike_min,
+                max_mm: rng.random_range(spike_min..=15.0),
+            }),
+            holes: Some(Holes {
+                count: rng.random_range(2..=8),
+                min_radius_mm: hole_min,
+                max_radius_mm: rng.random_range(hole_min..=6.0),
+            }),
+            ..sl
+        },
+        seed,
+        ..ScanOptions::default()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -139,6 +192,57 @@ mod tests {
             (10.0, 42, 30.0)
         );
         assert_eq!(o.artifacts, a);
+    }
+
+    #[test]
+    fn random_probes_turn_and_add_noise_only() {
+        use rand::SeedableRng;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+        let base = ScanSettings {
+            pitch_mm: 0.7,
+            ..ScanSettings::default()
+        };
+        let probes: Vec<ScanSettings> = (0..300).map(|_| base.random_probe(&mut rng)).collect();
+        for p in &probes {
+            assert!(p.yaw_deg.abs() <= 45.0 && p.yaw_deg.fract() == 0.0);
+            assert!(PROBE_NOISE_MM.contains(&p.noise_mm));
+            let back = ScanSettings {
+                yaw_deg: 0.0,
+                noise_mm: base.noise_mm,
+                ..*p
+            };
+            assert_eq!(back, base);
+        }
+        // Both sides, every noise level.
+        assert!(
+            probes.iter().any(|p| p.yaw_deg < -20.0) && probes.iter().any(|p| p.yaw_deg > 20.0)
+        );
+        for n in PROBE_NOISE_MM {
+            assert!(probes.iter().any(|p| p.noise_mm == n));
+        }
+    }
+
+    #[test]
+    fn random_scanners_stay_in_their_ranges_and_repeat() {
+        use rand::SeedableRng;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let draws: Vec<ScanOptions> = (0..200)
+            .map(|k| random_scanner(&mut rng, 10.0, k))
+            .collect();
+        for (k, o) in draws.iter().enumerate() {
+            let a = &o.artifacts;
+            assert!((0.4..=0.8).contains(&o.pitch_mm) && o.seed == k as u64);
+            assert!(o.pose.yaw_deg.abs() <= 20.0 && o.pose.pitch_deg.abs() <= 10.0);
+            let (sp, h) = (a.spikes.unwrap(), a.holes.unwrap());
+            assert!(3.0 <= sp.min_mm && sp.min_mm <= sp.max_mm && sp.max_mm <= 15.0);
+            assert!((2..=8).contains(&h.count) && 1.0 <= h.min_radius_mm);
+            assert!(h.min_radius_mm <= h.max_radius_mm && h.max_radius_mm <= 6.0);
+            assert!(a.validate().is_ok() && o.input_mm_per_unit == 10.0);
+        }
+        // Other yaws than the benchmark's frontal gallery, and the same draws again.
+        assert!(draws.iter().any(|o| o.pose.yaw_deg.abs() > 10.0));
+        let mut again = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        assert_eq!(random_scanner(&mut again, 10.0, 0), draws[0]);
     }
 
     #[test]
