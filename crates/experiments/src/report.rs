@@ -215,6 +215,19 @@ impl Failures {
     }
 }
 
+/// The value at fraction `p` of the sorted values `v` (the nearest rank, rounded; NaN when
+/// empty): the median of an even count is the upper middle value.
+pub fn quantile(v: &[f64], p: f64) -> f64 {
+    let k = ((v.len().max(1) - 1) as f64 * p).round() as usize;
+    v.get(k).copied().unwrap_or(f64::NAN)
+}
+
+/// `v` sorted (NaN last).
+pub fn sorted(mut v: Vec<f64>) -> Vec<f64> {
+    v.sort_by(f64::total_cmp);
+    v
+}
+
 /// Formats a number with 4 significant decimals.
 pub fn f4(x: f64) -> String {
     if x.is_finite() {
@@ -297,6 +310,17 @@ pub fn line_plot(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn quantiles_take_the_nearest_rank() {
+        let v = sorted(vec![4.0, 1.0, 3.0, 2.0]);
+        assert_eq!(v, [1.0, 2.0, 3.0, 4.0]);
+        assert_eq!(
+            [0.0, 0.5, 0.95, 1.0].map(|p| quantile(&v, p)),
+            [1.0, 3.0, 4.0, 4.0]
+        );
+        assert!(quantile(&[], 0.5).is_nan());
+    }
 
     #[test]
     fn report_writes_markdown_csv_and_figures() {

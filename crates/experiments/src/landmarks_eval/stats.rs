@@ -31,18 +31,7 @@ pub(super) struct Stats {
     pub within_10mm: f64,
 }
 
-/// The value at fraction `p` of the sorted values `v` (the nearest rank, rounded; NaN when
-/// empty).
-pub(super) fn quantile(v: &[f64], p: f64) -> f64 {
-    let k = ((v.len().max(1) - 1) as f64 * p).round() as usize;
-    v.get(k).copied().unwrap_or(f64::NAN)
-}
-
-/// `v` sorted.
-pub(super) fn sorted(mut v: Vec<f64>) -> Vec<f64> {
-    v.sort_by(f64::total_cmp);
-    v
-}
+pub(super) use crate::report::{quantile, sorted};
 
 /// The statistics of one landmark's errors `errs` (mm; infinite: not found).
 pub(super) fn stats(name: &str, errs: &[f64]) -> Stats {

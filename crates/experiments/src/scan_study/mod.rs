@@ -30,6 +30,7 @@ mod variants;
 
 use crate::paths::FaceSetArgs;
 use crate::pipeline::bar;
+use crate::report::{quantile, sorted};
 use acquisition::{settings, Setting};
 use anyhow::{bail, Result};
 use description::{describe_scan, Described};
@@ -143,12 +144,9 @@ struct ScanPair {
 
 /// Least, median, largest and count of the finite values of `v` (NaN and 0 when none is).
 fn quantiles(v: &[f64]) -> (f64, f64, f64, usize) {
-    let mut f: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
-    f.sort_by(f64::total_cmp);
-    if f.is_empty() {
-        return (f64::NAN, f64::NAN, f64::NAN, 0);
-    }
-    (f[0], f[f.len() / 2], f[f.len() - 1], f.len())
+    let f = sorted(v.iter().copied().filter(|x| x.is_finite()).collect());
+    let [lo, med, hi] = [0.0, 0.5, 1.0].map(|p| quantile(&f, p));
+    (lo, med, hi, f.len())
 }
 
 /// The faces of the set, kept to those `--only` names.

@@ -5,6 +5,7 @@ use super::describe::{noisy, Ctx, Descs};
 use super::figure15::{figure15, Fig15};
 use crate::pipeline::{bar, dist, error_grid, single_thread};
 use crate::polar::Pole;
+use crate::report::{quantile, sorted};
 use crate::robustness::stats::Sep;
 use crate::robustness::FacePrep;
 use crate::walk::Walker;
@@ -87,9 +88,8 @@ pub(super) fn between_persons(s: &Set<'_>) -> Result<Between> {
     // Median over the pairs: a pair preempted by other jobs on the shared machine does not
     // move it.
     let times: [f64; 4] = std::array::from_fn(|k| {
-        let mut v: Vec<f64> = row_times.iter().map(|t| t[k].as_secs_f64() * 1e3).collect();
-        v.sort_by(f64::total_cmp);
-        v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+        let v: Vec<f64> = row_times.iter().map(|t| t[k].as_secs_f64() * 1e3).collect();
+        quantile(&sorted(v), 0.5)
     });
     let persons: Vec<&str> = faces.iter().map(|f| f.person.as_str()).collect();
     let seps: Vec<Sep> = mats.iter().map(|m| Sep::of(m, &persons, test)).collect();
