@@ -1,8 +1,9 @@
 //! Faces beyond the span of a face model: expressions past full strength or mixed, and smooth
-//! random non-rigid warps (test faces the model cannot make).
+//! random non-rigid warps (test faces the model cannot make); and things that are not faces
+//! ([`non_faces`]), for a detector to refuse.
 
 use crate::{FaceModel, FaceModelError};
-use meshcore::{DVec3, TriMesh};
+use meshcore::{DAffine3, DQuat, DVec3, TriMesh};
 use rand::Rng;
 
 impl FaceModel {
@@ -179,10 +180,111 @@ pub fn random_warp<R: Rng>(
     })
 }
 
+/// Things that are not faces, in mm, named, each turned about the origin by a rotation drawn
+/// from `rng`: a sphere of radius 80, a 200 x 200 mm plane of 2 mm cells with 1 mm Gaussian
+/// noise along its normal, the back of a head (an ellipsoid cap 150 x 190 x 60 mm) and a face
+/// seen from behind: the mesh `face` makes (in mm, from the same stream, after the plane's
+/// noise) with every triangle's orientation reversed, so its normals point into the head.
+pub fn non_faces<R: Rng>(
+    rng: &mut R,
+    face: impl FnOnce(&mut R) -> Result<TriMesh, FaceModelError>,
+) -> Result<Vec<(String, TriMesh)>, FaceModelError> {
+    use meshcore::shapes::{grid, uv_sphere, Diagonals::Alternating};
+    let sphere = uv_sphere(60, 120).transformed(&DAffine3::from_scale(DVec3::splat(80.0)));
+    let plane = grid(100, 100, Alternating, |i, j| {
+        DVec3::new(2.0 * i as f64, 2.0 * j as f64, 0.0)
+    })?;
+    let noisy: Vec<DVec3> = plane
+        .positions()
+        .iter()
+        .map(|p| *p + DVec3::Z * crate::standard_normal(rng))
+        .collect();
+    let plane = TriMesh::new(noisy, plane.triangles().to_vec())?;
+    let back = grid(90, 90, Alternating, |i, j| {
+        let (u, v) = (i as f64 / 90.0 * 2.0 - 1.0, j as f64 / 90.0 * 2.0 - 1.0);
+        let r2 = (u * u + v * v).min(1.0);
+        DVec3::new(75.0 * u, 95.0 * v, 60.0 * (1.0 - r2).sqrt())
+    })?;
+    let face = face(rng)?;
+    let reversed = face.triangles().iter().map(|t| [t[0], t[2], t[1]]);
+    let behind = TriMesh::new(face.positions().to_vec(), reversed.collect())?;
+    let named = [
+        ("sphere r=80 mm", sphere),
+        ("plane with 1 mm noise", plane),
+        ("back of a head (ellipsoid cap)", back),
+        ("face seen from behind", behind),
+    ];
+    Ok(named
+        .into_iter()
+        .map(|(name, m)| {
+            let axis = DVec3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                1.0,
+            );
+            let angle = rng.random_range(0.0..std::f64::consts::TAU);
+            let t = DAffine3::from_rotation_translation(
+                DQuat::from_axis_angle(axis.normalize(), angle),
+                DVec3::ZERO,
+            );
+            (name.to_string(), m.transformed(&t))
+        })
+        .collect())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use rand::SeedableRng;
+
+    #[test]
+    fn non_faces_are_turned_shapes_and_a_face_inside_out() {
+        let face = meshcore::shapes::icosphere(2);
+        let make = |seed| {
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+            non_faces(&mut rng, |_| Ok(face.clone())).unwrap()
+        };
+        let shapes = make(1);
+        let names: Vec<&str> = shapes.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(names[0], "sphere r=80 mm");
+        assert_eq!(names[3], "face seen from behind");
+        // Rotations about the origin keep every sphere vertex 80 mm from it.
+        assert!(shapes[0]
+            .1
+            .positions()
+            .iter()
+            .all(|p| (p.length() - 80.0).abs() < 1e-9));
+        // The plane's noise: its points scatter about 1 mm off the plane through them.
+        let plane = &shapes[1].1;
+        let n = (0..plane.n_faces() as u32)
+            .map(|f| plane.face_cross(f))
+            .sum::<DVec3>()
+            .normalize();
+        let c = plane.positions().iter().sum::<DVec3>() / plane.n_vertices() as f64;
+        let sd = (plane
+            .positions()
+            .iter()
+            .map(|p| (*p - c).dot(n).powi(2))
+            .sum::<f64>()
+            / plane.n_vertices() as f64)
+            .sqrt();
+        assert!((0.8..1.5).contains(&sd), "{sd}");
+        // The face seen from behind is the face turned, its orientation reversed: the signed
+        // volume of the closed icosphere changes sign.
+        let volume = |m: &TriMesh| -> f64 {
+            (0..m.n_faces() as u32)
+                .map(|f| {
+                    let [a, b, c] = m.face_corners(f);
+                    a.dot(b.cross(c)) / 6.0
+                })
+                .sum()
+        };
+        let behind = &shapes[3].1;
+        assert!((volume(behind) + volume(&face)).abs() < 1e-9 * volume(&face).abs());
+        // The same stream makes the same shapes; another stream turns them otherwise.
+        assert_eq!(make(1)[2].1.positions(), shapes[2].1.positions());
+        assert_ne!(make(2)[2].1.positions(), shapes[2].1.positions());
+    }
 
     #[test]
     fn moves_the_face_by_2_to_6_mm_smoothly() {

@@ -14,11 +14,11 @@
 //!   quantised to 1-4 mm, 1 mm noise, flying pixels at the silhouette:
 //!   [`rangescan::add_flying_pixels`]), cleaned by `scanprep`.
 //! * [`non_faces`]: a sphere, a noisy plane, the back of a head (an ellipsoid cap) and a face
-//!   seen from behind (normals inverted).
+//!   seen from behind (normals inverted), by [`facemodel::variation::non_faces`].
 
 use anyhow::Result;
 use facemodel::FaceModel;
-use meshcore::{DAffine3, DQuat, DVec3, TriMesh};
+use meshcore::{DAffine3, DVec3, TriMesh};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rangescan::{
@@ -227,63 +227,17 @@ fn depth_camera(
     })
 }
 
-/// Things that are not faces, in mm, with a name: a sphere of radius 80, a plane with 1 mm
-/// noise, the back of a head (an ellipsoid cap 150 x 190 x 60 mm) and a face seen from behind
-/// (the ICT face of `seed` with its normals inverted), each under a random rigid motion.
+/// Things that are not faces, in mm, with a name ([`facemodel::variation::non_faces`]): a
+/// sphere, a noisy plane, the back of a head and a face seen from behind (the ICT face of
+/// `seed`'s stream with its normals inverted), each under a random rotation.
 pub fn non_faces(ict: &FaceModel, seed: u64) -> Result<Vec<(String, TriMesh)>> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x6e6f_6e66_6163_6500);
     let s = mm_per_unit(ict)?;
-    let sphere =
-        meshcore::shapes::uv_sphere(60, 120).transformed(&DAffine3::from_scale(DVec3::splat(80.0)));
-    let plane = meshcore::shapes::grid(
-        100,
-        100,
-        meshcore::shapes::Diagonals::Alternating,
-        |i, j| DVec3::new(2.0 * i as f64, 2.0 * j as f64, 0.0),
-    )?;
-    let noisy: Vec<DVec3> = plane
-        .positions()
-        .iter()
-        .map(|p| *p + DVec3::Z * facemodel::standard_normal(&mut rng))
-        .collect();
-    let plane = TriMesh::new(noisy, plane.triangles().to_vec())?;
-    let back = meshcore::shapes::grid(90, 90, meshcore::shapes::Diagonals::Alternating, |i, j| {
-        let (u, v) = (i as f64 / 90.0 * 2.0 - 1.0, j as f64 / 90.0 * 2.0 - 1.0);
-        let (a, b) = (75.0 * u, 95.0 * v);
-        let r2 = (u * u + v * v).min(1.0);
-        DVec3::new(a, b, 60.0 * (1.0 - r2).sqrt())
-    })?;
-    let id = ict.random_identity(&mut rng);
-    let face = ict
-        .sample(&id, &[])?
-        .transformed(&DAffine3::from_scale(DVec3::splat(s)));
-    let behind = TriMesh::new(
-        face.positions().to_vec(),
-        face.triangles()
-            .iter()
-            .map(|t| [t[0], t[2], t[1]])
-            .collect(),
-    )?;
-    let mut out = Vec::new();
-    for (name, m) in [
-        ("sphere r=80 mm", sphere),
-        ("plane with 1 mm noise", plane),
-        ("back of a head (ellipsoid cap)", back),
-        ("face seen from behind", behind),
-    ] {
-        let t = DAffine3::from_rotation_translation(
-            DQuat::from_axis_angle(
-                DVec3::new(
-                    rng.random_range(-1.0..1.0),
-                    rng.random_range(-1.0..1.0),
-                    1.0,
-                )
-                .normalize(),
-                rng.random_range(0.0..std::f64::consts::TAU),
-            ),
-            DVec3::ZERO,
-        );
-        out.push((name.to_string(), m.transformed(&t)));
-    }
-    Ok(out)
+    let face = |rng: &mut ChaCha8Rng| {
+        let id = ict.random_identity(rng);
+        Ok(ict
+            .sample(&id, &[])?
+            .transformed(&DAffine3::from_scale(DVec3::splat(s))))
+    };
+    Ok(facemodel::variation::non_faces(&mut rng, face)?)
 }
