@@ -132,6 +132,26 @@ impl Artifacts {
         }
     }
 
+    /// A consumer depth camera: 1 mm noise, depths quantised to `step_mm`, dropouts from 65 to
+    /// 80 degrees of incidence and 2 holes of 2-6 mm radius; no spikes, outliers or border (its
+    /// flying pixels at the silhouette are [`crate::add_flying_pixels`], on the grid).
+    pub fn depth_camera(step_mm: f64) -> Self {
+        Self {
+            noise: Some(DepthNoise { sigma_mm: 1.0 }),
+            quantisation: Some(Quantisation { step_mm }),
+            grazing: Some(GrazingDropout {
+                start_deg: 65.0,
+                full_deg: 80.0,
+            }),
+            holes: Some(Holes {
+                count: 2,
+                min_radius_mm: 2.0,
+                max_radius_mm: 6.0,
+            }),
+            ..Self::none()
+        }
+    }
+
     /// Checks every part's sizes.
     pub fn validate(&self) -> Result<(), ScanError> {
         // (what, value, lo, hi, the range as the error says it): the value must be finite and
@@ -383,4 +403,24 @@ fn bounds(idx: &[usize], nc: usize) -> Option<(usize, usize, usize, usize)> {
         let (r, c) = (i / nc, i % nc);
         (r0.min(r), r1.max(r), c0.min(c), c1.max(c))
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_depth_camera_quantises_and_drops_out_but_has_no_spikes() {
+        let a = Artifacts::depth_camera(2.5);
+        assert!(a.validate().is_ok());
+        assert_eq!(a.quantisation.map(|q| q.step_mm), Some(2.5));
+        assert_eq!(a.noise.map(|n| n.sigma_mm), Some(1.0));
+        assert_eq!(
+            a.grazing.map(|g| (g.start_deg, g.full_deg)),
+            Some((65.0, 80.0))
+        );
+        assert_eq!(a.holes.map(|h| h.count), Some(2));
+        assert!(a.spikes.is_none() && a.outliers.is_none() && a.border.is_none());
+        assert!(Artifacts::depth_camera(0.0).validate().is_err());
+    }
 }

@@ -11,8 +11,8 @@
 //! * [`Kind::Remesh`]: the face subdivided and decimated to 1-5 mm edges (another topology,
 //!   [`scanprep::remesh`]).
 //! * [`Kind::DepthCamera`]: a consumer-depth-camera-like range scan (2-5 mm pitch, depth
-//!   quantised to 1-4 mm, 1 mm noise, flying pixels at the silhouette:
-//!   [`rangescan::add_flying_pixels`]), cleaned by `scanprep`.
+//!   quantised to 1-4 mm, 1 mm noise: [`Artifacts::depth_camera`]; flying pixels at the
+//!   silhouette: [`rangescan::add_flying_pixels`]), cleaned by `scanprep`.
 //! * [`non_faces`]: a sphere, a noisy plane, the back of a head (an ellipsoid cap) and a face
 //!   seen from behind (normals inverted), by [`facemodel::variation::non_faces`].
 
@@ -21,9 +21,7 @@ use facemodel::FaceModel;
 use meshcore::{DAffine3, DVec3, TriMesh};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rangescan::{
-    Artifacts, DepthNoise, FlyingPixels, GrazingDropout, HeadPose, Holes, Quantisation, ScanOptions,
-};
+use rangescan::{Artifacts, FlyingPixels, HeadPose, ScanOptions};
 
 /// A kind of face outside the ICT model's span.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -172,20 +170,7 @@ fn depth_camera(
                 yaw_deg: yaw,
                 pitch_deg: 0.0,
             },
-            artifacts: Artifacts {
-                noise: Some(DepthNoise { sigma_mm: 1.0 }),
-                quantisation: Some(Quantisation { step_mm: step }),
-                grazing: Some(GrazingDropout {
-                    start_deg: 65.0,
-                    full_deg: 80.0,
-                }),
-                holes: Some(Holes {
-                    count: 2,
-                    min_radius_mm: 2.0,
-                    max_radius_mm: 6.0,
-                }),
-                ..Artifacts::none()
-            },
+            artifacts: Artifacts::depth_camera(step),
             seed: rng.random(),
             ..ScanOptions::default()
         },
