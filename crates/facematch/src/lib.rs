@@ -51,7 +51,7 @@ pub use options::{
     MatchOptions, PrepareOptions, SearchOptions, ViewOptions, DEFAULT_EDGE_MM, VERIFY_THRESHOLD,
 };
 pub use poles::{Lost, Pair, Poles};
-pub use prepare::{prepare, prepare_with, PreparedScan, ScanInput, StepTimes};
+pub use prepare::{detect_landmarks, prepare, prepare_with, PreparedScan, ScanInput, StepTimes};
 pub use template::{enroll, views_of, Template, TemplateView, FORMAT_VERSION};
 pub use view::{
     cut_to_view, describe_view, nearest_vertex, probe_direction, seen_within, view_directions,

@@ -196,15 +196,33 @@ pub fn prepare_with(
     })
 }
 
-/// The landmarks seen from `scanner` on `mesh` (mm), detected on a smoothed copy when asked,
-/// placed at their vertices of `mesh`.
+/// The landmarks seen from `scanner` on `mesh` (mm), as [`detect_landmarks`] finds them with
+/// `p`'s detection options and smoothing.
 fn detect(
     mesh: &TriMesh,
     generic: &GenericModel,
     scanner: DVec3,
     p: &PrepareOptions,
 ) -> Result<VisibleLandmarks, MatchError> {
-    let smoothed = match p.detect_smoothing {
+    let options = DetectOptions {
+        toward_viewer: Some(scanner),
+        ..p.detect
+    };
+    detect_landmarks(mesh, generic, &options, p.detect_smoothing)
+}
+
+/// The landmarks of `mesh` as [`prepare`] detects them: [`landmarks::detect_visible`] with
+/// `options` at the scale recognised from the face's size
+/// ([`landmarks::mesh_units_per_model_unit`]), on a copy of `mesh` smoothed by `smoothing`
+/// Taubin iterations (0: on `mesh` itself), each landmark placed at its vertex of `mesh`.
+/// Errors: the smoothing's, and [`MatchError::NoFace`] with the detector's reason.
+pub fn detect_landmarks(
+    mesh: &TriMesh,
+    generic: &GenericModel,
+    options: &DetectOptions,
+    smoothing: usize,
+) -> Result<VisibleLandmarks, MatchError> {
+    let smoothed = match smoothing {
         0 => None,
         k => Some(scanprep::taubin_smooth(mesh, k)?),
     };
@@ -216,8 +234,7 @@ fn detect(
         generic,
         &DetectOptions {
             mesh_units_per_model_unit: scale,
-            toward_viewer: Some(scanner),
-            ..p.detect
+            ..*options
         },
     )
     .map_err(|e| MatchError::NoFace(e.to_string()))?;

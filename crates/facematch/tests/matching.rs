@@ -215,3 +215,28 @@ fn a_crop_that_changes_nothing_keeps_the_first_detection() {
     assert!(cut.mesh.n_vertices() < first.mesh.n_vertices());
     assert!(cut.times.crop_detect > std::time::Duration::ZERO);
 }
+
+#[test]
+fn detect_landmarks_finds_what_prepare_found_on_its_scan() {
+    let Some([face]) = testsupport::paper_meshes(["id2_neutral.obj"]) else {
+        return;
+    };
+    let o = MatchOptions::default();
+    let p = prepare(ScanInput::Grid(&scan(&face, 10.0, 3)), &o).unwrap();
+    let generic = landmarks::GenericModel::default_model().unwrap();
+    let options = landmarks::DetectOptions {
+        toward_viewer: Some(p.scanner),
+        ..o.prepare.detect
+    };
+    let found = facematch::detect_landmarks(&p.mesh, &generic, &options, 0).unwrap();
+    assert_eq!(found, p.detected);
+    // On a smoothed copy the landmarks stay on the scan's own vertices.
+    let smoothed = facematch::detect_landmarks(&p.mesh, &generic, &options, 3).unwrap();
+    for l in smoothed.landmarks.iter().flatten() {
+        assert_eq!(l.position, p.mesh.position(l.vertex));
+    }
+    // A mesh with no face is no face, with the detector's reason.
+    let flat = meshcore::shapes::icosphere(2);
+    let e = facematch::detect_landmarks(&flat, &generic, &options, 0).unwrap_err();
+    assert!(matches!(e, facematch::MatchError::NoFace(_)), "{e}");
+}
