@@ -243,42 +243,26 @@ pub struct MethodUse {
     pub note: Option<String>,
 }
 
-/// Resolves a comma-separated method list; an unavailable exact solver falls back to fmm, then heat.
+/// Resolves a comma-separated method list; an unavailable exact solver falls back to fmm, then
+/// heat ([`geodesic::usable_method`]).
 pub fn resolve_methods(list: &str, mesh: &TriMesh) -> Result<Vec<MethodUse>> {
     let mut out: Vec<MethodUse> = Vec::new();
     for name in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
         let m: Method = name.parse().with_context(|| format!("--methods: {name}"))?;
-        let mut note = None;
-        let mut used = None;
-        let chain: Vec<Method> = match m {
-            Method::Exact => vec![Method::Exact, Method::Fmm, Method::Heat],
-            other => vec![other],
-        };
-        for c in chain {
-            match geodesic::new_solver(mesh, c) {
-                Ok(_) => {
-                    used = Some(c);
-                    break;
-                }
-                Err(e) => {
-                    let s = format!("{} unavailable ({e})", c.name());
-                    note = Some(match note {
-                        None => s,
-                        Some(prev) => format!("{prev}; {s}"),
-                    });
-                }
-            }
-        }
+        let (used, failed) = geodesic::usable_method(mesh, m);
+        let note = (!failed.is_empty()).then(|| {
+            let each = failed
+                .iter()
+                .map(|(c, e)| format!("{} unavailable ({e})", c.name()));
+            each.collect::<Vec<_>>().join("; ")
+        });
         match used {
-            Some(u) => {
-                if out.iter().all(|x| x.used != u) {
-                    out.push(MethodUse {
-                        requested: m,
-                        used: u,
-                        note,
-                    });
-                }
-            }
+            Some(used) if out.iter().all(|x| x.used != used) => out.push(MethodUse {
+                requested: m,
+                used,
+                note,
+            }),
+            Some(_) => {}
             None => eprintln!("warning: {}: skipped", note.unwrap_or_default()),
         }
     }

@@ -12,7 +12,7 @@ use facemodel::FaceModel;
 use indicatif::ProgressBar;
 use landmarks::{DetectOptions, GenericModel, LandmarkName, VisibleLandmarks};
 use meshcore::{DVec3, TriMesh};
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rangescan::Visibility;
 use rayon::prelude::*;
@@ -38,35 +38,21 @@ pub struct FaceSpec {
     pub seed: u64,
 }
 
-/// Weights of `identities` x `expressions` faces drawn from one stream of `seed`, identity by
-/// identity (expression 0 of each is neutral), as `(identity weights, expression weights per
-/// face)`.
+/// Weights of `identities` x `expressions` faces drawn from one stream of `seed`
+/// ([`FaceModel::random_faces`]: expression 0 of each identity neutral), as `(identity
+/// weights, expression weights per face)`.
 pub fn sample_weights(
     model: &FaceModel,
     identities: usize,
     expressions: usize,
     seed: u64,
 ) -> Vec<(Vec<f64>, Vec<Vec<f64>>)> {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    (0..identities)
-        .map(|_| {
-            let w = model.random_identity(&mut rng);
-            let ex = (0..expressions)
-                .map(|e| {
-                    if e == 0 {
-                        Vec::new()
-                    } else {
-                        model.random_expression(&mut rng)
-                    }
-                })
-                .collect();
-            (w, ex)
-        })
-        .collect()
+    model.random_faces(
+        &mut ChaCha8Rng::seed_from_u64(seed),
+        identities,
+        expressions,
+    )
 }
-
-/// Noise levels of the probes of the scan benchmark, mm.
-pub const PROBE_NOISE: [f64; 3] = [0.1, 0.2, 0.4];
 
 /// Makes the [`FaceSpec`]s of one sampled set ([`sample_weights`]), numbering their scan seeds
 /// ([`scan_seed`]) in the order they are made, from 1.
@@ -108,8 +94,8 @@ impl SpecMaker {
     }
 
     /// The scan benchmark's gallery and probes: per identity its neutral face at `base`, then
-    /// per identity and other expression a probe under a random yaw (0-45 degrees, either
-    /// side) and noise ([`PROBE_NOISE`]), both drawn from the set's own stream.
+    /// per identity and other expression a probe under a random yaw and noise drawn from the
+    /// set's own stream ([`ScanSettings::random_probe`]).
     pub fn gallery_and_probes(&mut self, base: ScanSettings) -> (Vec<FaceSpec>, Vec<FaceSpec>) {
         let (identities, expressions) = (
             self.weights.len(),
@@ -120,15 +106,9 @@ impl SpecMaker {
         let mut probes = Vec::new();
         for i in 0..identities {
             for e in 1..expressions {
-                let yaw =
-                    rng.random_range(0..=45) as f64 * if rng.random::<bool>() { 1.0 } else { -1.0 };
-                let noise = PROBE_NOISE[rng.random_range(0..PROBE_NOISE.len())];
-                let st = ScanSettings {
-                    yaw_deg: yaw,
-                    noise_mm: noise,
-                    ..base
-                };
-                probes.push(self.spec(i, e, st, &format!("-yaw{yaw}-noise{noise}")));
+                let st = base.random_probe(&mut rng);
+                let tag = format!("-yaw{}-noise{}", st.yaw_deg, st.noise_mm);
+                probes.push(self.spec(i, e, st, &tag));
             }
         }
         (gallery, probes)
@@ -206,6 +186,29 @@ pub const REFERENCE_LANDMARKS: [LandmarkName; 3] = [
     LandmarkName::OuterEyeLeft,
     LandmarkName::NoseTip,
 ];
+
+/// Distance (mm) of each detected reference landmark ([`REFERENCE_LANDMARKS`]) from its
+/// ground truth `truth` (the scanner's landmarks, in [`LandmarkName::ALL`] order), or, for one
+/// the detector reports unseen, why, with how far from its ground truth the fitted face
+/// predicts it.
+pub fn detection_errors(
+    truth: &[rangescan::ScannedLandmark],
+    found: &VisibleLandmarks,
+) -> [Result<f64, String>; 3] {
+    REFERENCE_LANDMARKS.map(|n| {
+        let truth = truth[n as usize].position;
+        match found.get(n) {
+            Ok(l) => Ok((l.position - truth).length()),
+            Err(u) => {
+                let off = (found.predicted[n as usize] - truth).length();
+                Err(format!(
+                    "{}: {u}; the fitted face predicts it {off:.2} mm from its ground truth",
+                    n.key()
+                ))
+            }
+        }
+    })
+}
 
 /// The direction toward the scanner in the frame of every scan `rangescan` writes.
 pub use facematch::GRID_SCANNER as SCANNER_SIDE;
@@ -324,12 +327,12 @@ pub fn scan_raw(model: &FaceModel, spec: &FaceSpec) -> Result<(rangescan::Scan, 
         .zip(truth_cm)
         .map(|(n, p)| (n.lm3_label().to_string(), p))
         .collect();
-    let mm_per_unit = match model.units() {
-        "mm" => 1.0,
-        "m" => 1000.0,
-        _ => 10.0,
-    };
-    let options = spec.settings.options(mm_per_unit, spec.seed);
+    // The model's units (cm where they are not recognised).
+    let units = model
+        .units()
+        .parse()
+        .unwrap_or(meshcore::units::Units::Centimetre);
+    let options = spec.settings.options(units.mm_per_unit(), spec.seed);
     let scan = rangescan::scan_with_landmarks(&face, &marks, &options)?;
     Ok((scan, t0.elapsed()))
 }
@@ -372,31 +375,13 @@ pub fn clean_scan(
     let truth: [Truth; 5] = truth
         .try_into()
         .map_err(|_| anyhow::anyhow!("the scanner returned another number of landmarks"))?;
-    let smoothed = match options.detect_smoothing {
-        0 => None,
-        k => Some(scanprep::taubin_smooth(&mesh, k)?),
-    };
-    let seen_by_detector = smoothed.as_ref().unwrap_or(&mesh);
     let detected = match &options.detect {
-        Some(o) => landmarks::mesh_units_per_model_unit(seen_by_detector, generic)
-            .and_then(|s| {
-                landmarks::detect_visible(
-                    seen_by_detector,
-                    generic,
-                    &DetectOptions {
-                        mesh_units_per_model_unit: s,
-                        ..*o
-                    },
-                )
-            })
-            .map(|mut found| {
-                // The same vertices, at their places on the scan.
-                for l in found.landmarks.iter_mut().flatten() {
-                    l.position = mesh.position(l.vertex);
-                }
-                found
-            })
-            .map_err(|e| e.to_string()),
+        // The detector's reason, not facematch's wording of it.
+        Some(o) => facematch::detect_landmarks(&mesh, generic, o, options.detect_smoothing)
+            .map_err(|e| match e {
+                facematch::MatchError::NoFace(why) => why,
+                e => e.to_string(),
+            }),
         None => Err("not run".into()),
     };
     let t3 = Instant::now();

@@ -24,7 +24,7 @@ use anyhow::{Context, Result};
 use facematch::metrics::{eer, error_rates};
 use facematch::{prepare, Description, Gallery, MatchOptions, ScanInput, Template};
 use facemodel::FaceModel;
-use figures::{figures, gate_label, gate_of, rank1, Figures, SCORE_COLUMNS};
+use figures::{figures, gate_label, gate_of, Figures, SCORE_COLUMNS};
 use mesh_io::BntGrid;
 use sets::{held_out_specs, process, scan_all, tuning_specs, Processed, Spec};
 use std::path::Path;
@@ -100,9 +100,9 @@ pub fn run(a: Args) -> Result<()> {
         .1
         .iter()
         .min_by(|a, b| {
-            a.1.eer
-                .total_cmp(&b.1.eer)
-                .then(b.1.identified.cmp(&a.1.identified))
+            (a.1.eval.eer)
+                .total_cmp(&b.1.eval.eer)
+                .then(b.1.eval.identified.cmp(&a.1.eval.identified))
         })
         .map(|x| x.0)
         .unwrap_or(0.0);
@@ -195,12 +195,15 @@ fn figures_section(rep: &mut Report, per_set: &[PerSet], chosen: f64) -> Result<
                 name.to_string(),
                 gate_label(*g) + if *g == chosen { " (chosen)" } else { "" },
                 f.not_enrolled.to_string(),
-                f.probes.to_string(),
-                f4(rank1(f)),
-                f.no_score.to_string(),
-                f4(f.eer),
-                f4(f.ratio),
-                format!("{} of {}", f.with_fallback, f.comparisons),
+                f.eval.probes.to_string(),
+                f4(f.eval.rank1()),
+                f.eval.no_score.to_string(),
+                f4(f.eval.eer),
+                f4(f.eval.ratio),
+                format!(
+                    "{} of {}",
+                    f.eval.fallbacks.with_fallback, f.eval.fallbacks.comparisons
+                ),
             ]);
         }
     }
@@ -256,7 +259,7 @@ fn threshold_section(rep: &mut Report, per_set: &[PerSet], chosen: f64, o: &Matc
     let Some((_, f)) = per_set[0].1.iter().find(|(g, _)| *g == chosen) else {
         return;
     };
-    let e = eer(&f.genuine, &f.impostor);
+    let e = eer(&f.eval.genuine, &f.eval.impostor);
     rep.heading(2, "Verification threshold");
     let mut lines = vec![format!(
         "tuning set at the chosen gate: EER {} at score {} (facematch::VERIFY_THRESHOLD is {})",
@@ -266,15 +269,16 @@ fn threshold_section(rep: &mut Report, per_set: &[PerSet], chosen: f64, o: &Matc
     )];
     for (name, fs) in per_set {
         if let Some((_, f)) = fs.iter().find(|(g, _)| *g == chosen) {
-            let (frr, far) = error_rates(&f.genuine, &f.impostor, o.verify_threshold);
+            let (g, i) = (&f.eval.genuine, &f.eval.impostor);
+            let (frr, far) = error_rates(g, i, o.verify_threshold);
             lines.push(format!(
                 "{name} at VERIFY_THRESHOLD {}: same person refused {} of {} ({}), other person accepted {} of {} ({})",
                 o.verify_threshold,
-                (frr * f.genuine.len() as f64).round(),
-                f.genuine.len(),
+                (frr * g.len() as f64).round(),
+                g.len(),
                 f4(frr),
-                (far * f.impostor.len() as f64).round(),
-                f.impostor.len(),
+                (far * i.len() as f64).round(),
+                i.len(),
                 f4(far)
             ));
         }
@@ -293,11 +297,7 @@ fn fallbacks_section(rep: &mut Report, per_set: &[PerSet], chosen: f64) -> Resul
             continue;
         };
         rep.heading(3, &format!("{name}: fallbacks at the chosen gate"));
-        let l: Vec<String> = f
-            .fallbacks
-            .iter()
-            .map(|(k, n)| format!("{k}: {n}"))
-            .collect();
+        let l = f.eval.fallbacks.kinds();
         if l.is_empty() {
             rep.para("none");
         } else {
@@ -310,8 +310,8 @@ fn fallbacks_section(rep: &mut Report, per_set: &[PerSet], chosen: f64) -> Resul
             &format!("{name} set, gate {}", gate_label(chosen)),
             "score",
             &[
-                ("same person".to_string(), f.genuine.clone()),
-                ("other persons".to_string(), f.impostor.clone()),
+                ("same person".to_string(), f.eval.genuine.clone()),
+                ("other persons".to_string(), f.eval.impostor.clone()),
             ],
             30,
         )?;

@@ -10,7 +10,7 @@ use facemodel::FaceModel;
 use mesh_io::BntGrid;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rangescan::{Artifacts, HeadPose, Holes, ScanOptions, Spikes};
+use rangescan::ScanOptions;
 use rayon::prelude::*;
 use std::path::Path;
 
@@ -45,41 +45,8 @@ pub(super) fn tuning_specs(model: &FaceModel, a: &Args) -> (Vec<Spec>, Vec<Spec>
     (of(g), of(p))
 }
 
-/// The held-out set's scanner: settings drawn from `rng` outside the benchmark's.
-fn other_scanner(rng: &mut ChaCha8Rng, seed: u64) -> ScanOptions {
-    let sl = Artifacts::structured_light();
-    let spike_min = rng.random_range(3.0..8.0);
-    let hole_min = rng.random_range(1.0..3.0);
-    ScanOptions {
-        input_mm_per_unit: 10.0,
-        pitch_mm: rng.random_range(0.4..=0.8),
-        pose: HeadPose {
-            yaw_deg: rng.random_range(-20.0..=20.0),
-            pitch_deg: rng.random_range(-10.0..=10.0),
-        },
-        artifacts: Artifacts {
-            noise: Some(rangescan::DepthNoise {
-                sigma_mm: rng.random_range(0.05..0.3),
-            }),
-            spikes: Some(Spikes {
-                fraction: rng.random_range(0.0005..0.003),
-                min_mm: spike_min,
-                max_mm: rng.random_range(spike_min..=15.0),
-            }),
-            holes: Some(Holes {
-                count: rng.random_range(2..=8),
-                min_radius_mm: hole_min,
-                max_radius_mm: rng.random_range(hole_min..=6.0),
-            }),
-            ..sl
-        },
-        seed,
-        ..ScanOptions::default()
-    }
-}
-
 /// The held-out set: per person a gallery scan and a probe scan, each from its own draw of the
-/// other scanner, the probe with an expression half the time.
+/// other scanner ([`rangescan::random_scanner`]), the probe with an expression half the time.
 pub(super) fn held_out_specs(model: &FaceModel, a: &Args) -> (Vec<Spec>, Vec<Spec>) {
     let weights = sample_weights(model, a.held_out, 2, a.held_out_seed);
     let mut rng = ChaCha8Rng::seed_from_u64(scan_seed(a.held_out_seed, u64::MAX));
@@ -98,7 +65,7 @@ pub(super) fn held_out_specs(model: &FaceModel, a: &Args) -> (Vec<Spec>, Vec<Spe
                 identity: i,
                 identity_weights: w.clone(),
                 expression_weights: expression,
-                scan: other_scanner(&mut rng, seed),
+                scan: rangescan::random_scanner(&mut rng, 10.0, seed),
             };
             if k == 0 {
                 gallery.push(s)

@@ -1,18 +1,17 @@
 //! The benchmark on clean meshes: faces sampled from the ICT model under random rigid motions,
 //! described with the model's landmarks and with detected ones.
 
-use super::compare::{icp_points, score_set, time_descriptions, TIMED_FACES, TIMED_PAIRS};
-use super::describe::{
-    describe_face, elastic_options, iso_levels_of, DescribeOptions, Described, ISO_POINTS,
-};
-use super::metrics::{paired_table, results_table, roc_figure, summarize, write_summary, Metrics};
+use super::compare::{icp_points, time_descriptions, TIMED_FACES, TIMED_PAIRS};
+use super::describe::{describe_face, elastic_options, iso_levels_of, DescribeOptions, ISO_POINTS};
+use super::metrics::{paired_table, results_table, roc_figure, write_summary, Metrics};
+use super::scans::{score_group, Face};
 use super::{Args, Lm};
 use crate::pipeline::{bar, resolve_methods};
 use crate::report::Report;
 use crate::walk::Walker;
 use anyhow::Result;
 use facemodel::{random_rigid_motion, FaceModel};
-use meshcore::{DVec3, FaceLocator, TriMesh};
+use meshcore::{FaceLocator, TriMesh};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -25,10 +24,6 @@ struct Sample {
     index: usize,
     mesh: TriMesh,
 }
-
-/// The descriptions of one face with the ground-truth and the detected landmarks (`None` where
-/// the landmarks or the description failed).
-type Both = [Option<Described>; 2];
 
 /// The run's samples and settings, as the report states them.
 struct Setup<'a> {
@@ -82,7 +77,15 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         .map_err(|e| anyhow::anyhow!("landmark model: {e}"))?;
     let detected = detect_all(&samples, &generic);
     // Descriptors for both landmark sets.
-    let described = describe_all(&samples, &detected, gt, method, &desc_opts, &probe_opts)?;
+    let faces = describe_all(
+        args,
+        &samples,
+        &detected,
+        gt,
+        method,
+        &desc_opts,
+        &probe_opts,
+    )?;
     let setup = Setup {
         identities,
         expressions,
@@ -98,7 +101,7 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         probe_opts: &probe_opts,
         detected: &detected,
     };
-    let all = score_all(args, &setup, &described, gt)?;
+    let all = score_all(args, &setup, faces, gt)?;
     write_report(args, &setup, gt, &all, &out, t0)
 }
 
@@ -158,79 +161,70 @@ fn detect_all(samples: &[Sample], generic: &landmarks::GenericModel) -> Vec<Opti
     detected
 }
 
-/// Every face described with the ground-truth landmarks `gt` and with its detected ones: the
-/// gallery faces with `desc_opts`, the probes with `probe_opts`.
+/// Every face described with the ground-truth landmarks `gt` and with its detected ones (the
+/// gallery faces with `desc_opts`, the probes with `probe_opts`), with its ICP points.
 fn describe_all(
+    args: &Args,
     samples: &[Sample],
     detected: &[Option<Lm>],
     gt: Lm,
     method: geodesic::Method,
     desc_opts: &DescribeOptions,
     probe_opts: &DescribeOptions,
-) -> Result<Vec<Both>> {
+) -> Result<Vec<Face>> {
     let pb = bar(samples.len(), &format!("descriptors ({})", method.name()));
-    let described: Vec<Both> = samples
+    let faces: Vec<Face> = samples
         .par_iter()
         .zip(detected)
         .map(|(s, det)| -> Result<_> {
             let solver = geodesic::new_solver(&s.mesh, method)?;
             let walker = Walker::new(&s.mesh);
             let o = if s.index == 0 { desc_opts } else { probe_opts };
-            let out = [Some(gt), *det].map(|lm| {
-                lm.and_then(|lm| describe_face(&s.mesh, solver.as_ref(), &walker, lm, o).ok())
+            let mut face = Face::new(&format!("id{:02}-e{}", s.identity, s.index), s.identity);
+            face.desc = [Some(gt), *det].map(|lm| {
+                let lm = lm.ok_or("no landmarks")?;
+                describe_face(&s.mesh, solver.as_ref(), &walker, lm, o)
             });
+            if s.index != 0 {
+                let pts = icp_points(&s.mesh, args.icp_points);
+                face.pts = [pts.clone(), pts];
+            }
             pb.inc(1);
-            Ok(out)
+            Ok(face)
         })
         .collect::<Result<_>>()?;
     pb.finish();
-    Ok(described)
+    Ok(faces)
 }
 
-/// The figures of every score with both landmark sets: the probes scored against the gallery
-/// in parallel, then the comparisons and descriptions timed on one thread.
-fn score_all(args: &Args, s: &Setup<'_>, described: &[Both], gt: Lm) -> Result<Vec<Metrics>> {
-    let (samples, gallery, probes) = (s.samples, &s.gallery, &s.probes);
-    let elastic = elastic_options(args.curve_samples);
-    let gid: Vec<usize> = gallery.iter().map(|&g| samples[g].identity).collect();
-    let pid: Vec<usize> = probes.iter().map(|&p| samples[p].identity).collect();
-    let locators: Vec<FaceLocator<'_>> = gallery
-        .iter()
-        .map(|&g| FaceLocator::new(&samples[g].mesh))
-        .collect();
-    let mut all = Vec::new();
-    let pb = bar(2 * probes.len(), "scoring");
-    let probe_pts: Vec<Vec<DVec3>> = probes
-        .iter()
-        .map(|&p| icp_points(&samples[p].mesh, args.icp_points))
-        .collect();
-    let mut timed = Vec::new();
-    for k in [0, 1] {
-        let gal: Vec<Option<(&Described, &FaceLocator<'_>)>> = gallery
-            .iter()
-            .zip(&locators)
-            .map(|(&g, l)| described[g][k].as_ref().map(|d| (d, l)))
-            .collect();
-        let pr: Vec<(Option<&Described>, &[DVec3])> = probes
-            .iter()
-            .zip(&probe_pts)
-            .map(|(&p, pts)| (described[p][k].as_ref(), pts.as_slice()))
-            .collect();
-        let (rows, _, ms_cmp) = score_set(&pr, &gal, &elastic, &pb)?;
-        timed.push((rows, ms_cmp));
-    }
-    pb.finish();
+/// The figures of every score with both landmark sets ([`score_group`]: the probes scored
+/// against the gallery in parallel, the comparisons timed on one thread), with the
+/// descriptions timed on one thread.
+fn score_all(args: &Args, s: &Setup<'_>, faces: Vec<Face>, gt: Lm) -> Result<Vec<Metrics>> {
+    let samples = s.samples;
     // Description times: the first gallery faces again, one at a time on one thread.
-    let first: Vec<(&TriMesh, Lm)> = gallery
+    let first: Vec<(&TriMesh, Lm)> = s
+        .gallery
         .iter()
         .take(TIMED_FACES)
         .map(|&g| (&samples[g].mesh, gt))
         .collect();
     let ms_desc = time_descriptions(&first, s.method, s.probe_opts)?;
-    for ((rows, ms_cmp), lname) in timed.iter().zip(["ground_truth", "detected"]) {
-        all.extend(summarize(rows, ms_cmp, &ms_desc, &pid, &gid, lname));
+    let (mut gallery, mut probes) = (Vec::new(), Vec::new());
+    for (f, x) in faces.into_iter().zip(samples) {
+        if x.index == 0 {
+            gallery.push(f)
+        } else {
+            probes.push(f)
+        }
     }
-    Ok(all)
+    let locators: Vec<[Option<FaceLocator<'_>>; 2]> = s
+        .gallery
+        .iter()
+        .map(|&g| [0, 1].map(|_| Some(FaceLocator::new(&samples[g].mesh))))
+        .collect();
+    let elastic = elastic_options(args.curve_samples);
+    Ok(score_group(&gallery, &locators, &probes, &elastic, &ms_desc)?.metrics)
 }
 
 /// Writes `report.md` (settings, landmark detection, results, the paired comparison, ROC) and

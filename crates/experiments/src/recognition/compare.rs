@@ -149,21 +149,16 @@ fn score_row(
 pub(super) type ScoredSet = (Vec<Row>, Vec<Vec<PairDistances>>, [f64; 5]);
 
 /// The scores of `probes` (description, ICP points) against `gallery` (description, surface):
-/// the rows and bipolar pair distances of [`score_row`], in parallel (`pb` counts the probes),
+/// the rows and bipolar pair distances of [`score_row`], in parallel,
 /// and each score's mean single-thread time over up to [`TIMED_PAIRS`] of the pairs.
 pub(super) fn score_set(
     probes: &[(Option<&Described>, &[DVec3])],
     gallery: &[Option<(&Described, &FaceLocator<'_>)>],
     elastic: &ElasticOptions,
-    pb: &indicatif::ProgressBar,
 ) -> Result<ScoredSet> {
     let (rows, pairs) = probes
         .par_iter()
-        .map(|(p, pts)| {
-            let r = score_row(*p, pts, gallery, elastic);
-            pb.inc(1);
-            r
-        })
+        .map(|(p, pts)| score_row(*p, pts, gallery, elastic))
         .unzip();
     let ms = time_comparisons(&timed_pairs(probes, gallery), elastic)?;
     Ok((rows, pairs, ms))

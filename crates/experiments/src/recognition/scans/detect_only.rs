@@ -4,7 +4,7 @@ use super::super::metrics::median;
 use super::p95;
 use crate::pipeline::bar;
 use crate::report::{Report, Series};
-use crate::scans::{scan_raw, FaceSpec, REFERENCE_LANDMARKS};
+use crate::scans::{detection_errors, scan_raw, FaceSpec};
 use anyhow::Result;
 use facemodel::FaceModel;
 use landmarks::GenericModel;
@@ -86,11 +86,8 @@ fn detect_all(
         .par_iter()
         .map(|spec| {
             let r = scan_raw(model, spec).map(|(raw, _)| {
-                let p = facematch::prepare_with(
-                    facematch::ScanInput::Grid(&raw.grid),
-                    generic,
-                    prep,
-                );
+                let p =
+                    facematch::prepare_with(facematch::ScanInput::Grid(&raw.grid), generic, prep);
                 (raw, p)
             });
             pb.inc(1);
@@ -104,30 +101,15 @@ fn detect_all(
                 Err(e) => failed("scan failed", format!("{e:#}")),
                 Ok((_, Err(e))) => failed("not found", e.to_string()),
                 Ok((raw, Ok(p))) => {
-                    let d = &p.detected;
-                    let mut why = Vec::new();
-                    let err = REFERENCE_LANDMARKS.map(|n| {
-                        let k = n as usize;
-                        let truth = raw.landmarks[k].position;
-                        match d.get(n) {
-                            Ok(l) => Some((l.position - truth).length()),
-                            Err(u) => {
-                                // Where the fitted face puts it: how far the pole would be
-                                // if it were used anyway.
-                                let off = (d.predicted[k] - truth).length();
-                                why.push(format!(
-                                    "{}: {u}; the fitted face predicts it {off:.2} mm from its ground truth",
-                                    n.key()
-                                ));
-                                None
-                            }
-                        }
-                    });
+                    let errs = detection_errors(&raw.landmarks, &p.detected);
+                    let why: Vec<String> = (errs.iter().filter_map(|e| e.clone().err()))
+                        .chain(p.notes.iter().cloned())
+                        .collect();
                     Outcome {
                         status: "found",
-                        err,
-                        confidence: Some(d.confidence),
-                        why: why.into_iter().chain(p.notes.clone()).collect::<Vec<_>>().join("; "),
+                        err: errs.map(Result::ok),
+                        confidence: Some(p.detected.confidence),
+                        why: why.join("; "),
                     }
                 }
             }

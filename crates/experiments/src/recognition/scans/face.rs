@@ -6,7 +6,7 @@ use super::super::describe::{describe_face, DescribeOptions, Described};
 use super::super::Lm;
 use crate::pipeline::bar;
 use crate::scans::{
-    clean_scan, scan_raw, FaceSpec, ScanSetOptions, ScannedFace, MAX_SNAP_MM, REFERENCE_LANDMARKS,
+    clean_scan, detection_errors, scan_raw, FaceSpec, ScanSetOptions, ScannedFace, MAX_SNAP_MM,
     SCANNER_SIDE,
 };
 use crate::walk::Walker;
@@ -18,9 +18,9 @@ use rayon::prelude::*;
 use std::time::Instant;
 
 /// One scanned and described face.
-pub(super) struct Face {
-    pub(super) name: String,
-    pub(super) identity: usize,
+pub(in super::super) struct Face {
+    pub(in super::super) name: String,
+    pub(in super::super) identity: usize,
     /// Per landmark set, the cleaned scan, kept for gallery faces (ICP target): for the ground
     /// truth cropped around the true nose tip, for the detected landmarks the scan
     /// `facematch::prepare` made (cropped around the detected nose tip).
@@ -28,9 +28,9 @@ pub(super) struct Face {
     /// Its ground-truth landmark vertices, when on the scan.
     pub(super) gt_lm: Option<Lm>,
     /// Per landmark set, the ICP probe points (of that set's scan).
-    pub(super) pts: [Vec<DVec3>; 2],
+    pub(in super::super) pts: [Vec<DVec3>; 2],
     /// Per landmark set: the description or why there is none.
-    pub(super) desc: [Result<Described, String>; 2],
+    pub(in super::super) desc: [Result<Described, String>; 2],
     /// Detected minus true position of the outer eye corners and the nose tip (mm), when
     /// detected and on the scan.
     pub(super) det_err: Option<[f64; 3]>,
@@ -42,6 +42,25 @@ pub(super) struct Face {
     /// Wall seconds: scan, clean (ground truth's), prepare (the detected path's cleanings and
     /// detections), describe.
     pub(super) secs: [f64; 4],
+}
+
+impl Face {
+    /// A face not yet described: no meshes, points, descriptions or times.
+    pub(in super::super) fn new(name: &str, identity: usize) -> Self {
+        Face {
+            name: name.to_string(),
+            identity,
+            mesh: [None, None],
+            gt_lm: None,
+            pts: [Vec::new(), Vec::new()],
+            desc: [Err(String::new()), Err(String::new())],
+            det_err: None,
+            prepare_notes: Vec::new(),
+            valid_samples: 0,
+            vertices: 0,
+            secs: [0.0; 4],
+        }
+    }
 }
 
 /// What describing a face needs: the model, the landmark model, the geodesic method, the
@@ -91,19 +110,7 @@ impl Pipeline<'_> {
             icp_n,
             save,
         } = *self;
-        let mut face = Face {
-            name: spec.name.clone(),
-            identity: spec.identity,
-            mesh: [None, None],
-            gt_lm: None,
-            pts: [Vec::new(), Vec::new()],
-            desc: [Err(String::new()), Err(String::new())],
-            det_err: None,
-            prepare_notes: Vec::new(),
-            valid_samples: 0,
-            vertices: 0,
-            secs: [0.0; 4],
-        };
+        let mut face = Face::new(&spec.name, spec.identity);
         let gt_opts = ScanSetOptions {
             detect: None,
             ..scan_opts.clone()
@@ -129,16 +136,19 @@ impl Pipeline<'_> {
         let prepared =
             facematch::prepare_with(facematch::ScanInput::Grid(&raw.grid), generic, prep)
                 .map_err(|e| format!("prepare: {e}"));
-        drop(raw);
         face.secs[2] = t.elapsed().as_secs_f64();
         face.valid_samples = s.valid_samples;
         face.vertices = s.mesh.n_vertices();
         face.secs[0] = s.times.scan.as_secs_f64();
         face.secs[1] = s.times.clean.as_secs_f64();
         if let Ok(p) = &prepared {
-            face.det_err = detection_errors(&s, &p.detected);
+            // An unseen landmark counts as infinitely far off; none when the truth is off the scan.
+            face.det_err = s.truth_vertices().is_ok().then(|| {
+                detection_errors(&raw.landmarks, &p.detected).map(|e| e.unwrap_or(f64::INFINITY))
+            });
             face.prepare_notes = p.notes.clone();
         }
+        drop(raw);
         // The reference-point search is the probes' (the gallery keeps its one description).
         let gallery_opts = dopt.without_search();
         let dopt = if keep_mesh { &gallery_opts } else { dopt };
@@ -198,15 +208,4 @@ fn truth_lm(s: &ScannedFace, allow_lost: bool) -> Result<Lm, String> {
         [at(L::OuterEyeRight), at(L::OuterEyeLeft)],
         allow_lost,
     )
-}
-
-/// Distances (mm) of the detected outer eye corners and nose tip from their ground truth (an
-/// unseen one counts as infinitely far off), when the ground truth is on the scan.
-fn detection_errors(s: &ScannedFace, found: &landmarks::VisibleLandmarks) -> Option<[f64; 3]> {
-    s.truth_vertices().ok()?;
-    Some(REFERENCE_LANDMARKS.map(|n| {
-        found.get(n).map_or(f64::INFINITY, |l| {
-            (l.position - s.truth[n as usize].position).length()
-        })
-    }))
 }

@@ -27,14 +27,16 @@ use crate::pipeline::resolve_methods;
 use crate::scans::{scan_face, FaceSpec, ScanSetOptions, ScanSettings};
 use anyhow::{bail, Context, Result};
 use detect_only::detect_only;
-use face::{Face, Pipeline};
+pub(super) use face::Face;
+use face::Pipeline;
 use facecurves::{ElasticOptions, IsoLevels};
 use facemodel::FaceModel;
 use geodesic::Method;
 use landmarks::GenericModel;
 use meshcore::{DVec3, FaceLocator, TriMesh};
 use scanprep::{CleanOptions, Crop};
-use score::{failures, score_group, Scored};
+pub(super) use score::score_group;
+use score::{failures, Scored};
 use specs::{sweeps, Specs, Sweep};
 use std::time::Instant;
 

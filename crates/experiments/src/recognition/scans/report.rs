@@ -6,7 +6,7 @@ use super::face::Face;
 use super::score::Scored;
 use super::{p95, Results, Setup};
 use crate::report::{Report, Series};
-use crate::scans::{MAX_SNAP_MM, PROBE_NOISE};
+use crate::scans::MAX_SNAP_MM;
 use anyhow::Result;
 
 /// Writes the report, its CSVs and figures and `summary.json`; prints the fallbacks' counts, the
@@ -113,7 +113,7 @@ fn intro(s: &Setup<'_>, r: &Results) -> String {
     gallery.len(),
     base.label(),
     probes.len(),
-    PROBE_NOISE.map(|x| x.to_string()).join(" / "),
+    rangescan::PROBE_NOISE_MM.map(|x| x.to_string()).join(" / "),
     args.scan.crop_radius,
     scan_opts
         .clean

@@ -12,7 +12,7 @@ use meshcore::{DVec3, FaceLocator};
 
 /// Figures of a probe group against the gallery, per landmark set and score, with the times
 /// per comparison (timed on pairs of this group) and per description (`ms_desc`).
-pub(super) fn score_group(
+pub(in super::super) fn score_group(
     gallery: &[Face],
     locators: &[[Option<FaceLocator<'_>>; 2]],
     probes: &[Face],
@@ -35,24 +35,18 @@ pub(super) fn score_group(
             .iter()
             .map(|p| (p.desc[k].as_ref().ok(), p.pts[k].as_slice()))
             .collect();
-        let hidden = indicatif::ProgressBar::hidden();
-        let (rows, pairs, ms_cmp) = score_set(&pr, &gal, elastic, &hidden)?;
+        let (rows, pairs, ms_cmp) = score_set(&pr, &gal, elastic)?;
         all.extend(summarize(&rows, &ms_cmp, ms_desc, &pid, &gid, set));
         for (p, row) in probes.iter().zip(&rows) {
             for (j, score) in SCORES.iter().enumerate() {
                 per_probe.push(probe_rank(&p.name, p.identity, set, score, &row[j], &gid));
             }
         }
-        let mut kinds = std::collections::BTreeMap::<String, usize>::new();
-        let (mut with, mut total) = (0, 0);
+        let mut count = facematch::FallbackCount::default();
         for (p, ds) in probes.iter().zip(&pairs) {
             let Ok(x) = &p.desc[k] else { continue };
             for (g, (d, fb)) in gallery.iter().zip(ds) {
-                total += 1;
-                with += usize::from(!fb.is_empty());
-                for f in fb {
-                    *kinds.entry(f.clone()).or_default() += 1;
-                }
+                count.add(fb);
                 by_pair.push(
                     [
                         p.name.clone(),
@@ -70,16 +64,7 @@ pub(super) fn score_group(
                 );
             }
         }
-        let kinds: Vec<String> = kinds.iter().map(|(k, n)| format!("{k}: {n}")).collect();
-        fallbacks.push(format!(
-            "{set}: {with} of {total} bipolar comparisons took a fallback{}{}",
-            if kinds.is_empty() { "" } else { " (" },
-            if kinds.is_empty() {
-                String::new()
-            } else {
-                kinds.join("; ") + ")"
-            }
-        ));
+        fallbacks.push(format!("{set}: {}", count.sentence("bipolar comparisons")));
     }
     Ok(Scored {
         metrics: all,
@@ -91,9 +76,9 @@ pub(super) fn score_group(
 
 /// What [`score_group`] gives: the figures, the lines of `probes.csv` and those of
 /// `bipolar-pairs.csv`, and per landmark set the count of bipolar comparisons that took a
-/// fallback ([`facematch::Comparison::fallbacks`]), by kind.
-pub(super) struct Scored {
-    pub(super) metrics: Vec<Metrics>,
+/// fallback ([`facematch::FallbackCount`]), by kind.
+pub(in super::super) struct Scored {
+    pub(in super::super) metrics: Vec<Metrics>,
     pub(super) per_probe: Vec<Vec<String>>,
     pub(super) by_pair: Vec<Vec<String>>,
     pub(super) fallbacks: Vec<String>,
