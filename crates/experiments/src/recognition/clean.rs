@@ -3,8 +3,8 @@
 
 use super::compare::{icp_points, time_descriptions, TIMED_FACES, TIMED_PAIRS};
 use super::describe::{describe_face, elastic_options, iso_levels_of, DescribeOptions, ISO_POINTS};
-use super::metrics::{paired_table, results_table, roc_figure, write_summary, Metrics};
-use super::scans::{score_group, Face};
+use super::metrics::{paired_table, results_table, roc_figure, write_summary};
+use super::scans::{score_group, Face, Scored};
 use super::{Args, Lm};
 use crate::pipeline::{bar, resolve_methods};
 use crate::report::Report;
@@ -101,8 +101,8 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         probe_opts: &probe_opts,
         detected: &detected,
     };
-    let all = score_all(args, &setup, faces, gt)?;
-    write_report(args, &setup, gt, &all, &out, t0)
+    let scored = score_all(args, &setup, faces, gt)?;
+    write_report(args, &setup, gt, &scored, &out, t0)
 }
 
 /// Samples `identities` x `expressions` faces (expression 0 neutral), each under a random rigid
@@ -197,10 +197,10 @@ fn describe_all(
     Ok(faces)
 }
 
-/// The figures of every score with both landmark sets ([`score_group`]: the probes scored
-/// against the gallery in parallel, the comparisons timed on one thread), with the
-/// descriptions timed on one thread.
-fn score_all(args: &Args, s: &Setup<'_>, faces: Vec<Face>, gt: Lm) -> Result<Vec<Metrics>> {
+/// The figures of every score with both landmark sets and the bipolar comparisons' fallbacks
+/// ([`score_group`]: the probes scored against the gallery in parallel, the comparisons timed
+/// on one thread), with the descriptions timed on one thread.
+fn score_all(args: &Args, s: &Setup<'_>, faces: Vec<Face>, gt: Lm) -> Result<Scored> {
     let samples = s.samples;
     // Description times: the first gallery faces again, one at a time on one thread.
     let first: Vec<(&TriMesh, Lm)> = s
@@ -224,16 +224,16 @@ fn score_all(args: &Args, s: &Setup<'_>, faces: Vec<Face>, gt: Lm) -> Result<Vec
         .map(|&g| [0, 1].map(|_| Some(FaceLocator::new(&samples[g].mesh))))
         .collect();
     let elastic = elastic_options(args.curve_samples);
-    Ok(score_group(&gallery, &locators, &probes, &elastic, &ms_desc)?.metrics)
+    score_group(&gallery, &locators, &probes, &elastic, &ms_desc)
 }
 
-/// Writes `report.md` (settings, landmark detection, results, the paired comparison, ROC) and
-/// `summary.json`; prints the output folder.
+/// Writes `report.md` (settings, landmark detection, results, the paired comparison, the bipolar
+/// fallbacks, ROC) and `summary.json`; prints the fallbacks' counts and the output folder.
 fn write_report(
     args: &Args,
     s: &Setup<'_>,
     gt: Lm,
-    all: &[Metrics],
+    scored: &Scored,
     out: &std::path::Path,
     t0: Instant,
 ) -> Result<()> {
@@ -262,8 +262,14 @@ fn write_report(
     let mean_err =
         |k: usize| det_err.iter().map(|e| e[k]).sum::<f64>() / det_err.len().max(1) as f64;
     rep.para(&format!("Landmark detection: {n_det} of {} faces detected; mean error right corner {:.3} cm, left corner {:.3} cm, nose tip {:.3} cm.", samples.len(), mean_err(0), mean_err(1), mean_err(2)));
+    let all = &scored.metrics;
     results_table(&mut rep, all, "results.csv")?;
     paired_table(&mut rep, all);
+    rep.para("The bipolar comparisons' fallbacks (a probe's own descriptor that failed replaced by the least of its moved ones, moved descriptors that failed left out), counted per landmark set:");
+    rep.list(&scored.fallbacks);
+    for f in &scored.fallbacks {
+        println!("{f}");
+    }
     roc_figure(&mut rep, all, "roc.svg", "ROC (verification)")?;
     rep.png_twins()?;
     let secs = t0.elapsed().as_secs_f64();

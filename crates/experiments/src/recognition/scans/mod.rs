@@ -35,8 +35,8 @@ use geodesic::Method;
 use landmarks::GenericModel;
 use meshcore::{DVec3, FaceLocator, TriMesh};
 use scanprep::{CleanOptions, Crop};
-pub(super) use score::score_group;
-use score::{failures, Scored};
+use score::failures;
+pub(super) use score::{score_group, Scored};
 use specs::{sweeps, Specs, Sweep};
 use std::time::Instant;
 

@@ -81,7 +81,7 @@ pub(in super::super) struct Scored {
     pub(in super::super) metrics: Vec<Metrics>,
     pub(super) per_probe: Vec<Vec<String>>,
     pub(super) by_pair: Vec<Vec<String>>,
-    pub(super) fallbacks: Vec<String>,
+    pub(in super::super) fallbacks: Vec<String>,
 }
 
 /// One line of `probes.csv`: where the probe's own identity ranks among the gallery for one
