@@ -15,6 +15,27 @@ pub struct DepthNoise {
     pub sigma_mm: f64,
 }
 
+impl DepthNoise {
+    /// `mesh` with this noise along its vertex normals instead of along a scan's rays: each
+    /// vertex moved by a Gaussian draw of standard deviation `sigma_mm` (`sigma_mm /
+    /// mm_per_unit` in the mesh's units), the draws from `rng` in vertex order. Errors when the
+    /// moved mesh is not valid (a non-finite position).
+    pub fn along_normals<R: Rng>(
+        &self,
+        mesh: &meshcore::TriMesh,
+        mm_per_unit: f64,
+        rng: &mut R,
+    ) -> Result<meshcore::TriMesh, meshcore::MeshError> {
+        let sigma = self.sigma_mm / mm_per_unit;
+        let normals = mesh.vertex_normals();
+        let moved = mesh.positions().iter().zip(&normals).map(|(p, n)| {
+            let z: f64 = rng.sample(StandardNormal);
+            *p + *n * (sigma * z)
+        });
+        meshcore::TriMesh::new(moved.collect(), mesh.triangles().to_vec())
+    }
+}
+
 /// Depth quantisation: the depth is rounded to a multiple of the step (consumer depth cameras
 /// store depth in steps of 1-4 mm). Orthographic: the `z` coordinate; pinhole: the distance
 /// from the camera plane, the sample staying on its ray.
@@ -408,6 +429,25 @@ fn bounds(idx: &[usize], nc: usize) -> Option<(usize, usize, usize, usize)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn noise_along_normals_moves_a_sphere_radially_by_sigma() {
+        let sphere = meshcore::shapes::icosphere(4);
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let noise = DepthNoise { sigma_mm: 0.5 };
+        // A unit sphere in cm: 0.5 mm is 0.05 units, along the (radial) normals.
+        let moved = noise.along_normals(&sphere, 10.0, &mut rng).unwrap();
+        assert_eq!(moved.triangles(), sphere.triangles());
+        let dr: Vec<f64> = moved.positions().iter().map(|p| p.length() - 1.0).collect();
+        let sd = (dr.iter().map(|d| d * d).sum::<f64>() / dr.len() as f64).sqrt();
+        assert!((0.045..0.055).contains(&sd), "{sd}");
+        for (p, q) in sphere.positions().iter().zip(moved.positions()) {
+            assert!(p.cross(*q).length() < 1e-3, "moved off the normal");
+        }
+        // The same stream moves the same way.
+        let again = noise.along_normals(&sphere, 10.0, &mut ChaCha8Rng::seed_from_u64(3));
+        assert_eq!(again.unwrap().positions(), moved.positions());
+    }
 
     #[test]
     fn a_depth_camera_quantises_and_drops_out_but_has_no_spikes() {

@@ -6,14 +6,10 @@ use crate::pipeline::{bipolar, dist, DescriptorRule, Refs, Region};
 use crate::polar::{self, polar_descriptor, PolarOptions, Pole};
 use crate::report::Failures;
 use crate::walk::Walker;
-use anyhow::Result;
 use bipolar::PolarDescriptor;
 use facecurves::nose::{facial_curves, facial_distance, iso_curves, iso_distance};
 use facecurves::{ElasticOptions, FacialCurvesDescriptor, IsoCurvatureDescriptor, IsoLevels};
 use meshcore::{Surface, TriMesh};
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
-use rand_distr::{Distribution, StandardNormal};
 use std::time::{Duration, Instant};
 
 /// The four descriptors of one face configuration (`None`: not asked for, or refused and
@@ -138,21 +134,4 @@ impl Ctx<'_> {
         }
         (d, t)
     }
-}
-
-/// `mesh` with Gaussian noise of standard deviation `sigma` (mesh units) along its vertex
-/// normals.
-pub(super) fn noisy(mesh: &TriMesh, sigma: f64, seed: u64) -> Result<TriMesh> {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let normals = mesh.vertex_normals();
-    let pos = mesh
-        .positions()
-        .iter()
-        .zip(&normals)
-        .map(|(p, n)| {
-            let z: f64 = StandardNormal.sample(&mut rng);
-            *p + *n * (sigma * z)
-        })
-        .collect();
-    Ok(TriMesh::new(pos, mesh.triangles().to_vec())?)
 }

@@ -1,7 +1,7 @@
 //! The measurements of section 6 on a described face set: the between-person matrices and
 //! the time per comparison, the reference-point grid, the depth noise and figure 15.
 
-use super::describe::{noisy, Ctx, Descs};
+use super::describe::{Ctx, Descs};
 use super::figure15::{figure15, Fig15};
 use crate::pipeline::{bar, dist, error_grid, single_thread};
 use crate::polar::Pole;
@@ -11,6 +11,8 @@ use crate::robustness::FacePrep;
 use crate::walk::Walker;
 use anyhow::{Context, Result};
 use facemodel::Face;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use std::time::Duration;
 
@@ -165,7 +167,8 @@ pub(super) fn depth_noise(s: &Set<'_>, mm: f64) -> Result<Cells<(f64, usize)>> {
         .map(|&(sigma_mm, k)| -> Result<[f64; 4]> {
             let seed =
                 args.seed ^ (k as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ sigma_mm.to_bits();
-            let m = noisy(&tf.mesh, sigma_mm / mm, seed)?;
+            let noise = rangescan::DepthNoise { sigma_mm };
+            let m = noise.along_normals(&tf.mesh, mm, &mut ChaCha8Rng::seed_from_u64(seed))?;
             let noisy_face = Face {
                 mesh: m,
                 ..tf.clone()
