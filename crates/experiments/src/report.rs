@@ -215,6 +215,27 @@ impl Failures {
     }
 }
 
+/// `f` of every item of `items`, in parallel (rayon) and in item order, counted on a progress
+/// bar labelled `msg` (`pipeline::bar`).
+pub fn par_map<T: Sync, R: Send>(
+    items: &[T],
+    msg: &str,
+    f: impl Fn(&T) -> R + Sync + Send,
+) -> Vec<R> {
+    use rayon::prelude::*;
+    let pb = crate::pipeline::bar(items.len(), msg);
+    let out = items
+        .par_iter()
+        .map(|x| {
+            let r = f(x);
+            pb.inc(1);
+            r
+        })
+        .collect();
+    pb.finish();
+    out
+}
+
 /// The value at fraction `p` of the sorted values `v` (the nearest rank, rounded; NaN when
 /// empty): the median of an even count is the upper middle value.
 pub fn quantile(v: &[f64], p: f64) -> f64 {

@@ -5,8 +5,9 @@
 use super::base::Base;
 use super::stats::{max, mean, min};
 use super::{eye_mid, Ctx, FacePrep, MethodResults, RESOLUTIONS};
-use crate::pipeline::{bar, error_grid, Refs, Region};
+use crate::pipeline::{error_grid, Refs, Region};
 use crate::polar::{polar_descriptor, Pole};
+use crate::report::par_map;
 use anyhow::Result;
 use bipolar::PolarDescriptor;
 use rayon::prelude::*;
@@ -23,26 +24,21 @@ struct Cell {
 /// Moves q and the nose tip of the test face for every (radius, direction) cell.
 fn perturbed(ctx: &Ctx<'_>, prep: &[FacePrep], cells: &[(f64, f64)]) -> Result<Vec<Cell>> {
     let (test, tr) = (ctx.test, &prep[ctx.test].refs);
-    let pb = bar(cells.len(), &format!("{}: perturbation grid", ctx.mname()));
-    let grid = cells
-        .par_iter()
-        .map(|&cell| -> Result<_> {
-            let w = &ctx.walkers[test];
-            let (refs, (sn, un), (cut_q, cut_nose)) =
-                prep[test].moved_cell(&ctx.faces[test], w, cell)?;
-            let pole = Pole::Point(sn);
-            let polar = polar_descriptor(w, &un, pole, eye_mid(tr), &ctx.polar_opts(tr))?;
-            pb.inc(1);
-            Ok(Cell {
-                refs,
-                polar,
-                cut_q,
-                cut_nose,
-            })
+    let w = &ctx.walkers[test];
+    let msg = format!("{}: perturbation grid", ctx.mname());
+    let grid = par_map(cells, &msg, |&cell| -> Result<_> {
+        let (refs, (sn, un), (cut_q, cut_nose)) =
+            prep[test].moved_cell(&ctx.faces[test], w, cell)?;
+        let pole = Pole::Point(sn);
+        let polar = polar_descriptor(w, &un, pole, eye_mid(tr), &ctx.polar_opts(tr))?;
+        Ok(Cell {
+            refs,
+            polar,
+            cut_q,
+            cut_nose,
         })
-        .collect::<Result<_>>()?;
-    pb.finish();
-    Ok(grid)
+    });
+    grid.into_iter().collect()
 }
 
 /// Fills the perturbation grid (figures 9, 10, 17) and the three cases (figure 11).

@@ -21,7 +21,7 @@ use crate::pipeline::{
     bipolar, dist, field, field_at, perturb, resolve_methods, DescriptorRule, Keyed, Refs, Region,
 };
 use crate::polar::PolarOptions;
-use crate::report::Failures;
+use crate::report::{par_map, Failures};
 use crate::walk::Walker;
 use anyhow::{bail, Result};
 use bipolar::PolarDescriptor;
@@ -299,15 +299,10 @@ pub fn run(args: Args) -> Result<()> {
 
 /// The [`FacePrep`] of every face with the context's method.
 fn prepare(ctx: &Ctx<'_>) -> Result<Vec<FacePrep>> {
-    let pb = crate::pipeline::bar(ctx.faces.len(), &format!("{}: base fields", ctx.mname()));
-    let prepared = ctx.faces.par_iter().map(|f| {
-        let p = FacePrep::new(f, ctx.method);
-        pb.inc(1);
-        p
-    });
-    let prepared = prepared.collect::<Result<Vec<_>>>()?;
-    pb.finish();
-    Ok(prepared)
+    let msg = format!("{}: base fields", ctx.mname());
+    par_map(ctx.faces, &msg, |f| FacePrep::new(f, ctx.method))
+        .into_iter()
+        .collect()
 }
 
 fn run_method(ctx: &Ctx<'_>, out: &Path) -> Result<MethodResults> {

@@ -3,8 +3,9 @@
 //! between the perturbed descriptors.
 
 use super::{eye_mid, Ctx, Desc, FacePrep, MethodResults};
-use crate::pipeline::{bar, field, field_at, perturb, Refs, Region};
+use crate::pipeline::{field, field_at, perturb, Refs, Region};
 use crate::polar::{polar_descriptor, Pole};
+use crate::report::par_map;
 use crate::walk::Walker;
 use anyhow::Result;
 use bipolar::PolarDescriptor;
@@ -13,7 +14,6 @@ use geodesic::Source;
 use meshcore::{DVec3, SurfacePoint};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rayon::prelude::*;
 
 /// The perturbed descriptors of one face and the radius of its one-corner error (% of D).
 struct Run {
@@ -93,16 +93,10 @@ fn one_face(ctx: &Ctx<'_>, prep: &FacePrep, i: usize) -> Result<Run> {
 /// Fills the random-error matrices.
 pub(super) fn run(ctx: &Ctx<'_>, prep: &[FacePrep], res: &mut MethodResults) -> Result<()> {
     let nf = ctx.faces.len();
-    let pb = bar(nf, &format!("{}: random errors", ctx.mname()));
-    let runs: Vec<Run> = (0..nf)
-        .into_par_iter()
-        .map(|i| {
-            let r = one_face(ctx, &prep[i], i);
-            pb.inc(1);
-            r
-        })
-        .collect::<Result<_>>()?;
-    pb.finish();
+    let ids: Vec<usize> = (0..nf).collect();
+    let msg = format!("{}: random errors", ctx.mname());
+    let runs = par_map(&ids, &msg, |&i| one_face(ctx, &prep[i], i));
+    let runs = runs.into_iter().collect::<Result<Vec<Run>>>()?;
     let (mut one, mut both, mut nose) = (Vec::new(), Vec::new(), Vec::new());
     for r in runs {
         res.rand_one_pct.push(r.one_pct);

@@ -29,14 +29,12 @@ mod tests;
 mod variants;
 
 use crate::paths::FaceSetArgs;
-use crate::pipeline::bar;
-use crate::report::{quantile, sorted};
+use crate::report::{par_map, quantile, sorted};
 use acquisition::{settings, Setting};
 use anyhow::{bail, Result};
 use description::{describe_scan, Described};
 use facemodel::{load_face_set, Face};
 use meshcore::FaceLocator;
-use rayon::prelude::*;
 use std::time::Instant;
 use variants::{LEAST, VARIANTS};
 
@@ -171,21 +169,14 @@ fn describe_all(faces: &[Face], sets: &[Setting], args: &Args) -> Vec<ScanResult
     let jobs: Vec<(usize, usize)> = (0..faces.len())
         .flat_map(|f| (0..sets.len()).map(move |s| (f, s)))
         .collect();
-    let pb = bar(jobs.len(), "scan, clean, describe");
-    let scans = jobs
-        .par_iter()
-        .map(|&(f, s)| {
-            let status = describe_scan(&faces[f], &sets[s], args).map_err(|e| format!("{e:#}"));
-            pb.inc(1);
-            ScanResult {
-                face: f,
-                setting: s,
-                status,
-            }
-        })
-        .collect();
-    pb.finish();
-    scans
+    par_map(&jobs, "scan, clean, describe", |&(f, s)| {
+        let status = describe_scan(&faces[f], &sets[s], args).map_err(|e| format!("{e:#}"));
+        ScanResult {
+            face: f,
+            setting: s,
+            status,
+        }
+    })
 }
 
 /// The pairs of usable scans that `--pairs` asks for, compared.
@@ -205,34 +196,26 @@ fn compare_all(faces: &[Face], scans: &[ScanResult], args: &Args) -> Vec<ScanPai
             all_pairs || x.face == y.face || x.setting == y.setting
         })
         .collect();
-    let pb = bar(idx_pairs.len(), "distances");
-    let pairs = idx_pairs
-        .par_iter()
-        .map(|&(a, b)| {
-            let (ia, da) = ok[a];
-            let (ib, db) = ok[b];
-            let (fa, fb) = (&faces[scans[ia].face], &faces[scans[ib].face]);
-            let rel = if scans[ia].face == scans[ib].face {
-                Relation::SameFace
-            } else if fa.person == fb.person {
-                Relation::SamePerson
-            } else {
-                Relation::Other
-            };
-            let (d, fallbacks) =
-                distances::pair_distances(da, db, &locators[a], &locators[b], args);
-            pb.inc(1);
-            ScanPair {
-                a: ia,
-                b: ib,
-                rel,
-                d,
-                fallbacks,
-            }
-        })
-        .collect();
-    pb.finish();
-    pairs
+    par_map(&idx_pairs, "distances", |&(a, b)| {
+        let (ia, da) = ok[a];
+        let (ib, db) = ok[b];
+        let (fa, fb) = (&faces[scans[ia].face], &faces[scans[ib].face]);
+        let rel = if scans[ia].face == scans[ib].face {
+            Relation::SameFace
+        } else if fa.person == fb.person {
+            Relation::SamePerson
+        } else {
+            Relation::Other
+        };
+        let (d, fallbacks) = distances::pair_distances(da, db, &locators[a], &locators[b], args);
+        ScanPair {
+            a: ia,
+            b: ib,
+            rel,
+            d,
+            fallbacks,
+        }
+    })
 }
 
 /// Runs the study; prints the report folder on the last line.

@@ -3,9 +3,9 @@
 
 use super::describe::{Ctx, Descs};
 use super::figure15::{figure15, Fig15};
-use crate::pipeline::{bar, dist, error_grid, single_thread};
+use crate::pipeline::{dist, error_grid, single_thread};
 use crate::polar::Pole;
-use crate::report::{quantile, sorted};
+use crate::report::{par_map, quantile, sorted};
 use crate::robustness::stats::Sep;
 use crate::robustness::FacePrep;
 use crate::walk::Walker;
@@ -13,8 +13,6 @@ use anyhow::{Context, Result};
 use facemodel::Face;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use rayon::prelude::*;
-use std::time::Duration;
 
 /// The described face set: faces, their geodesic set-ups, walkers and base descriptors, the
 /// test face, and the describing context.
@@ -58,20 +56,10 @@ pub(super) fn between_persons(s: &Set<'_>) -> Result<Between> {
     let pairs: Vec<(usize, usize)> = (0..nf)
         .flat_map(|i| (i + 1..nf).map(move |j| (i, j)))
         .collect();
-    let pb = bar(pairs.len(), "12 x 12 matrices");
-    let cells: Vec<([f64; 4], [Duration; 4])> = pairs
-        .par_iter()
-        .map(|&(i, j)| {
-            let r = ctx.distances(
-                &base[i],
-                &base[j],
-                &format!("{} vs {}", faces[i].name, faces[j].name),
-            );
-            pb.inc(1);
-            r
-        })
-        .collect();
-    pb.finish();
+    let cells = par_map(&pairs, "12 x 12 matrices", |&(i, j)| {
+        let what = format!("{} vs {}", faces[i].name, faces[j].name);
+        ctx.distances(&base[i], &base[j], &what)
+    });
     let mut mats = vec![vec![vec![0.0; nf]; nf]; 4];
     for (&(i, j), (d, _)) in pairs.iter().zip(&cells) {
         for k in 0..4 {
@@ -110,16 +98,10 @@ pub(super) fn between_persons(s: &Set<'_>) -> Result<Between> {
 /// walk was stopped by a hole).
 pub(super) fn reference_grid(s: &Set<'_>) -> Result<Cells<(f64, f64)>> {
     let grid_cells = error_grid();
-    let pb = bar(grid_cells.len(), "reference-point grid");
-    let grid: Vec<[f64; 4]> = grid_cells
-        .par_iter()
-        .map(|&(pct, theta)| -> Result<[f64; 4]> {
-            let d = grid_cell(s, pct, theta);
-            pb.inc(1);
-            d
-        })
-        .collect::<Result<_>>()?;
-    pb.finish();
+    let grid = par_map(&grid_cells, "reference-point grid", |&(pct, theta)| {
+        grid_cell(s, pct, theta)
+    });
+    let grid = grid.into_iter().collect::<Result<Vec<_>>>()?;
     Ok((grid_cells, grid))
 }
 
@@ -161,10 +143,10 @@ pub(super) fn depth_noise(s: &Set<'_>, mm: f64) -> Result<Cells<(f64, usize)>> {
         .iter()
         .flat_map(|&s| (0..args.noise_draws).map(move |k| (s, k)))
         .collect();
-    let pb = bar(noise_cells.len(), "depth noise");
-    let noise: Vec<[f64; 4]> = noise_cells
-        .par_iter()
-        .map(|&(sigma_mm, k)| -> Result<[f64; 4]> {
+    let noise = par_map(
+        &noise_cells,
+        "depth noise",
+        |&(sigma_mm, k)| -> Result<[f64; 4]> {
             let seed =
                 args.seed ^ (k as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ sigma_mm.to_bits();
             let noise = rangescan::DepthNoise { sigma_mm };
@@ -178,12 +160,10 @@ pub(super) fn depth_noise(s: &Set<'_>, mm: f64) -> Result<Cells<(f64, usize)>> {
             let name = format!("{} with {sigma_mm} mm noise, draw {k}", tf.name);
             let nose = Pole::Vertex(tf.landmarks.nose_tip);
             let dsc = ctx.describe((&noisy_face.mesh, &wn), &p.refs, &p.un, nose, &name);
-            let (d, _) = ctx.distances(&s.base[s.test], &dsc, &name);
-            pb.inc(1);
-            Ok(d)
-        })
-        .collect::<Result<_>>()?;
-    pb.finish();
+            Ok(ctx.distances(&s.base[s.test], &dsc, &name).0)
+        },
+    );
+    let noise = noise.into_iter().collect::<Result<Vec<_>>>()?;
     Ok((noise_cells, noise))
 }
 

@@ -16,10 +16,9 @@
 //! states for each claim of section 6 whether the numbers support it.
 
 use crate::paths::FaceSetArgs;
-use crate::pipeline::bar;
 use crate::polar::Pole;
 use crate::report::Failures;
-use crate::report::Report;
+use crate::report::{par_map, Report};
 use crate::robustness::FacePrep;
 use crate::walk::Walker;
 use anyhow::{bail, Context, Result};
@@ -86,16 +85,10 @@ pub fn run(args: Args) -> Result<()> {
     let out = args.set.out.out_dir("section6");
     let mut rep = Report::new(&out, "Section 6: the four representations side by side")?;
     let walkers: Vec<Walker<'_>> = faces.par_iter().map(|f| Walker::new(&f.mesh)).collect();
-    let pb = bar(faces.len(), "geodesic fields");
-    let preps: Vec<FacePrep> = faces
-        .par_iter()
-        .map(|f| {
-            let p = FacePrep::new(f, geodesic::Method::Exact);
-            pb.inc(1);
-            p
-        })
-        .collect::<Result<_>>()?;
-    pb.finish();
+    let preps = par_map(&faces, "geodesic fields", |f| {
+        FacePrep::new(f, geodesic::Method::Exact)
+    });
+    let preps = preps.into_iter().collect::<Result<Vec<_>>>()?;
     let failures = Failures::default();
     // Iso-curvature levels: quantiles of the test face's nose disc, the same for all faces.
     let tf = &faces[test];
@@ -160,18 +153,10 @@ fn describe_all(
     preps: &[FacePrep],
     walkers: &[Walker<'_>],
 ) -> Vec<Descs> {
-    let pb = bar(faces.len(), "descriptors");
-    let base: Vec<Descs> = faces
-        .par_iter()
-        .zip(preps)
-        .zip(walkers)
-        .map(|((f, p), w)| {
-            let nose = Pole::Vertex(f.landmarks.nose_tip);
-            let d = ctx.describe((&f.mesh, w), &p.refs, &p.un, nose, &f.name);
-            pb.inc(1);
-            d
-        })
-        .collect();
-    pb.finish();
-    base
+    let ids: Vec<usize> = (0..faces.len()).collect();
+    par_map(&ids, "descriptors", |&i| {
+        let (f, p) = (&faces[i], &preps[i]);
+        let nose = Pole::Vertex(f.landmarks.nose_tip);
+        ctx.describe((&f.mesh, &walkers[i]), &p.refs, &p.un, nose, &f.name)
+    })
 }
