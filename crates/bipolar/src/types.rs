@@ -328,6 +328,25 @@ impl Descriptor {
             .unzip()
     }
 
+    /// An FNV-1a hash of the points' packed keys and the bit patterns of their positions, in
+    /// point order: equal fingerprints mean the same points, bit for bit (a check that a change
+    /// of the pipeline left a descriptor as it was).
+    pub fn fingerprint(&self) -> u64 {
+        let mut h = 0xcbf2_9ce4_8422_2325_u64;
+        let mut eat = |x: u64| {
+            for b in x.to_le_bytes() {
+                h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+            }
+        };
+        for p in &self.points {
+            eat(p.key.pack());
+            for c in p.position.to_array() {
+                eat(c.to_bits());
+            }
+        }
+        h
+    }
+
     /// Number of points.
     pub fn len(&self) -> usize {
         self.points.len()
@@ -336,5 +355,33 @@ impl Descriptor {
     /// True when there are no points.
     pub fn is_empty(&self) -> bool {
         self.points.is_empty()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn a_fingerprint_changes_with_any_point_bit_for_bit() {
+        let mesh = meshcore::shapes::icosphere(3);
+        let solver = geodesic::new_solver(&mesh, geodesic::Method::Dijkstra).unwrap();
+        let references = [geodesic::Source::Vertex(0), geodesic::Source::Vertex(5)];
+        let d = crate::describe(
+            &crate::Surface::new(mesh),
+            crate::Fields::Solve {
+                solver: solver.as_ref(),
+                references: &references,
+            },
+            &crate::DescriptorOptions::default(),
+        )
+        .unwrap();
+        assert!(d.len() > 10);
+        assert_eq!(d.clone().fingerprint(), d.fingerprint());
+        let mut moved = d.clone();
+        let x = &mut moved.points[3].position.x;
+        *x = f64::from_bits(x.to_bits() + 1);
+        assert_ne!(moved.fingerprint(), d.fingerprint());
+        let mut fewer = d.clone();
+        fewer.points.pop();
+        assert_ne!(fewer.fingerprint(), d.fingerprint());
     }
 }
