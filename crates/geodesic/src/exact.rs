@@ -88,10 +88,10 @@ impl HeGeom {
     }
 }
 
-/// Reusable per-solve buffers of [`ExactGeodesic`] (vertex states, window-list headers and
+/// Reusable per-solve buffers of [`ExactGeodesic`] (vertex states, window-list slots and
 /// flags, queues, a pool of window lists) for [`ExactGeodesic::distances_with`]: a caller
 /// solving many fields on one mesh keeps one per thread instead of allocating them per solve.
-/// After a solve it holds `10 n + 25 h` bytes for a mesh of `n` vertices and `h` half-edges,
+/// After a solve it holds `10 n + 5 h` bytes for a mesh of `n` vertices and `h` half-edges,
 /// plus the queues, the child buffers of one list step and up to 4096 emptied window lists
 /// kept for reuse.
 #[derive(Debug, Default)]

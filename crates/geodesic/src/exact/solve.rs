@@ -91,13 +91,19 @@ pub(crate) struct Solve<'a> {
 
 /// The per-solve arrays of [`Solve`] that can be reused by the next solve on the same mesh
 /// (everything but the distances, which are the result): vertex states, per-half-edge list
-/// headers and flags, queues, and a pool of emptied window lists.
+/// slots and flags, the lists in use, queues, and a pool of emptied window lists.
 #[derive(Debug, Default)]
 pub(crate) struct Buffers {
     state: Vec<u8>,
     emitted: Vec<f64>,
     emit_flag: Vec<bool>,
-    lists: Vec<Vec<Window>>,
+    /// Per half-edge: 0 (no list) or 1 + the index of its window list in `held`. Four bytes
+    /// per half-edge (zeroed memory when allocated) instead of a list header each: only the
+    /// half-edges of the wavefront hold a list at any time.
+    slot: Vec<u32>,
+    /// The window lists of the half-edges that hold one; emptied entries are in `free`.
+    held: Vec<Vec<Window>>,
+    free: Vec<u32>,
     /// Per half-edge: [`QUEUED`] (in `fifo`) and [`FILLED`] (its list is not empty), one byte
     /// so that the queue checks do not load the list headers.
     flags: Vec<u8>,
@@ -124,23 +130,26 @@ impl Buffers {
         self.emitted.resize(n, f64::NAN);
         self.emit_flag.clear();
         self.emit_flag.extend_from_slice(&g.pseudo);
-        if self.lists.len() != nh || self.flags.len() != nh {
-            self.lists = (0..nh).map(|_| Vec::new()).collect();
+        if self.slot.len() != nh || self.flags.len() != nh {
+            self.slot = vec![0; nh];
             self.flags = vec![0; nh];
         } else {
-            // A finished solve leaves every list empty and every flag clear; a solve stopped
-            // early (an error while seeding) may not.
+            // A finished solve leaves every slot and flag clear; a solve stopped early (an
+            // error while seeding) may not.
             for (h, f) in self.flags.iter_mut().enumerate() {
                 if *f != 0 {
                     *f = 0;
-                    let mut l = std::mem::take(&mut self.lists[h]);
-                    l.clear();
-                    if self.pool.len() < POOL_MAX {
-                        self.pool.push(l);
-                    }
+                    self.slot[h] = 0;
                 }
             }
         }
+        for mut l in self.held.drain(..) {
+            if l.capacity() > 0 && self.pool.len() < POOL_MAX {
+                l.clear();
+                self.pool.push(l);
+            }
+        }
+        self.free.clear();
         self.fifo.clear();
         self.heap.clear();
         self.pending_emit.clear();
@@ -323,9 +332,21 @@ impl<'a> Solve<'a> {
     /// end vertices is inside (or while draining).
     #[inline]
     fn append(&mut self, h: u32, ws: &[Window]) {
-        let list = &mut self.b.lists[h as usize];
+        let b = &mut self.b;
+        let mut i = b.slot[h as usize];
+        if i == 0 {
+            i = match b.free.pop() {
+                Some(i) => i,
+                None => {
+                    b.held.push(Vec::new());
+                    b.held.len() as u32
+                }
+            };
+            b.slot[h as usize] = i;
+        }
+        let list = &mut b.held[i as usize - 1];
         if list.capacity() == 0 {
-            if let Some(v) = self.b.pool.pop() {
+            if let Some(v) = b.pool.pop() {
                 *list = v;
             }
         }
@@ -478,8 +499,13 @@ impl<'a> Solve<'a> {
 
     /// The triangle step: filters the list of `h` and pushes its windows across face(h).
     fn process(&mut self, h: u32) {
-        let mut ws = std::mem::take(&mut self.b.lists[h as usize]);
+        let i = std::mem::take(&mut self.b.slot[h as usize]);
         self.b.flags[h as usize] &= !FILLED;
+        if i == 0 {
+            return;
+        }
+        self.b.free.push(i);
+        let mut ws = std::mem::take(&mut self.b.held[i as usize - 1]);
         if ws.is_empty() {
             return;
         }
