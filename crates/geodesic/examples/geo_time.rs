@@ -7,7 +7,7 @@
 //!
 //! METHOD is exact, fmm, heat or dijkstra; SOURCE a vertex index (or `a,b,c` for several);
 //! CUTOFF `-` for none. Prints one line `JSON {...}` with the median setup and solve times
-//! (seconds; the solve also as CPU time of the solving thread), the window propagations (exact) and the peak RSS; OUT (optional) receives the
+//! (seconds; both also as CPU time of the thread), the window propagations (exact) and the peak RSS; OUT (optional) receives the
 //! field, one value per line (`inf` beyond the cut-off).
 
 use geodesic::{new_solver, ExactGeodesic, Method, SolveOptions, Source};
@@ -55,12 +55,14 @@ fn main() {
         .map(|s| s.parse::<f64>().expect("cut-off"));
     let repeat: usize = a.get(5).map_or(3, |s| s.parse().expect("repeat"));
     let opts = SolveOptions { max_distance };
-    let (mut setup, mut solve, mut cpu) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut setup, mut setup_cpu) = (Vec::new(), Vec::new());
+    let (mut solve, mut cpu) = (Vec::new(), Vec::new());
     let mut field = Vec::new();
     for _ in 0..repeat {
-        let t = Instant::now();
+        let (t, c) = (Instant::now(), thread_cpu_s());
         let s = new_solver(&mesh, method).expect("solver");
         setup.push(t.elapsed().as_secs_f64());
+        setup_cpu.push(thread_cpu_s() - c);
         let (t, c) = (Instant::now(), thread_cpu_s());
         field = s.distances(&sources, &opts).expect("solve");
         solve.push(t.elapsed().as_secs_f64());
@@ -72,9 +74,10 @@ fn main() {
     } else {
         0
     };
-    let (st, so, sc) = (median(setup), median(solve), median(cpu));
+    let (st, stc) = (median(setup), median(setup_cpu));
+    let (so, sc) = (median(solve), median(cpu));
     println!(
-        "JSON {{\"nV\": {}, \"method\": \"{}\", \"setup_s\": {st:.6}, \"solve_s\": {so:.6}, \"solve_cpu_s\": {sc:.6}, \"total_s\": {:.6}, \"propagations\": {props}, \"peak_rss_mb\": {:.1}}}",
+        "JSON {{\"nV\": {}, \"method\": \"{}\", \"setup_s\": {st:.6}, \"setup_cpu_s\": {stc:.6}, \"solve_s\": {so:.6}, \"solve_cpu_s\": {sc:.6}, \"total_s\": {:.6}, \"propagations\": {props}, \"peak_rss_mb\": {:.1}}}",
         mesh.positions().len(),
         method.name(),
         st + so,
