@@ -93,7 +93,7 @@ impl ExactGeodesic {
             .map(|v| {
                 let opp = &vopp[deg[v] as usize..deg[v + 1] as usize];
                 boundary[v]
-                    || if (angle[v] - saddle_min).abs() > opp.len() as f64 * APPROX_ATAN2_SLACK {
+                    || if angle_sum_decides(angle[v], opp.len(), saddle_min) {
                         angle[v] > saddle_min
                     } else {
                         corner_angle_sum(&positions, &tris, opp) > saddle_min
@@ -170,7 +170,8 @@ fn edge_at_most(e: DVec3, min_edge: f64) -> bool {
 ///
 /// The half-edges are bucketed by their lower end vertex (a counting sort, half-edge order kept
 /// within a bucket), then each bucket is ordered by the upper end: the groups of equal
-/// undirected edges are those of a sort of all `(edge, half-edge)` keys, in linear time.
+/// undirected edges are those of a sort of all `(edge, half-edge)` keys, without sorting more
+/// than one vertex's edges at a time.
 fn twins(tris: &[[u32; 3]], live: &[bool], n: usize, report: &mut ExactMeshReport) -> Vec<u32> {
     // (lower end, upper end, half-edge) of every live half-edge, in half-edge order.
     let live_halfedges = || {
@@ -246,9 +247,18 @@ fn corner_angle_sum(positions: &[DVec3], tris: &[[u32; 3]], opp: &[u32]) -> f64 
     })
 }
 
-/// Bound on `|approx_atan2(y, x) - y.atan2(x)|` plus the rounding of one more addition to a
-/// sum below `8`, per corner (the truncation of the series is below `7e-11`).
+/// Bound on `|approx_atan2(y, x) - y.atan2(x)|` per corner (the truncation of the series is
+/// below `7e-11`, its rounding and `atan2`'s error a few ulps).
 const APPROX_ATAN2_SLACK: f64 = 2e-10;
+
+/// True when the approximate angle sum `sum` of `corners` corners is far enough from
+/// `threshold` that the `atan2` sum lies on the same side: each corner adds at most
+/// [`APPROX_ATAN2_SLACK`] of approximation error and, in either sum, one rounding of at most
+/// an ulp of the sum (`2.3e-16 |sum|`; `1e-15 |sum|` covers both sums with room).
+#[inline]
+fn angle_sum_decides(sum: f64, corners: usize, threshold: f64) -> bool {
+    (sum - threshold).abs() > corners as f64 * (APPROX_ATAN2_SLACK + 1e-15 * sum.abs())
+}
 
 /// The Taylor coefficients of `atan(u) / u` in `u^2`: `(-1)^k / (2k + 1)`, `k = 0..=10`.
 const ATAN_SERIES: [f64; 11] = [
