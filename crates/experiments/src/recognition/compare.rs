@@ -35,13 +35,14 @@ pub(super) fn icp_points(mesh: &TriMesh, n: usize) -> Vec<DVec3> {
     shapedist::strided_points(mesh.positions(), n)
 }
 
-/// A probe `x` compared with a gallery face `y` by [`facematch::compare`], as with `y`'s
-/// template (view matching against its stored view nearest the probe's scanner direction; per
-/// pair the least over the probe's own and moved descriptors), or `None` when a side has no
-/// descriptions.
-fn bipolar_compare(x: &Described, y: &Described) -> Option<facematch::Comparison> {
+/// The bipolar distance of a probe `x` to a gallery face `y` by each pole pair (NaN where a
+/// side has no descriptions or the distance fails) and the kinds of the fallbacks the comparison
+/// took: [`facematch::compare`] as with `y`'s template (view matching against its stored view
+/// nearest the probe's scanner direction; per pair the least over the probe's own and moved
+/// descriptors).
+fn bipolar_pairs(x: &Described, y: &Described) -> PairDistances {
     let (Ok(xd), Ok(yd)) = (&x.bip, &y.bip) else {
-        return None;
+        return ([f64::NAN; 3], Vec::new());
     };
     let template = facematch::Template {
         identity: String::new(),
@@ -55,16 +56,8 @@ fn bipolar_compare(x: &Described, y: &Described) -> Option<facematch::Comparison
         view: y.views.as_ref().map(|v| v.1.clone()),
         ..x.matching.clone()
     };
-    Some(facematch::compare(xd, &template, &o))
-}
-
-/// The bipolar distance of a probe `x` to a gallery face `y` by each pole pair (NaN where a
-/// side has no descriptor or the distance fails; [`bipolar_compare`]) and the kinds of the
-/// fallbacks the comparison took ([`facematch::Comparison::fallback_kinds`]).
-fn bipolar_pairs(x: &Described, y: &Described) -> PairDistances {
-    bipolar_compare(x, y).map_or(([f64::NAN; 3], Vec::new()), |c| {
-        (c.pairs.map(|u| u.distance), c.fallback_kinds())
-    })
+    let c = facematch::compare(xd, &template, &o);
+    (c.pairs.map(|u| u.distance), c.fallback_kinds())
 }
 
 /// The bipolar distances of one comparison by each pole pair, and the kinds of its fallbacks.

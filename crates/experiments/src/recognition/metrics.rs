@@ -32,6 +32,22 @@ pub(super) struct Metrics {
     pub(super) identified: Vec<bool>,
 }
 
+impl Metrics {
+    /// `descriptor (landmarks)`: the score's name in tables and figures.
+    pub(super) fn label(&self) -> String {
+        format!("{} ({})", self.descriptor, self.landmarks)
+    }
+
+    /// The score's line through `points` in a figure, dashed for the detected landmarks.
+    pub(super) fn series(&self, points: Vec<(f64, f64)>) -> Series {
+        Series {
+            name: self.label(),
+            points,
+            dashed: self.landmarks == "detected",
+        }
+    }
+}
+
 /// Appends the paired comparison of bipolar with every other score on the same probes, per
 /// landmark set: the probes only one of the two identifies and the exact McNemar p-value
 /// ([`mcnemar_exact`]), so that a difference in rank-1 can be told from chance.
@@ -225,14 +241,7 @@ pub(super) fn print_results(all: &[Metrics]) {
 
 /// Draws the ROC curves of `all` into `file` and appends the figure to the report.
 pub(super) fn roc_figure(rep: &mut Report, all: &[Metrics], file: &str, title: &str) -> Result<()> {
-    let series: Vec<Series> = all
-        .iter()
-        .map(|m| Series {
-            name: format!("{} ({})", m.descriptor, m.landmarks),
-            points: m.roc.clone(),
-            dashed: m.landmarks == "detected",
-        })
-        .collect();
+    let series: Vec<Series> = all.iter().map(|m| m.series(m.roc.clone())).collect();
     let labels = (title, "false accept rate", "true accept rate");
     rep.plot(
         file,

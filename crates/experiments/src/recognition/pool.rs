@@ -217,20 +217,15 @@ fn write_pooled(out: &Path, runs: &[(u64, Vec<RunRow>)]) -> Result<()> {
     // Rank-1 per seed, one line per score and landmark set.
     let series: Vec<Series> = pool
         .iter()
-        .map(|m| Series {
-            name: format!("{} ({})", m.descriptor, m.landmarks),
-            points: {
-                let mut p: Vec<(f64, f64)> = runs
-                    .iter()
-                    .filter_map(|(seed, rows)| {
-                        same_score(rows, &m.descriptor, &m.landmarks)
-                            .map(|r| (*seed as f64, r.rank1))
-                    })
-                    .collect();
-                p.sort_by(|a, b| a.0.total_cmp(&b.0));
-                p
-            },
-            dashed: m.landmarks == "detected",
+        .map(|m| {
+            let mut p: Vec<(f64, f64)> = runs
+                .iter()
+                .filter_map(|(seed, rows)| {
+                    same_score(rows, &m.descriptor, &m.landmarks).map(|r| (*seed as f64, r.rank1))
+                })
+                .collect();
+            p.sort_by(|a, b| a.0.total_cmp(&b.0));
+            m.series(p)
         })
         .collect();
     rep.plot(

@@ -1,11 +1,13 @@
 //! The report of a scan run: `report.md` with its tables and figures, the CSVs (results,
 //! probes, bipolar pairs, landmarks, sweeps, failures) and `summary.json`.
 
-use super::super::metrics::{median, paired_table, results_table, roc_figure, write_summary};
+use super::super::metrics::{
+    median, paired_table, results_table, roc_figure, write_summary, Metrics,
+};
 use super::face::Face;
 use super::score::Scored;
 use super::{p95, Results, Setup};
-use crate::report::{Report, Series};
+use crate::report::Report;
 use crate::scans::MAX_SNAP_MM;
 use anyhow::Result;
 
@@ -303,7 +305,7 @@ fn sweeps_section(rep: &mut Report, s: &Setup<'_>, r: &Results) -> Result<()> {
         let mut series = Vec::new();
         let mut breaks = Vec::new();
         for (j, m0) in per_value[0].iter().enumerate() {
-            let label = format!("{} ({})", m0.descriptor, m0.landmarks);
+            let label = m0.label();
             hdr.push(label.clone());
             let pts: Vec<(f64, f64)> = sw
                 .values
@@ -323,11 +325,7 @@ fn sweeps_section(rep: &mut Report, s: &Setup<'_>, r: &Results) -> Result<()> {
                     format!("{v} {} (rank-1 {r:.3})", sw.unit)
                 }),
             ]);
-            series.push(Series {
-                name: label,
-                points: pts,
-                dashed: m0.landmarks == "detected",
-            });
+            series.push(m0.series(pts));
         }
         rep.heading(3, &format!("Rank-1 against {}", sw.name));
         let rows: Vec<Vec<String>> = sw
@@ -359,10 +357,7 @@ fn sweeps_section(rep: &mut Report, s: &Setup<'_>, r: &Results) -> Result<()> {
         );
     }
     let mut hdr = vec!["sweep".to_string(), "value".to_string()];
-    hdr.extend(
-        main.iter()
-            .map(|m| format!("{} ({})", m.descriptor, m.landmarks)),
-    );
+    hdr.extend(main.iter().map(Metrics::label));
     rep.csv("sweeps.csv", &hdr, &csv_rows)?;
     Ok(())
 }
