@@ -39,24 +39,6 @@ pub struct Args {
     pub out: OutArgs,
 }
 
-/// FNV-1a hash of the descriptor's keys and point positions (bit patterns): equal fingerprints
-/// mean the same descriptor, so a speed-up can be checked not to change it.
-fn fingerprint(d: &bipolar::Descriptor) -> u64 {
-    let mut h = 0xcbf2_9ce4_8422_2325_u64;
-    let mut eat = |x: u64| {
-        for b in x.to_le_bytes() {
-            h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
-        }
-    };
-    for p in &d.points {
-        eat(p.key.pack());
-        for c in p.position.to_array() {
-            eat(c.to_bits());
-        }
-    }
-    h
-}
-
 fn median(mut v: Vec<Duration>) -> Duration {
     v.sort();
     v.get(v.len() / 2).copied().unwrap_or_default()
@@ -175,7 +157,7 @@ pub fn run(args: Args) -> Result<()> {
                 ],
                 d.points.len(),
                 d.stats.ambiguous,
-                fingerprint(&d)
+                d.fingerprint()
             );
         }
         eprintln!("run {}: {:.3} s", run + 1, (t[n] - t[0]).as_secs_f64());
