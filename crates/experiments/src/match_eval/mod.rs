@@ -144,7 +144,7 @@ fn scan_and_process(
         &dir.join("probes"),
         &format!("{name} probe scans"),
     )?;
-    let pr = process(g, &gg, p, &gp, o);
+    let pr = process(g, &gg, &gp, o);
     let gdir = out.join("gallery").join(name);
     std::fs::create_dir_all(&gdir)?;
     for (t, s) in pr.templates.iter().zip(g) {

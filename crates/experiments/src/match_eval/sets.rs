@@ -2,7 +2,7 @@
 //! one), their scanning into `.bnt` files and their passage through the public API.
 
 use super::Args;
-use crate::pipeline::bar;
+use crate::report::par_map;
 use crate::scans::{sample_weights, scan_seed, FaceSpec, ScanSettings, SpecMaker};
 use anyhow::{Context, Result};
 use facematch::{prepare, Description, MatchOptions, ScanInput, Template};
@@ -11,7 +11,6 @@ use mesh_io::BntGrid;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rangescan::ScanOptions;
-use rayon::prelude::*;
 use std::path::Path;
 
 /// A scan to make: name, identity, face weights, scanner options.
@@ -85,19 +84,14 @@ pub(super) fn scan_all(
     msg: &str,
 ) -> Result<Vec<BntGrid>> {
     std::fs::create_dir_all(dir).with_context(|| dir.display().to_string())?;
-    let pb = bar(specs.len(), msg);
-    let out = specs
-        .par_iter()
-        .map(|s| {
-            let face = model.sample(&s.identity_weights, &s.expression_weights)?;
-            let grid = rangescan::scan(&face, &s.scan)?.grid;
-            mesh_io::write_bnt(dir.join(format!("{}.bnt", s.name)), &grid)?;
-            pb.inc(1);
-            Ok(grid)
-        })
-        .collect::<Result<Vec<_>>>();
-    pb.finish();
-    out
+    par_map(specs, msg, |s| {
+        let face = model.sample(&s.identity_weights, &s.expression_weights)?;
+        let grid = rangescan::scan(&face, &s.scan)?.grid;
+        mesh_io::write_bnt(dir.join(format!("{}.bnt", s.name)), &grid)?;
+        Ok(grid)
+    })
+    .into_iter()
+    .collect()
 }
 
 /// One side of a set through the public API: templates of the gallery (`Err`: why not) and
@@ -109,47 +103,27 @@ pub(super) struct Processed {
     pub probe_notes: Vec<Vec<String>>,
 }
 
-/// Enrols the gallery scans and describes the probes (with the search), in parallel.
+/// Enrols the gallery scans (`gallery`, their grids `grids_g`) and describes the probes' grids
+/// `grids_p` (with the search), in parallel.
 pub(super) fn process(
     gallery: &[Spec],
     grids_g: &[BntGrid],
-    probes: &[Spec],
     grids_p: &[BntGrid],
     o: &MatchOptions,
 ) -> Processed {
-    let pb = bar(gallery.len(), "enrol");
-    let templates = gallery
-        .par_iter()
-        .zip(grids_g)
-        .map(|(s, g)| {
-            let t = facematch::enroll(
-                ScanInput::Grid(g),
-                &s.identity.to_string(),
-                &format!("{}.bnt", s.name),
-                o,
-            )
-            .map_err(|e| e.to_string());
-            pb.inc(1);
-            t
-        })
-        .collect();
-    pb.finish();
-    let pb = bar(probes.len(), "probes");
-    let (probes, probe_notes) = probes
-        .par_iter()
-        .zip(grids_p)
-        .map(|(_, g)| {
-            let d = prepare(ScanInput::Grid(g), o)
-                .and_then(|s| Ok((s.describe(o, true)?, s.notes)))
-                .map_err(|e| e.to_string());
-            pb.inc(1);
-            match d {
-                Ok((d, notes)) => (Ok(d), notes),
-                Err(e) => (Err(e), Vec::new()),
-            }
-        })
-        .unzip();
-    pb.finish();
+    let enrolled: Vec<(&Spec, &BntGrid)> = gallery.iter().zip(grids_g).collect();
+    let templates = par_map(&enrolled, "enrol", |(s, g)| {
+        let (identity, source) = (s.identity.to_string(), format!("{}.bnt", s.name));
+        facematch::enroll(ScanInput::Grid(g), &identity, &source, o).map_err(|e| e.to_string())
+    });
+    let (probes, probe_notes) = par_map(grids_p, "probes", |g| {
+        match prepare(ScanInput::Grid(g), o).and_then(|s| Ok((s.describe(o, true)?, s.notes))) {
+            Ok((d, notes)) => (Ok(d), notes),
+            Err(e) => (Err(e.to_string()), Vec::new()),
+        }
+    })
+    .into_iter()
+    .unzip();
     Processed {
         templates,
         probes,

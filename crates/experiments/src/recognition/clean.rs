@@ -6,15 +6,14 @@ use super::describe::{describe_face, elastic_options, iso_levels_of, DescribeOpt
 use super::metrics::{paired_table, results_table, roc_figure, write_summary};
 use super::scans::{score_group, Face, Scored};
 use super::{Args, Lm};
-use crate::pipeline::{bar, resolve_methods};
-use crate::report::Report;
+use crate::pipeline::resolve_methods;
+use crate::report::{par_map, Report};
 use crate::walk::Walker;
 use anyhow::Result;
 use facemodel::{random_rigid_motion, FaceModel};
 use meshcore::{FaceLocator, TriMesh};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use rayon::prelude::*;
 use std::time::Instant;
 
 /// One sampled face.
@@ -142,23 +141,15 @@ fn sample_faces(
 
 /// The detected landmarks of every face (`None` where detection failed).
 fn detect_all(samples: &[Sample], generic: &landmarks::GenericModel) -> Vec<Option<Lm>> {
-    let pb = bar(samples.len(), "detecting landmarks");
-    let detected: Vec<Option<Lm>> = samples
-        .par_iter()
-        .map(|s| {
-            let r = landmarks::detect(&s.mesh, generic).ok().map(|l| {
-                Lm::new(
-                    l.outer_eye_right.vertex,
-                    l.outer_eye_left.vertex,
-                    l.nose_tip.vertex,
-                )
-            });
-            pb.inc(1);
-            r
-        })
-        .collect();
-    pb.finish();
-    detected
+    par_map(samples, "detecting landmarks", |s| {
+        let l = landmarks::detect(&s.mesh, generic).ok()?;
+        let v = |p: landmarks::Landmark| p.vertex;
+        Some(Lm::new(
+            v(l.outer_eye_right),
+            v(l.outer_eye_left),
+            v(l.nose_tip),
+        ))
+    })
 }
 
 /// Every face described with the ground-truth landmarks `gt` and with its detected ones (the
@@ -172,29 +163,25 @@ fn describe_all(
     desc_opts: &DescribeOptions,
     probe_opts: &DescribeOptions,
 ) -> Result<Vec<Face>> {
-    let pb = bar(samples.len(), &format!("descriptors ({})", method.name()));
-    let faces: Vec<Face> = samples
-        .par_iter()
-        .zip(detected)
-        .map(|(s, det)| -> Result<_> {
-            let solver = geodesic::new_solver(&s.mesh, method)?;
-            let walker = Walker::new(&s.mesh);
-            let o = if s.index == 0 { desc_opts } else { probe_opts };
-            let mut face = Face::new(&format!("id{:02}-e{}", s.identity, s.index), s.identity);
-            face.desc = [Some(gt), *det].map(|lm| {
-                let lm = lm.ok_or("no landmarks")?;
-                describe_face(&s.mesh, solver.as_ref(), &walker, lm, o)
-            });
-            if s.index != 0 {
-                let pts = icp_points(&s.mesh, args.icp_points);
-                face.pts = [pts.clone(), pts];
-            }
-            pb.inc(1);
-            Ok(face)
-        })
-        .collect::<Result<_>>()?;
-    pb.finish();
-    Ok(faces)
+    let faces: Vec<(&Sample, &Option<Lm>)> = samples.iter().zip(detected).collect();
+    let msg = format!("descriptors ({})", method.name());
+    par_map(&faces, &msg, |&(s, det)| -> Result<_> {
+        let solver = geodesic::new_solver(&s.mesh, method)?;
+        let walker = Walker::new(&s.mesh);
+        let o = if s.index == 0 { desc_opts } else { probe_opts };
+        let mut face = Face::new(&format!("id{:02}-e{}", s.identity, s.index), s.identity);
+        face.desc = [Some(gt), *det].map(|lm| {
+            let lm = lm.ok_or("no landmarks")?;
+            describe_face(&s.mesh, solver.as_ref(), &walker, lm, o)
+        });
+        if s.index != 0 {
+            let pts = icp_points(&s.mesh, args.icp_points);
+            face.pts = [pts.clone(), pts];
+        }
+        Ok(face)
+    })
+    .into_iter()
+    .collect()
 }
 
 /// The figures of every score with both landmark sets and the bipolar comparisons' fallbacks

@@ -4,7 +4,7 @@
 
 use super::compare::Row;
 use super::Args;
-use crate::report::{f4, Report, Series};
+use crate::report::{f4, quantile, sorted, Report, Series};
 use anyhow::Result;
 use facematch::metrics::{discordant, mcnemar_exact, score_figures};
 
@@ -101,20 +101,16 @@ pub(super) const SCORES: [&str; 5] = [
 /// has none).
 pub(super) const DESCRIPTION_OF: [Option<usize>; 5] = [Some(0), Some(1), None, Some(2), Some(3)];
 
-/// The element at `pick(len)` of the sorted finite values (NaN when there is none).
-pub(super) fn order_stat(mut v: Vec<f64>, pick: impl Fn(usize) -> usize) -> f64 {
+/// The nearest-rank quantile `p` of the finite values ([`quantile`]: the median of an even
+/// count is the upper middle value; NaN when there is none).
+pub(super) fn finite_quantile(mut v: Vec<f64>, p: f64) -> f64 {
     v.retain(|x| x.is_finite());
-    v.sort_by(f64::total_cmp);
-    if v.is_empty() {
-        f64::NAN
-    } else {
-        v[pick(v.len())]
-    }
+    quantile(&sorted(v), p)
 }
 
-/// Median of the finite values (the upper one of an even count; NaN when there is none).
+/// Median of the finite values ([`finite_quantile`]).
 pub(super) fn median(v: Vec<f64>) -> f64 {
-    order_stat(v, |n| n / 2)
+    finite_quantile(v, 0.5)
 }
 
 /// The figures of the five score matrices of one landmark set (rows from

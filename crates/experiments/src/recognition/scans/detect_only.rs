@@ -2,13 +2,11 @@
 
 use super::super::metrics::median;
 use super::p95;
-use crate::pipeline::bar;
-use crate::report::{Report, Series};
+use crate::report::{par_map, Report, Series};
 use crate::scans::{detection_errors, scan_raw, FaceSpec};
 use anyhow::Result;
 use facemodel::FaceModel;
 use landmarks::GenericModel;
-use rayon::prelude::*;
 
 /// One scan: its outcome, each landmark's error (`None`: not placed) and the reasons.
 struct Outcome {
@@ -81,16 +79,15 @@ fn detect_all(
     specs: &[&FaceSpec],
     prep: &facematch::MatchOptions,
 ) -> Vec<Outcome> {
-    let pb = bar(specs.len(), "scan, prepare (clean, detect, crop, detect)");
-    let outcomes: Vec<Outcome> = specs
-        .par_iter()
-        .map(|spec| {
+    par_map(
+        specs,
+        "scan, prepare (clean, detect, crop, detect)",
+        |spec| {
             let r = scan_raw(model, spec).map(|(raw, _)| {
                 let p =
                     facematch::prepare_with(facematch::ScanInput::Grid(&raw.grid), generic, prep);
                 (raw, p)
             });
-            pb.inc(1);
             let failed = |status, why| Outcome {
                 status,
                 err: [None; 3],
@@ -113,10 +110,8 @@ fn detect_all(
                     }
                 }
             }
-        })
-        .collect();
-    pb.finish();
-    outcomes
+        },
+    )
 }
 
 /// The lines of `detection.csv`, one per scan.

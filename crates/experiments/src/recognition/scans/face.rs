@@ -4,7 +4,7 @@
 use super::super::compare::icp_points;
 use super::super::describe::{describe_face, DescribeOptions, Described};
 use super::super::Lm;
-use crate::pipeline::bar;
+use crate::report::par_map;
 use crate::scans::{
     clean_scan, detection_errors, scan_raw, FaceSpec, ScanSetOptions, ScannedFace, MAX_SNAP_MM,
     SCANNER_SIDE,
@@ -14,7 +14,6 @@ use facemodel::FaceModel;
 use geodesic::Method;
 use landmarks::GenericModel;
 use meshcore::{DVec3, TriMesh};
-use rayon::prelude::*;
 use std::time::Instant;
 
 /// One scanned and described face.
@@ -82,17 +81,7 @@ impl Pipeline<'_> {
     /// Scans, cleans, detects and describes every face (in parallel, in order); gallery faces
     /// (`keep_mesh`) keep their meshes.
     pub(super) fn process(&self, specs: &[FaceSpec], keep_mesh: bool, msg: &str) -> Vec<Face> {
-        let pb = bar(specs.len(), msg);
-        let out = specs
-            .par_iter()
-            .map(|spec| {
-                let f = self.describe_spec(spec, keep_mesh);
-                pb.inc(1);
-                f
-            })
-            .collect();
-        pb.finish();
-        out
+        par_map(specs, msg, |spec| self.describe_spec(spec, keep_mesh))
     }
 
     /// Scans the face of `spec`; cleans it for the ground-truth landmarks (crop around the true

@@ -21,7 +21,7 @@ mod specs;
 
 use super::compare::{time_descriptions, TIMED_FACES};
 use super::describe::{elastic_options, iso_levels_of, DescribeOptions};
-use super::metrics::{order_stat, Metrics};
+use super::metrics::{finite_quantile, Metrics};
 use super::{Args, Lm};
 use crate::pipeline::resolve_methods;
 use crate::scans::{scan_face, FaceSpec, ScanSetOptions, ScanSettings};
@@ -72,7 +72,7 @@ struct Results {
 
 /// 95th percentile (nearest rank) of the finite values.
 fn p95(v: Vec<f64>) -> f64 {
-    order_stat(v, |n| ((n - 1) as f64 * 0.95).round() as usize)
+    finite_quantile(v, 0.95)
 }
 
 /// Runs the scan benchmark; prints the output folder on the last line.
