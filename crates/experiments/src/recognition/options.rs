@@ -15,7 +15,8 @@ pub struct Args {
     /// Seed of the sampling.
     #[arg(long, default_value_t = 7)]
     pub seed: u64,
-    /// Geodesic method (exact falls back to fmm, then heat, if unavailable).
+    /// Geodesic method (clean meshes: exact falls back to fmm, then heat, if it cannot be
+    /// prepared, and the report says so; scans: the method as given, no substitute).
     #[arg(long, default_value = "exact")]
     pub method: String,
     /// Descriptor resolution.

@@ -23,7 +23,6 @@ use super::compare::{time_descriptions, TIMED_FACES};
 use super::describe::{elastic_options, iso_levels_of, DescribeOptions};
 use super::metrics::{finite_quantile, Metrics};
 use super::{Args, Lm};
-use crate::pipeline::resolve_methods;
 use crate::scans::{scan_face, FaceSpec, ScanSetOptions, ScanSettings};
 use anyhow::{bail, Context, Result};
 use detect_only::detect_only;
@@ -103,8 +102,13 @@ pub(super) fn run(args: &Args, model: &FaceModel, t0: Instant) -> Result<()> {
         std::fs::create_dir_all(dir)
             .with_context(|| format!("creating --save-scans {}", dir.display()))?;
     }
-    let methods = resolve_methods(&args.method, &meshcore::shapes::icosphere(1))?;
-    let method = methods[0].used;
+    // The method as asked: on scans nothing substitutes another (a scan its solver cannot be
+    // prepared on fails, and the failure is counted with the others).
+    let method: geodesic::Method = args
+        .method
+        .trim()
+        .parse()
+        .with_context(|| format!("--method {}", args.method))?;
     dopt.iso_levels = Some(first_iso_levels(
         model,
         &generic,
