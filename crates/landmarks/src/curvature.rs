@@ -101,7 +101,8 @@ pub use meshcore::VertexAdjacency;
 pub(crate) struct BallCollector {
     stamp: Vec<u32>,
     generation: u32,
-    queue: Vec<u32>,
+    /// Vertices reached but outside the ball (with their offsets), kept for ring growth.
+    outside: Vec<(u32, DVec3)>,
 }
 
 impl BallCollector {
@@ -109,13 +110,14 @@ impl BallCollector {
         Self {
             stamp: vec![0; n],
             generation: 0,
-            queue: Vec::new(),
+            outside: Vec::new(),
         }
     }
 
     /// Vertices (including `v`) connected to `v` through vertices within `radius` of `center`;
     /// if fewer than `min_count`, whole edge rings are added until there are enough (or the
-    /// component is exhausted).
+    /// component is exhausted). `offsets` gets each one's position minus `center`, in the
+    /// same order.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn collect(
         &mut self,
@@ -126,8 +128,10 @@ impl BallCollector {
         radius: f64,
         min_count: usize,
         out: &mut Vec<u32>,
+        offsets: &mut Vec<DVec3>,
     ) {
         out.clear();
+        offsets.clear();
         self.generation = self.generation.wrapping_add(1);
         if self.generation == 0 {
             self.stamp.iter_mut().for_each(|s| *s = 0);
@@ -135,39 +139,44 @@ impl BallCollector {
         }
         let g = self.generation;
         let r2 = radius * radius;
-        self.queue.clear();
-        self.queue.push(v);
+        // `out` and `offsets` are the queue: a vertex is appended when it is reached inside
+        // the ball and expanded in that order.
+        out.push(v);
+        offsets.push(pos[v as usize] - center);
         self.stamp[v as usize] = g;
+        let outside = &mut self.outside;
+        outside.clear();
         let mut head = 0;
-        // Vertices reached but outside the ball, kept for ring growth.
-        let mut outside: Vec<u32> = Vec::new();
-        while head < self.queue.len() {
-            let u = self.queue[head];
+        while head < out.len() {
+            let u = out[head];
             head += 1;
-            out.push(u);
             for &w in adj.neighbours(u) {
-                if self.stamp[w as usize] == g {
+                let s = &mut self.stamp[w as usize];
+                if *s == g {
                     continue;
                 }
-                self.stamp[w as usize] = g;
-                if (pos[w as usize] - center).length_squared() <= r2 {
-                    self.queue.push(w);
+                *s = g;
+                let d = pos[w as usize] - center;
+                if d.length_squared() <= r2 {
+                    out.push(w);
+                    offsets.push(d);
                 } else {
-                    outside.push(w);
+                    outside.push((w, d));
                 }
             }
         }
         // Ring growth when the ball is too small for a stable fit.
         while out.len() < min_count && !outside.is_empty() {
-            let ring = std::mem::take(&mut outside);
-            for &u in &ring {
+            let ring = std::mem::take(outside);
+            for &(u, d) in &ring {
                 out.push(u);
+                offsets.push(d);
             }
-            for &u in &ring {
+            for &(u, _) in &ring {
                 for &w in adj.neighbours(u) {
                     if self.stamp[w as usize] != g {
                         self.stamp[w as usize] = g;
-                        outside.push(w);
+                        outside.push((w, pos[w as usize] - center));
                     }
                 }
             }
@@ -233,16 +242,16 @@ pub fn curvatures_at(
         .copied()
         .with_min_len(256)
         .map_init(
-            || (BallCollector::new(n), Vec::new()),
-            |(ball, nb), v| {
+            || (BallCollector::new(n), Vec::new(), Vec::new()),
+            |(ball, nb, offsets), v| {
                 let (Some(&p), Some(&nrm)) = (pos.get(v as usize), normals.get(v as usize)) else {
                     return flat(DVec3::Z);
                 };
                 if nrm == DVec3::ZERO {
                     return flat(DVec3::Z);
                 }
-                ball.collect(adj, pos, v, p, radius, min_count, nb);
-                fit_vertex(pos, p, nrm, nb, radius).unwrap_or_else(|| flat(nrm))
+                ball.collect(adj, pos, v, p, radius, min_count, nb, offsets);
+                fit_vertex(nrm, offsets, radius).unwrap_or_else(|| flat(nrm))
             },
         )
         .collect()
@@ -259,25 +268,23 @@ fn flat(n: DVec3) -> Curvature {
     }
 }
 
-/// Quadric fit at one vertex; heights measured along `-n` so that convex (outward-normal) caps
-/// have positive curvature.
-fn fit_vertex(pos: &[DVec3], p: DVec3, n: DVec3, nb: &[u32], radius: f64) -> Option<Curvature> {
-    if nb.len() < 6 {
+/// Quadric fit at one vertex from the offsets of its neighbours (the vertex itself among them);
+/// heights measured along `-n` so that convex (outward-normal) caps have positive curvature.
+fn fit_vertex(n: DVec3, offsets: &[DVec3], radius: f64) -> Option<Curvature> {
+    if offsets.len() < 6 {
         return None;
     }
     let (u, w) = tangent_basis(n);
     // Effective radius: at least the farthest neighbour (ring growth may exceed `radius`).
     let mut r2max: f64 = radius * radius;
-    for &q in nb {
-        let d = pos[q as usize] - p;
+    for &d in offsets {
         r2max = r2max.max((d - n * d.dot(n)).length_squared());
     }
     let r2max = r2max * 1.0001 + 1e-300;
     let mut ata = [[0.0; 6]; 6];
     let mut atb = [0.0; 6];
     let scale = r2max.sqrt();
-    for &q in nb {
-        let d = pos[q as usize] - p;
+    for &d in offsets {
         // Normalised coordinates for conditioning.
         let x = d.dot(u) / scale;
         let y = d.dot(w) / scale;

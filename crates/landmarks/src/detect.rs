@@ -436,13 +436,15 @@ fn detect_impl(
     let p = &model.params;
     let debug = options.trace;
     let clock = std::time::Instant::now();
-    let mut idx = surface_index(mesh_m);
-    idx.unseen_rim = unseen_rims(mesh_m, &idx, options.toward_viewer, p.inlier_distance)?;
-    let adj = VertexAdjacency::new(mesh_m);
-    // Candidates come from the curvature at vertices about a sixth of the curvature radius
-    // apart: every vertex of a mesh as coarse as the training faces, a subsample of a dense scan
-    // (its fits still use every neighbour).
-    let at = spaced_vertices(mesh_m, p.curvature_radius / 6.0);
+    // The index, the adjacency and the vertices to fit are independent, and so are the rims
+    // of unseen surface, the far marks and the curvature fits: each group in parallel.
+    let ((mut idx, adj), at) = rayon::join(
+        || rayon::join(|| surface_index(mesh_m), || VertexAdjacency::new(mesh_m)),
+        // Candidates come from the curvature at vertices about a sixth of the curvature radius
+        // apart: every vertex of a mesh as coarse as the training faces, a subsample of a
+        // dense scan (its fits still use every neighbour).
+        || spaced_vertices(mesh_m, p.curvature_radius / 6.0),
+    );
     if debug {
         eprintln!(
             "[{:.1} ms] index and adjacency built; curvature at {} of {} vertices",
@@ -451,13 +453,25 @@ fn detect_impl(
             mesh_m.n_vertices()
         );
     }
-    let curv = curvatures_at(
-        mesh_m,
-        &idx.nrm,
-        &adj,
-        &CurvatureOptions::with_radius(p.curvature_radius),
-        &at,
+    let (marks, curv) = rayon::join(
+        || {
+            unseen_rims(mesh_m, &idx, options.toward_viewer, p.inlier_distance).map(|rims| {
+                // The widest inlier band of the fits: the coarse scores of the pose
+                // hypotheses.
+                (rims, idx.far_grid(3.0 * p.inlier_distance))
+            })
+        },
+        || {
+            curvatures_at(
+                mesh_m,
+                &idx.nrm,
+                &adj,
+                &CurvatureOptions::with_radius(p.curvature_radius),
+                &at,
+            )
+        },
     );
+    (idx.unseen_rim, idx.far) = marks?;
     use LandmarkName as L;
     let mut n_noses = 0;
     let mut n_eyes = 0;
@@ -937,17 +951,24 @@ fn refine_all(
         confidence: 0.0,
     }; 5];
     let mut agreement = [0.0; 5];
-    for name in L::ALL {
-        let pred = t.transform_point3(model.landmark(name));
-        let tpl = model.patches[name as usize].pairs();
-        // The nose tip is a strong feature but far from the eyes that dominate the pose: wider
-        // search.
-        let radius = if name == L::NoseTip {
-            NOSE_SEARCH * p.search_radius
-        } else {
-            p.search_radius
-        };
-        let (v, cost) = refine(idx, &tpl, t, pred, radius, p.inlier_distance);
+    // The five searches are independent: in parallel, reported in order.
+    let found: Vec<(DVec3, u32, f64)> = L::ALL
+        .par_iter()
+        .map(|&name| {
+            let pred = t.transform_point3(model.landmark(name));
+            let tpl = model.patches[name as usize].pairs();
+            // The nose tip is a strong feature but far from the eyes that dominate the pose:
+            // wider search.
+            let radius = if name == L::NoseTip {
+                NOSE_SEARCH * p.search_radius
+            } else {
+                p.search_radius
+            };
+            let (v, cost) = refine(idx, &tpl, t, pred, radius, p.inlier_distance);
+            (pred, v, cost)
+        })
+        .collect();
+    for (name, (pred, v, cost)) in L::ALL.into_iter().zip(found) {
         let c_local = (-(cost / (p.typical_rms * p.typical_rms)) * 0.1).exp();
         if debug {
             eprintln!(
@@ -1082,8 +1103,18 @@ fn refine(
         .iter()
         .map(|(q, _)| pose.transform_vector3(*q))
         .collect();
-    let eval = |c: DVec3, pts: &mut dyn Iterator<Item = &DVec3>| -> f64 {
+    // The template's cost at `c` over the points `pts` (`count` of them) plus `prior`, or
+    // `None` as soon as it is certain to exceed `bound`: every term is non-negative and the
+    // mean runs over at most `count` points, so the running sum over `count` plus the prior
+    // (each operation monotone in floating point) never exceeds the final cost.
+    let eval = |c: DVec3,
+                pts: &mut dyn Iterator<Item = &DVec3>,
+                count: usize,
+                prior: f64,
+                bound: f64|
+     -> Option<f64> {
         let (mut s, mut n, mut unseen) = (0.0, 0usize, 0usize);
+        let whole = count.max(1) as f64;
         for q in pts {
             let h = idx.query(c + *q);
             if h.d2 < tau2 {
@@ -1094,13 +1125,17 @@ fn refine(
                 s += tau2;
             }
             n += 1;
+            if s / whole + prior > bound {
+                return None;
+            }
         }
         let seen = n - unseen;
-        if seen as f64 >= MIN_OBSERVED * n as f64 {
+        let mean = if seen as f64 >= MIN_OBSERVED * n as f64 {
             s / seen.max(1) as f64
         } else {
             (s + unseen as f64 * tau2) / n.max(1) as f64
-        }
+        };
+        Some(mean + prior)
     };
     let prior = |c: DVec3| 0.02 * tau2 * (c - pred).length_squared() / (radius * radius);
     let mut cands = idx.within(pred, radius);
@@ -1108,20 +1143,47 @@ fn refine(
     if !cands.contains(&pv) {
         cands.push(pv);
     }
-    // Coarse pass on a subsample, then the full template on the best few.
-    let mut coarse: Vec<(f64, u32)> = cands
+    // Coarse pass on a subsample, then the full template on the best few (`KEEP`, least cost,
+    // ties by vertex). The candidates nearest the prediction go first; the cost of the
+    // `KEEP`-th best of them bounds the others, whose evaluation stops once they are certain
+    // to exceed it (they could not be among the best few).
+    const KEEP: usize = 8;
+    let n_coarse = rotated.len().div_ceil(5);
+    let coarse_cost = |v: u32, bound: f64| {
+        let c = idx.pos[v as usize];
+        eval(c, &mut rotated.iter().step_by(5), n_coarse, prior(c), bound).map(|cost| (cost, v))
+    };
+    let mut by_distance: Vec<(f64, u32)> = cands
         .iter()
-        .map(|&v| {
-            let c = idx.pos[v as usize];
-            (eval(c, &mut rotated.iter().step_by(5)) + prior(c), v)
-        })
+        .map(|&v| ((idx.pos[v as usize] - pred).length_squared(), v))
+        .collect();
+    by_distance.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    let (first, rest) = by_distance.split_at(by_distance.len().min(4 * KEEP));
+    let mut coarse: Vec<(f64, u32)> = first
+        .iter()
+        .filter_map(|&(_, v)| coarse_cost(v, f64::INFINITY))
         .collect();
     coarse.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-    coarse.truncate(8);
+    let bound = coarse.get(KEEP - 1).map_or(f64::INFINITY, |c| c.0);
+    coarse.extend(
+        rest.par_iter()
+            .with_min_len(64)
+            .filter_map(|&(_, v)| coarse_cost(v, bound))
+            .collect::<Vec<_>>(),
+    );
+    coarse.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    coarse.truncate(KEEP);
     let mut best = (f64::INFINITY, pv);
     for &(_, v) in &coarse {
         let c = idx.pos[v as usize];
-        let cost = eval(c, &mut rotated.iter()) + prior(c);
+        let cost = eval(
+            c,
+            &mut rotated.iter(),
+            rotated.len(),
+            prior(c),
+            f64::INFINITY,
+        )
+        .unwrap_or(f64::INFINITY);
         if cost < best.0 || (cost == best.0 && v < best.1) {
             best = (cost, v);
         }

@@ -21,6 +21,137 @@ pub struct SurfaceIndex {
     /// Whether each vertex is on a rim of unobserved surface (see
     /// [`crate::DetectOptions::toward_viewer`]); all `false` from [`SurfaceIndex::new`].
     pub unseen_rim: Vec<bool>,
+    /// Cells of space where every point is far from the surface ([`SurfaceIndex::mark_far`]);
+    /// `None` until marked.
+    pub(crate) far: Option<FarGrid>,
+}
+
+/// A grid of cubic cells over the vertices' bounding box that knows where space is far from
+/// every vertex: a point in a cell not marked `near` is farther than `bound` (plus each
+/// vertex's reach) from every vertex, so its approximate squared distance to the surface
+/// ([`SurfaceIndex::query`]) is at least `bound^2`. Points outside the grid are far too.
+#[derive(Debug, Clone)]
+pub(crate) struct FarGrid {
+    origin: DVec3,
+    cell: f64,
+    dims: [usize; 3],
+    near: Vec<bool>,
+    bound: f64,
+}
+
+impl FarGrid {
+    /// Marks every cell within `bound + reach` (Chebyshev cell distance, one cell of margin) of
+    /// a vertex; `None` when the bound or the positions are not finite or the grid would be
+    /// larger than about a million cells.
+    fn new(pos: &[DVec3], reach: &[f64], bound: f64) -> Option<Self> {
+        if !(bound.is_finite() && bound > 0.0) || pos.is_empty() {
+            return None;
+        }
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        for p in pos {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
+        }
+        // Most vertices share a common dilation; a vertex with a longer reach (a spike, a long
+        // border edge) is dilated on its own.
+        let mut sorted: Vec<f64> = reach.to_vec();
+        sorted.sort_by(f64::total_cmp);
+        let common_reach = sorted[sorted.len() / 2] * 4.0;
+        let max_reach = sorted.last().copied().unwrap_or(0.0);
+        if !(lo.is_finite() && hi.is_finite() && max_reach.is_finite()) {
+            return None;
+        }
+        let cell = 0.25 * (bound + common_reach);
+        let cells_of = |r: f64| ((bound + r) / cell).ceil() as usize + 1;
+        let k = cells_of(common_reach);
+        let pad = cells_of(max_reach) + 1;
+        let origin = lo - DVec3::splat(pad as f64 * cell);
+        let ext = (hi - origin) / cell;
+        let dims = [
+            ext.x as usize + pad + 2,
+            ext.y as usize + pad + 2,
+            ext.z as usize + pad + 2,
+        ];
+        let total = dims[0].checked_mul(dims[1])?.checked_mul(dims[2])?;
+        if total > 1 << 20 {
+            return None;
+        }
+        let index = |c: [usize; 3]| (c[2] * dims[1] + c[1]) * dims[0] + c[0];
+        let cell_of = |p: DVec3| {
+            let c = (p - origin) / cell;
+            [c.x as usize, c.y as usize, c.z as usize]
+        };
+        let mut occupied = vec![false; total];
+        let mut near = vec![false; total];
+        for (p, &r) in pos.iter().zip(reach) {
+            let c = cell_of(*p);
+            if r <= common_reach {
+                occupied[index(c)] = true;
+                continue;
+            }
+            let m = cells_of(r);
+            for z in c[2] - m..=c[2] + m {
+                for y in c[1] - m..=c[1] + m {
+                    for x in c[0] - m..=c[0] + m {
+                        near[index([x, y, z])] = true;
+                    }
+                }
+            }
+        }
+        // The cube of half-side k around every occupied cell: one running-window pass per axis.
+        let strides = [1, dims[0], dims[0] * dims[1]];
+        let mut buf = occupied;
+        for axis in 0..3 {
+            let n = dims[axis];
+            let stride = strides[axis];
+            let mut out = vec![false; total];
+            let lines = total / n;
+            for line in 0..lines {
+                // The start of the `line`-th run along `axis`.
+                let below = line % stride;
+                let above = line / stride;
+                let start = above * stride * n + below;
+                let mut count = 0usize;
+                // Window [i - k, i + k]: prime it with [0, k).
+                for i in 0..k.min(n) {
+                    count += usize::from(buf[start + i * stride]);
+                }
+                for i in 0..n {
+                    if i + k < n {
+                        count += usize::from(buf[start + (i + k) * stride]);
+                    }
+                    if i > k {
+                        count -= usize::from(buf[start + (i - k - 1) * stride]);
+                    }
+                    out[start + i * stride] = count > 0;
+                }
+            }
+            buf = out;
+        }
+        for (n, b) in near.iter_mut().zip(&buf) {
+            *n |= *b;
+        }
+        Some(Self {
+            origin,
+            cell,
+            dims,
+            near,
+            bound,
+        })
+    }
+
+    /// Whether `q` is certainly farther than the grid's bound (plus reach) from every vertex.
+    fn is_far(&self, q: DVec3) -> bool {
+        let c = (q - self.origin) / self.cell;
+        if !(c.x >= 0.0 && c.y >= 0.0 && c.z >= 0.0) {
+            return true;
+        }
+        let (x, y, z) = (c.x as usize, c.y as usize, c.z as usize);
+        if x >= self.dims[0] || y >= self.dims[1] || z >= self.dims[2] {
+            return true;
+        }
+        !self.near[(z * self.dims[1] + y) * self.dims[0] + x]
+    }
 }
 
 /// Result of a nearest query.
@@ -46,6 +177,31 @@ impl SurfaceIndex {
             nrm,
             reach,
             unseen_rim,
+            far: None,
+        }
+    }
+
+    /// Marks the space farther than `bound` from the surface, so that [`SurfaceIndex::near`]
+    /// answers queries there without a tree search (a query far from a dense mesh is the
+    /// tree's slowest). Nothing is marked when the grid would be too large.
+    pub fn mark_far(&mut self, bound: f64) {
+        self.far = self.far_grid(bound);
+    }
+
+    /// The marks of [`SurfaceIndex::mark_far`], to be stored in `far` later (built while the
+    /// index is shared).
+    pub(crate) fn far_grid(&self, bound: f64) -> Option<FarGrid> {
+        FarGrid::new(&self.pos, &self.reach, bound)
+    }
+
+    /// [`SurfaceIndex::query`] for a point that may be within `tau` of the surface; `None`
+    /// when the point is certainly not (its approximate squared distance is at least `tau^2`
+    /// and it is farther than `tau` plus its reach from every vertex), known without a tree
+    /// search when `tau` is at most the bound given to [`SurfaceIndex::mark_far`].
+    pub fn near(&self, q: DVec3, tau: f64) -> Option<Hit> {
+        match &self.far {
+            Some(f) if tau <= f.bound && f.is_far(q) => None,
+            _ => Some(self.query(q)),
         }
     }
 
@@ -107,9 +263,11 @@ pub fn score(
     let mut sse = 0.0;
     for (p, n) in pts {
         let q = t.transform_point3(*p);
-        let h = idx.query(q);
-        let ok = h.d2 < tau2 && idx.nrm[h.vertex as usize].dot(t.transform_vector3(*n)) > min_dot;
-        if ok {
+        // A point certainly beyond `tau` is an outlier whatever its nearest vertex.
+        let inlier = idx.near(q, tau).filter(|h| {
+            h.d2 < tau2 && idx.nrm[h.vertex as usize].dot(t.transform_vector3(*n)) > min_dot
+        });
+        if let Some(h) = inlier {
             cost += h.d2;
             sse += h.d2;
             inl += 1;
@@ -215,6 +373,48 @@ mod tests {
             .map(|p| p * DVec3::new(3.0, 2.0, 1.2))
             .collect();
         meshcore::TriMesh::new(pos, tri).unwrap()
+    }
+
+    /// Every point the far grid calls far is farther than the bound plus its reach from every
+    /// vertex (so `near` is `None` only where `query` would give `d2 >= tau^2`), and the grid
+    /// does call far most of the space well away from the surface.
+    #[test]
+    fn far_cells_are_far_from_every_vertex() {
+        let mesh = ellipsoid();
+        let mut idx = crate::detect::surface_index(&mesh);
+        // One vertex with a long reach (as a spike's) gets its own, wider dilation.
+        idx.reach[0] = 0.8;
+        let bound = 0.3;
+        idx.mark_far(bound);
+        let (mut far, mut total) = (0, 0);
+        for i in 0..40 {
+            for j in 0..40 {
+                for k in 0..20 {
+                    let q = DVec3::new(
+                        -4.5 + 9.0 * i as f64 / 39.0,
+                        -3.5 + 7.0 * j as f64 / 39.0,
+                        -2.5 + 5.0 * k as f64 / 19.0,
+                    );
+                    total += 1;
+                    for tau in [bound, 0.5 * bound] {
+                        match idx.near(q, tau) {
+                            None => {
+                                far += usize::from(tau == bound);
+                                for (v, p) in idx.pos.iter().enumerate() {
+                                    let gap = (*p - q).length() - idx.reach[v];
+                                    assert!(gap > bound, "{q:?} is {gap} from vertex {v}");
+                                }
+                                assert!(idx.query(q).d2 >= tau * tau);
+                            }
+                            Some(h) => assert_eq!(h.vertex, idx.query(q).vertex),
+                        }
+                    }
+                    // Beyond the bound the grid says nothing: the tree answers.
+                    assert!(idx.near(q, 2.0 * bound).is_some());
+                }
+            }
+        }
+        assert!(far > total / 3, "{far} of {total} points called far");
     }
 
     proptest! {

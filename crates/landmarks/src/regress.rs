@@ -384,34 +384,45 @@ impl LandmarkRegressor {
         pose: &DAffine3,
         scan: bool,
     ) -> [Option<DVec3>; 5] {
+        use rayon::prelude::*;
         let inv = rigid_inverse(pose);
         let canon: Vec<DVec3> = mesh
             .positions()
-            .iter()
+            .par_iter()
+            .with_min_len(4096)
             .map(|p| inv.transform_point3(*p))
             .collect();
+        // The landmarks are independent: in parallel, collected in order.
+        let found: Vec<Option<DVec3>> = self
+            .patches
+            .par_iter()
+            .take(5)
+            .map(|p| {
+                let x = raw_inputs(&patch_depths(&canon, mesh.triangles(), p));
+                let n = p.cells.len();
+                // Cells without surface where the training faces had one carry no information
+                // the regression learned: both their inputs take the training mean.
+                let unseen: Vec<bool> = (0..n)
+                    .map(|i| scan && !x[i].is_finite() && p.mean[n + i] < UNSEEN_RATE)
+                    .collect();
+                if unseen.iter().filter(|&&u| u).count() as f64 > UNSEEN_GAP_SHARE * n as f64 {
+                    return None;
+                }
+                let mut off = DVec3::from_array(p.intercept);
+                for (i, (&xi, c)) in x.iter().zip(&p.coef).enumerate() {
+                    let v = if xi.is_finite() && !unseen[i % n] {
+                        xi - p.mean[i]
+                    } else {
+                        0.0
+                    };
+                    off += DVec3::from_array(*c) * v;
+                }
+                Some(DVec3::from_array(p.center) + off)
+            })
+            .collect();
         let mut out = [None; 5];
-        for (k, p) in self.patches.iter().enumerate().take(5) {
-            let x = raw_inputs(&patch_depths(&canon, mesh.triangles(), p));
-            let n = p.cells.len();
-            // Cells without surface where the training faces had one carry no information the
-            // regression learned: both their inputs take the training mean.
-            let unseen: Vec<bool> = (0..n)
-                .map(|i| scan && !x[i].is_finite() && p.mean[n + i] < UNSEEN_RATE)
-                .collect();
-            if unseen.iter().filter(|&&u| u).count() as f64 > UNSEEN_GAP_SHARE * n as f64 {
-                continue;
-            }
-            let mut off = DVec3::from_array(p.intercept);
-            for (i, (&xi, c)) in x.iter().zip(&p.coef).enumerate() {
-                let v = if xi.is_finite() && !unseen[i % n] {
-                    xi - p.mean[i]
-                } else {
-                    0.0
-                };
-                off += DVec3::from_array(*c) * v;
-            }
-            out[k] = Some(DVec3::from_array(p.center) + off);
+        for (o, f) in out.iter_mut().zip(found) {
+            *o = f;
         }
         out
     }
