@@ -121,7 +121,7 @@ impl BallCollector {
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn collect(
         &mut self,
-        adj: &VertexAdjacency,
+        adj: &[&[u32]],
         pos: &[DVec3],
         v: u32,
         center: DVec3,
@@ -150,7 +150,7 @@ impl BallCollector {
         while head < out.len() {
             let u = out[head];
             head += 1;
-            for &w in adj.neighbours(u) {
+            for &w in adj[u as usize] {
                 let s = &mut self.stamp[w as usize];
                 if *s == g {
                     continue;
@@ -173,7 +173,7 @@ impl BallCollector {
                 offsets.push(d);
             }
             for &(u, _) in &ring {
-                for &w in adj.neighbours(u) {
+                for &w in adj[u as usize] {
                     if self.stamp[w as usize] != g {
                         self.stamp[w as usize] = g;
                         outside.push((w, pos[w as usize] - center));
@@ -235,6 +235,10 @@ pub fn curvatures_at(
     let n = pos.len();
     let radius = options.radius.max(0.0);
     let min_count = options.min_neighbours.max(5) + 1;
+    // The neighbour lists once, indexed here (the walks of the balls read them millions of
+    // times).
+    let adj: Vec<&[u32]> = adj.iter().collect();
+    let adj = adj.as_slice();
     // Vertices are independent: in parallel, each result computed exactly as on one thread
     // (the ball collector's state only marks visited vertices), collected in vertex order.
     vertices
@@ -283,6 +287,7 @@ fn fit_vertex(n: DVec3, offsets: &[DVec3], radius: f64) -> Option<Curvature> {
     let r2max = r2max * 1.0001 + 1e-300;
     let mut ata = [[0.0; 6]; 6];
     let mut atb = [0.0; 6];
+    let mut edge = [0.0; 6];
     let scale = r2max.sqrt();
     for &d in offsets {
         // Normalised coordinates for conditioning.
@@ -291,13 +296,24 @@ fn fit_vertex(n: DVec3, offsets: &[DVec3], radius: f64) -> Option<Curvature> {
         let h = -d.dot(n) / scale;
         let r2 = x * x + y * y;
         let wt = (1.0 - r2 * scale * scale / r2max).max(0.0).powi(2) + 1e-3;
-        let row = [x * x, x * y, y * y, x, y, 1.0];
-        for i in 0..6 {
-            for j in 0..6 {
-                ata[i][j] += wt * row[i] * row[j];
+        // The row is [x^2, xy, y^2, x, y, 1]: each entry of `ata` sums `wt * row[i] * row[j]`
+        // (left to right); those with the constant term are `wt * row[i]` (times 1, exactly),
+        // the same summands in the same order for `ata[i][5]` and `ata[5][i]`: summed once.
+        let row = [x * x, x * y, y * y, x, y];
+        let wr = row.map(|r| wt * r);
+        for i in 0..5 {
+            for j in 0..5 {
+                ata[i][j] += wr[i] * row[j];
             }
-            atb[i] += wt * row[i] * h;
+            edge[i] += wr[i];
+            atb[i] += wr[i] * h;
         }
+        edge[5] += wt;
+        atb[5] += wt * h;
+    }
+    for i in 0..6 {
+        ata[i][5] = edge[i];
+        ata[5][i] = edge[i];
     }
     let c = meshcore::linalg::solve_sym_tol(ata, atb, 1e-13)?;
     // Back to mesh units: h = s * H(x/s, y/s): second derivatives divide by s, first unchanged.
