@@ -32,7 +32,8 @@ pub struct StepTimes {
     pub clean: Duration,
     /// Detection on it.
     pub detect: Duration,
-    /// The cleaning with the crop around the detected nose tip.
+    /// The crop around the detected nose tip and the rest of the cleaning after it
+    /// ([`scanprep::Uncropped::finish`]).
     pub crop_clean: Duration,
     /// Detection on the cropped scan (zero when the crop left the cleaned scan as it was and
     /// the first detection stands).

@@ -369,7 +369,7 @@ fn costs(g: &BntGrid, probe: &Description, gallery: &[Template], n: usize) -> Re
     let st = scan.times;
     Ok(vec![
         format!(
-            "enrolment of one scan ({} valid samples of {} x {}): {} = prepare {} (clean {}, detect {}, crop and clean again {}, detect again {}) + template {} (descriptions and {} views); {} bytes",
+            "enrolment of one scan ({} valid samples of {} x {}): {} = prepare {} (clean {}, detect {}, the crop finishing the cleaning {}, detect again {}) + template {} (descriptions and {} views); {} bytes",
             valid,
             g.ncols,
             g.nrows,
