@@ -42,4 +42,4 @@ pub use locate::{closest_point_on_triangle, FaceLocator};
 pub use mesh::{Aabb, SurfacePoint, TriMesh};
 pub use subdivide::subdivide_midpoint;
 pub use surface::Surface;
-pub use topology::{Edge, Topology, NO_FACE};
+pub use topology::{vertex_components, Edge, Topology, NO_FACE};

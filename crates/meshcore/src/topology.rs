@@ -145,38 +145,7 @@ impl Topology {
             .collect();
         inconsistent.retain(|&e| !edges[e as usize].is_non_manifold());
 
-        // Components with union-find over face corners.
-        let mut parent: Vec<u32> = (0..n as u32).collect();
-        fn find(p: &mut [u32], mut x: u32) -> u32 {
-            while p[x as usize] != x {
-                p[x as usize] = p[p[x as usize] as usize];
-                x = p[x as usize];
-            }
-            x
-        }
-        for t in tris {
-            for &v in &t[1..] {
-                // Re-find both roots every time: a union may have changed t[0]'s root.
-                let r0 = find(&mut parent, t[0]);
-                let r = find(&mut parent, v);
-                if r != r0 {
-                    let (lo, hi) = (r.min(r0), r.max(r0));
-                    parent[hi as usize] = lo;
-                }
-            }
-        }
-        // Components numbered in order of their first vertex.
-        let mut comp_of_root = vec![u32::MAX; n];
-        let mut n_components = 0u32;
-        let mut vertex_component = vec![0u32; n];
-        for v in 0..n as u32 {
-            let r = find(&mut parent, v) as usize;
-            if comp_of_root[r] == u32::MAX {
-                comp_of_root[r] = n_components;
-                n_components += 1;
-            }
-            vertex_component[v as usize] = comp_of_root[r];
-        }
+        let (vertex_component, n_components) = vertex_components(mesh);
         let isolated_vertices = (0..n).filter(|&v| offsets[v + 1] == offsets[v]).count();
 
         let mut topo = Self {
@@ -186,7 +155,7 @@ impl Topology {
             face_edges,
             boundary_loops: Vec::new(),
             vertex_component,
-            n_components: n_components as usize,
+            n_components,
             isolated_vertices,
             non_manifold_edges,
             non_manifold_vertices: Vec::new(),
@@ -369,6 +338,45 @@ impl Topology {
         }
         out
     }
+}
+
+/// The connected component of each vertex (faces sharing a vertex are connected; a vertex in
+/// no face is a component of its own), numbered in order of each component's first vertex, and
+/// the number of components: what [`Topology::new`] stores, without the edges and loops.
+pub fn vertex_components(mesh: &TriMesh) -> (Vec<u32>, usize) {
+    let n = mesh.n_vertices();
+    // Union-find over face corners.
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    fn find(p: &mut [u32], mut x: u32) -> u32 {
+        while p[x as usize] != x {
+            p[x as usize] = p[p[x as usize] as usize];
+            x = p[x as usize];
+        }
+        x
+    }
+    for t in mesh.triangles() {
+        for &v in &t[1..] {
+            // Re-find both roots every time: a union may have changed t[0]'s root.
+            let r0 = find(&mut parent, t[0]);
+            let r = find(&mut parent, v);
+            if r != r0 {
+                let (lo, hi) = (r.min(r0), r.max(r0));
+                parent[hi as usize] = lo;
+            }
+        }
+    }
+    let mut comp_of_root = vec![u32::MAX; n];
+    let mut n_components = 0u32;
+    let mut vertex_component = vec![0u32; n];
+    for v in 0..n as u32 {
+        let r = find(&mut parent, v) as usize;
+        if comp_of_root[r] == u32::MAX {
+            comp_of_root[r] = n_components;
+            n_components += 1;
+        }
+        vertex_component[v as usize] = comp_of_root[r];
+    }
+    (vertex_component, n_components as usize)
 }
 
 #[cfg(test)]

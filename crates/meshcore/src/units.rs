@@ -18,7 +18,8 @@
 //! detection assumes the surface is a face (a 5 m wall in metres reads as a 50 cm
 //! face in centimetres), which is why callers let the user override it.
 
-use crate::{Topology, TriMesh};
+use crate::topology::vertex_components;
+use crate::TriMesh;
 use std::fmt;
 use std::str::FromStr;
 
@@ -169,15 +170,25 @@ pub fn robust_diagonal(points: &[crate::DVec3]) -> f64 {
 /// The face size of a mesh: [`robust_diagonal`] of the vertices of its largest connected
 /// component (most vertices; ties to the component of the smallest vertex id).
 pub fn face_size(mesh: &TriMesh) -> f64 {
-    let topo = Topology::new(mesh);
-    let comps = topo.components();
-    let best = comps
+    let (component, n) = vertex_components(mesh);
+    let mut size = vec![0usize; n];
+    for &c in &component {
+        size[c as usize] += 1;
+    }
+    let best = size
         .iter()
         .enumerate()
-        .max_by_key(|(i, c)| (c.len(), std::cmp::Reverse(*i)))
-        .map(|(_, c)| c);
+        .max_by_key(|(i, len)| (**len, std::cmp::Reverse(*i)))
+        .map(|(i, _)| i as u32);
     let pts: Vec<crate::DVec3> = best
-        .map(|c| c.iter().map(|&v| mesh.position(v)).collect())
+        .map(|b| {
+            component
+                .iter()
+                .enumerate()
+                .filter(|(_, &c)| c == b)
+                .map(|(v, _)| mesh.position(v as u32))
+                .collect()
+        })
         .unwrap_or_default();
     robust_diagonal(&pts)
 }
@@ -266,6 +277,38 @@ mod tests {
             assert!(matches!(e, UnitsError::NoUnitFits { .. }), "{e}");
             assert!(e.to_string().contains("not a face"), "{e}");
         }
+    }
+
+    #[test]
+    fn of_two_equal_components_the_first_decides() {
+        // Two single triangles of three vertices each (sizes 1 and 10 mm across), the larger
+        // listed second, and an unused vertex: equal counts, so the first component's size.
+        let p = |x: f64, y: f64| DVec3::new(x, y, 0.0);
+        let m = TriMesh::new(
+            vec![
+                p(0.0, 0.0),
+                p(1.0, 0.0),
+                p(0.0, 1.0),
+                p(50.0, 0.0),
+                p(60.0, 0.0),
+                p(50.0, 10.0),
+            ],
+            vec![[0, 1, 2], [3, 4, 5]],
+        )
+        .unwrap();
+        let (component, n) = crate::vertex_components(&m);
+        assert_eq!((component, n), (vec![0, 0, 0, 1, 1, 1], 2));
+        assert!(
+            (face_size(&m) - 2f64.sqrt()).abs() < 1e-12,
+            "{}",
+            face_size(&m)
+        );
+        let swapped = TriMesh::new(m.positions().to_vec(), vec![[3, 4, 5], [0, 1, 2]]).unwrap();
+        assert_eq!(
+            face_size(&swapped),
+            face_size(&m),
+            "by vertex order, not face order"
+        );
     }
 
     #[test]
