@@ -18,6 +18,7 @@
 
 pub mod curvature;
 mod detect;
+pub mod eval;
 pub mod geom;
 pub mod io;
 mod model;

@@ -3,11 +3,12 @@
 //! errors, and per non-face whether it was refused.
 
 use super::beyond::{make, mm_per, non_faces, BeyondFace, Kind};
-use super::stats::{quantile, score, scored_stats, sorted, text, Scored};
+use super::stats::{quantile, scored_stats, sorted, text};
 use crate::pipeline::bar;
 use crate::report::{write_csv, write_json};
 use anyhow::{Context, Result};
 use facemodel::FaceModel;
+use landmarks::eval::{score, weakest_agreement, Scored};
 use landmarks::{detect_visible, DetectOptions, GenericModel, LandmarkName, VisibleLandmarks};
 use rayon::prelude::*;
 use std::path::Path;
@@ -51,16 +52,10 @@ fn options_for(
 
 /// The numbers of a detection `v` under options `o`.
 fn found(v: &VisibleLandmarks, o: &DetectOptions) -> Found {
-    let weakest = v
-        .landmarks
-        .iter()
-        .flatten()
-        .map(|l| l.confidence / v.confidence.max(1e-12))
-        .fold(1.0, f64::min);
     Found {
         confidence: v.confidence,
         symmetry: v.symmetry,
-        weakest,
+        weakest: weakest_agreement(v.confidence, v.landmarks.iter().flatten()),
         weak: v.weak_evidence(o).iter().map(|w| w.to_string()).collect(),
     }
 }
@@ -119,10 +114,14 @@ fn kind_summary(kind: Kind, rows: &[&Outcome]) -> serde_json::Value {
     let pred: Vec<f64> = scored
         .iter()
         .flat_map(|o| o.predicted_unseen.iter())
-        .filter(|(l, _, on)| {
-            *on && matches!(l, LandmarkName::OuterEyeRight | LandmarkName::OuterEyeLeft)
+        .filter(|p| {
+            p.truth_on_surface
+                && matches!(
+                    p.name,
+                    LandmarkName::OuterEyeRight | LandmarkName::OuterEyeLeft
+                )
         })
-        .map(|x| x.1)
+        .map(|p| p.distance)
         .collect();
     let (pm, pp) = median_p95(pred.clone());
     let (tm, _) = median_p95(rows.iter().map(|o| o.detect_ms).collect());

@@ -7,6 +7,7 @@ use crate::pipeline::bar;
 use crate::report::{write_csv, write_json};
 use anyhow::Result;
 use facemodel::{FaceModel, LANDMARK_NAMES};
+use landmarks::eval::{canonical_errors, pose_only_errors, weakest_agreement};
 use landmarks::{detect_with, DetectOptions, GenericModel, LandmarkName, Landmarks};
 use meshcore::{DVec3, TriMesh};
 use rayon::prelude::*;
@@ -65,10 +66,7 @@ fn detect_face(
             error: None,
             confidence: lm.confidence,
             symmetry: lm.symmetry,
-            local: LandmarkName::ALL
-                .iter()
-                .map(|&n| lm.get(n).confidence / lm.confidence.max(1e-12))
-                .fold(1.0, f64::min),
+            local: weakest_agreement(lm.confidence, LandmarkName::ALL.map(|n| lm.get(n))),
             row: detection_row(&lm, gt, generic, unit_mm),
         },
         Err(e) => Outcome {
@@ -93,20 +91,17 @@ fn detection_row(
     generic: &GenericModel,
     unit_mm: f64,
 ) -> Vec<String> {
-    let pose = lm.model_to_mesh;
-    let inv = pose.inverse();
-    let mut row = Vec::new();
-    for &n in &LandmarkName::ALL {
-        let pred = pose.transform_point3(generic.landmark(n));
-        row.push(format!("{:.2}", (pred - gt[n as usize]).length() * unit_mm));
-    }
+    let pose_only = pose_only_errors(lm, gt, generic).map(|e| format!("{:.2}", e * unit_mm));
     let od = |p: [DVec3; 5]| format!("{:.2}", (p[3] - p[0]).length() * unit_mm);
-    row.extend([od(*gt), od(lm.positions())]);
-    for &n in &LandmarkName::ALL {
-        let dv = inv.transform_vector3(lm.get(n).position - gt[n as usize]) * unit_mm;
-        row.push(format!("{:.2} {:.2} {:.2}", dv.x, dv.y, dv.z));
-    }
-    row
+    let xyz = canonical_errors(lm, gt).map(|v| {
+        let dv = v * unit_mm;
+        format!("{:.2} {:.2} {:.2}", dv.x, dv.y, dv.z)
+    });
+    pose_only
+        .into_iter()
+        .chain([od(*gt), od(lm.positions())])
+        .chain(xyz)
+        .collect()
 }
 
 /// The evaluation on meshes: detects the landmarks of the test faces (or the training faces

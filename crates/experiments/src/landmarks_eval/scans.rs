@@ -1,8 +1,7 @@
 //! `landmarks-eval --scans`: detection on range scans of sampled ICT faces against the ground
 //! truth the scanner projected.
 
-use super::stats::{print_table, quantile, score, scored_histogram, scored_stats, sorted};
-use super::stats::{text, Scored, Stats};
+use super::stats::{print_table, quantile, scored_histogram, scored_stats, sorted, text, Stats};
 
 use super::{test_seed, Args};
 use crate::pipeline::bar;
@@ -10,6 +9,7 @@ use crate::report::{write_csv, write_json};
 use crate::scans::{sample_weights, scan_faces, scan_seed, FaceSpec, ScanSetOptions, ScanSettings};
 use anyhow::{Context, Result};
 use facemodel::FaceModel;
+use landmarks::eval::{score, Scored};
 use landmarks::{DetectOptions, GenericModel, LandmarkName};
 use meshcore::DVec3;
 use std::path::Path;
@@ -157,7 +157,7 @@ fn scan_and_detect(
         });
         let mut scored = score(&truth, f.detected.as_ref());
         let outer = [LandmarkName::OuterEyeRight, LandmarkName::OuterEyeLeft];
-        scored.predicted_unseen.retain(|p| outer.contains(&p.0));
+        scored.predicted_unseen.retain(|p| outer.contains(&p.name));
         outcomes.push(ScanOutcome {
             name: spec.name.clone(),
             scored,
@@ -246,7 +246,7 @@ impl<'a> Summary<'a> {
             |f: fn(&ScanOutcome) -> f64| quantile(&sorted(outcomes.iter().map(f).collect()), 0.5);
         let predicted = scored
             .iter()
-            .flat_map(|o| o.predicted_unseen.iter().map(|p| p.1));
+            .flat_map(|o| o.predicted_unseen.iter().map(|p| p.distance));
         Summary {
             n,
             st: scored_stats(&scored),
@@ -378,7 +378,7 @@ fn write_per_face(path: &Path, outcomes: &[ScanOutcome]) -> Result<()> {
             let s = &o.scored;
             let e = s.errors.iter().zip(&s.unseen).map(|(e, u)| {
                 let reported = u
-                    .as_deref()
+                    .as_ref()
                     .map(|u| format!(" (reported unseen: {u})"))
                     .unwrap_or_default();
                 text(&match e {

@@ -1,9 +1,9 @@
-//! Per-landmark error statistics, the error histogram and the scoring of a detection against
-//! the truth, shared by the evaluations on meshes, on range scans and beyond the model.
+//! Per-landmark error statistics and the error histogram, shared by the evaluations on meshes,
+//! on range scans and beyond the model (a detection is scored by `landmarks::eval`).
 
 use anyhow::Result;
-use landmarks::{LandmarkName, VisibleLandmarks};
-use meshcore::DVec3;
+use landmarks::eval::{scored_errors, Scored};
+use landmarks::LandmarkName;
 use std::path::Path;
 
 /// Statistics of one landmark's errors (mm).
@@ -116,57 +116,6 @@ pub(super) fn scored_histogram(path: &Path, title: &str, scored: &[&Scored]) -> 
         .map(|&n| (n.key().to_string(), scored_errors(scored, n)))
         .collect();
     error_histogram(path, title, series)
-}
-
-/// A detection scored against the truth: per landmark the error in mm (`inf`: not placed, the
-/// face not found) or why the truth is not on the surface; why the detector reported a
-/// landmark unseen; per landmark reported unseen, how far its prediction is from the truth and
-/// whether the truth is on the surface.
-#[derive(Debug)]
-pub(super) struct Scored {
-    pub errors: [Result<f64, String>; 5],
-    pub unseen: [Option<String>; 5],
-    pub predicted_unseen: Vec<(LandmarkName, f64, bool)>,
-}
-
-/// Scores `detected` against `truth` (per landmark the true position and, when it is not on
-/// the surface, why).
-pub(super) fn score<E>(
-    truth: &[(DVec3, Option<String>); 5],
-    detected: Result<&VisibleLandmarks, E>,
-) -> Scored {
-    let errors = LandmarkName::ALL.map(|n| match (&truth[n as usize], &detected) {
-        ((_, Some(why)), _) => Err(why.clone()),
-        ((t, None), Ok(d)) => Ok(d
-            .get(n)
-            .map_or(f64::INFINITY, |l| (l.position - *t).length())),
-        (_, Err(_)) => Ok(f64::INFINITY),
-    });
-    let d = detected.ok();
-    let unseen = LandmarkName::ALL.map(|n| d.and_then(|d| d.get(n).err()).map(|u| u.to_string()));
-    let predicted_unseen = d.map_or_else(Vec::new, |d| {
-        LandmarkName::ALL
-            .iter()
-            .filter(|&&n| d.get(n).is_err())
-            .map(|&n| {
-                let (t, why) = &truth[n as usize];
-                (n, (d.predicted[n as usize] - *t).length(), why.is_none())
-            })
-            .collect()
-    });
-    Scored {
-        errors,
-        unseen,
-        predicted_unseen,
-    }
-}
-
-/// The errors of landmark `n` whose truth is on the surface.
-pub(super) fn scored_errors(scored: &[&Scored], n: LandmarkName) -> Vec<f64> {
-    scored
-        .iter()
-        .filter_map(|o| o.errors[n as usize].as_ref().ok().copied())
-        .collect()
 }
 
 /// The per-landmark statistics of the errors whose truth is on the surface.
