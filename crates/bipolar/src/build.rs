@@ -549,23 +549,14 @@ fn source_position(mesh: &TriMesh, r: &Source) -> Result<DVec3, BipolarError> {
     })
 }
 
+/// The value of field `f` at reference `r`: its vertex value, or interpolated at a surface point.
 fn field_at(mesh: &TriMesh, f: &[f64], r: &Source) -> Result<f64, BipolarError> {
     Ok(match r {
         Source::Vertex(v) => {
             mesh.try_position(*v)?;
             f[*v as usize]
         }
-        Source::Point(sp) => {
-            mesh.check_surface_point(sp)?;
-            let t = mesh.triangles()[sp.face as usize];
-            let mut s = 0.0;
-            for k in 0..3 {
-                if sp.bary[k] != 0.0 {
-                    s += sp.bary[k] * f[t[k] as usize];
-                }
-            }
-            s
-        }
+        Source::Point(sp) => mesh.interpolate(f, sp)?,
     })
 }
 

@@ -1,9 +1,10 @@
 //! Pipeline pieces shared by the experiments: reference configurations, the bipolar descriptor
-//! per region (built by the `bipolar` crate), keyed distances (`shapedist`), reference-point
-//! perturbation, geodesic method resolution and progress bars.
+//! per region (built by the `bipolar` crate), keyed distances (`facematch::KeyedSet`),
+//! reference-point perturbation, geodesic method resolution and progress bars.
 
 use crate::walk::Walker;
 use anyhow::{bail, Context, Result};
+use facematch::KeyedSet;
 use facemodel::{face_frame, static_mask, Face, FaceFrame};
 use geodesic::{GeodesicSolver, Method, SolveOptions, Source};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -73,12 +74,6 @@ pub use shapedist::landmark_icp_rms;
 /// Distance field from one source.
 pub fn field(solver: &dyn GeodesicSolver, src: Source) -> Result<Vec<f64>> {
     Ok(solver.distances(&[src], &SolveOptions::default())?)
-}
-
-/// Linear interpolation of a vertex field at a surface point.
-pub fn field_at(mesh: &TriMesh, u: &[f64], sp: &SurfacePoint) -> f64 {
-    let t = mesh.triangles()[sp.face as usize];
-    sp.bary.x * u[t[0] as usize] + sp.bary.y * u[t[1] as usize] + sp.bary.z * u[t[2] as usize]
 }
 
 /// Which `bipolar` selection rule builds the face descriptors (`--descriptor`).
@@ -155,49 +150,50 @@ pub fn restrict(mask: Option<Vec<bool>>, seen: Option<&[bool]>) -> Option<Vec<bo
 
 pub use facematch::kept_vertices;
 
-/// A keyed point set as `shapedist::keyed_distance` takes it.
+/// A descriptor as the keyed point set a comparison reads (`facematch::KeyedSet`).
 pub trait Keyed {
     /// Packed keys and positions of the points that may be paired (ambiguous points left out).
-    fn unambiguous(&self) -> (Vec<u64>, Vec<DVec3>);
+    fn keyed_set(&self) -> KeyedSet;
 }
 
 impl Keyed for bipolar::Descriptor {
-    fn unambiguous(&self) -> (Vec<u64>, Vec<DVec3>) {
-        self.keyed_points(false)
+    fn keyed_set(&self) -> KeyedSet {
+        KeyedSet::of(self)
     }
 }
 
 /// The single-pole descriptor has one point per key: none is ambiguous.
 impl Keyed for bipolar::PolarDescriptor {
-    fn unambiguous(&self) -> (Vec<u64>, Vec<DVec3>) {
-        (self.keys(), self.positions())
+    fn keyed_set(&self) -> KeyedSet {
+        KeyedSet {
+            keys: self.keys(),
+            points: self.positions(),
+        }
     }
 }
 
 /// A descriptor that could not be built counts as a set without points.
 impl<T: Keyed> Keyed for Option<T> {
-    fn unambiguous(&self) -> (Vec<u64>, Vec<DVec3>) {
+    fn keyed_set(&self) -> KeyedSet {
         self.as_ref()
-            .map_or_else(|| (Vec::new(), Vec::new()), Keyed::unambiguous)
+            .map_or_else(KeyedSet::default, Keyed::keyed_set)
     }
 }
 
 /// A descriptor that could not be built (its error kept for the report) counts as a set without
 /// points.
 impl<T: Keyed, E> Keyed for Result<T, E> {
-    fn unambiguous(&self) -> (Vec<u64>, Vec<DVec3>) {
+    fn keyed_set(&self) -> KeyedSet {
         self.as_ref()
-            .map_or_else(|_| (Vec::new(), Vec::new()), Keyed::unambiguous)
+            .map_or_else(|_| KeyedSet::default(), Keyed::keyed_set)
     }
 }
 
-/// Keyed distance of the unambiguous points: `shapedist::keyed_distance` (Kabsch closed form,
-/// no gate). Fewer than 3 shared keys is `ShapeDistError::TooFewPairs`.
+/// Keyed distance of the unambiguous points: `facematch::KeyedSet::distance` without a gate
+/// (`shapedist::keyed_distance`, Kabsch closed form). Fewer than 3 shared keys is
+/// `ShapeDistError::TooFewPairs`.
 pub fn dist<A: Keyed + ?Sized, B: Keyed + ?Sized>(a: &A, b: &B) -> Result<f64, ShapeDistError> {
-    let (ka, pa) = a.unambiguous();
-    let (kb, pb) = b.unambiguous();
-    shapedist::keyed_distance(&ka, &pa, &kb, &pb, &shapedist::KeyedOptions::default())
-        .map(|k| k.distance)
+    a.keyed_set().distance(&b.keyed_set(), None)
 }
 
 /// Perturbation radii of the reference-point error grid (figures 9-11), in percent of D.

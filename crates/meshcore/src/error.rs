@@ -52,6 +52,14 @@ pub enum MeshError {
         /// Number of vertices.
         vertices: usize,
     },
+    /// A per-vertex field whose length is not the mesh's vertex count.
+    #[error("a per-vertex field has {values} values for a mesh of {vertices} vertices")]
+    FieldLength {
+        /// Number of values given.
+        values: usize,
+        /// Number of vertices.
+        vertices: usize,
+    },
     /// Barycentric coordinates that are not finite, negative beyond tolerance or do not sum to 1.
     #[error("invalid barycentric coordinates ({0}, {1}, {2}): must be finite, >= 0 and sum to 1")]
     InvalidBarycentric(f64, f64, f64),

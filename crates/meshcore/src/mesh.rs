@@ -242,6 +242,29 @@ impl TriMesh {
         Ok(p.bary.x * a + p.bary.y * b + p.bary.z * c)
     }
 
+    /// Value of a per-vertex field at a surface point: the barycentric (linear) interpolation of
+    /// the values at its face's corners. A corner of weight exactly 0 is left out, so a
+    /// non-finite value there (an unreached vertex of a distance field) does not reach a point
+    /// on the opposite edge. An error if the surface point is invalid or `values` does not have
+    /// one value per vertex.
+    pub fn interpolate(&self, values: &[f64], p: &SurfacePoint) -> Result<f64, MeshError> {
+        self.check_surface_point(p)?;
+        if values.len() != self.positions.len() {
+            return Err(MeshError::FieldLength {
+                values: values.len(),
+                vertices: self.positions.len(),
+            });
+        }
+        let t = self.triangles[p.face as usize];
+        let mut s = 0.0;
+        for (k, &v) in t.iter().enumerate() {
+            if p.bary[k] != 0.0 {
+                s += p.bary[k] * values[v as usize];
+            }
+        }
+        Ok(s)
+    }
+
     /// The corner of a surface point's face with the largest barycentric weight (the first on
     /// ties): the vertex nearest to it in the face's own coordinates. An error if the surface
     /// point is invalid.
@@ -318,6 +341,32 @@ mod tests {
         assert!((m.ring_length(&[0, 2]) - 2.0 * 2f64.sqrt()).abs() < 1e-12);
         assert_eq!(m.ring_length(&[1]), 0.0);
         assert_eq!(m.ring_length(&[]), 0.0);
+    }
+
+    #[test]
+    fn interpolation_is_linear_and_skips_zero_weights() {
+        let m = quad();
+        let x: Vec<f64> = m.positions().iter().map(|p| p.x + 2.0 * p.y).collect();
+        let sp = SurfacePoint::new(1, DVec3::new(0.2, 0.3, 0.5));
+        let p = m.point_position(&sp).unwrap();
+        assert!((m.interpolate(&x, &sp).unwrap() - (p.x + 2.0 * p.y)).abs() < 1e-12);
+        // Vertex 2 unreached: a point on the edge 0-3 (weight 0 at vertex 2) stays finite.
+        let u = [1.0, 2.0, f64::INFINITY, 4.0];
+        let edge = SurfacePoint::new(1, DVec3::new(0.25, 0.0, 0.75));
+        assert_eq!(m.interpolate(&u, &edge).unwrap(), 0.25 * 1.0 + 0.75 * 4.0);
+        assert!(m.interpolate(&u, &sp).unwrap().is_infinite());
+        assert_eq!(
+            m.interpolate(&u[..3], &sp),
+            Err(MeshError::FieldLength {
+                values: 3,
+                vertices: 4
+            })
+        );
+        let bad = SurfacePoint::new(2, DVec3::new(1.0, 0.0, 0.0));
+        assert!(matches!(
+            m.interpolate(&u, &bad),
+            Err(MeshError::FaceOutOfRange { face: 2, faces: 2 })
+        ));
     }
 
     #[test]

@@ -18,7 +18,7 @@ pub(crate) mod stats;
 
 use crate::paths::FaceSetArgs;
 use crate::pipeline::{
-    bipolar, dist, field, field_at, perturb, resolve_methods, DescriptorRule, Keyed, Refs, Region,
+    bipolar, dist, field, perturb, resolve_methods, DescriptorRule, Keyed, Refs, Region,
 };
 use crate::polar::PolarOptions;
 use crate::report::{par_map, Failures};
@@ -118,7 +118,7 @@ impl FacePrep {
         let uq = field(self.solver.as_ref(), Source::Point(sp))?;
         let q = m.point_position(&sp)?;
         let right = face.landmarks.right_eye_outer as usize;
-        let d = 0.5 * (uq[right] + field_at(m, &self.refs.ur, &sp));
+        let d = 0.5 * (uq[right] + m.interpolate(&self.refs.ur, &sp)?);
         let (ur, frame) = (self.refs.ur.clone(), face_frame(m, r, q, nose));
         Ok(Refs {
             ur,
@@ -325,7 +325,7 @@ fn run_method(ctx: &Ctx<'_>, out: &Path) -> Result<MethodResults> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::pipeline::{field_at, perturb};
+    use crate::pipeline::perturb;
 
     #[test]
     fn perturbation_moves_by_the_radius_on_a_plane() {
@@ -343,6 +343,6 @@ mod tests {
         let q = m.point_position(&sp).unwrap();
         assert!((q - (p + 0.2 * DVec3::Y)).length() < 1e-9);
         let u: Vec<f64> = m.positions().iter().map(|x| x.x).collect();
-        assert!((field_at(&m, &u, &sp) - q.x).abs() < 1e-12);
+        assert!((m.interpolate(&u, &sp).unwrap() - q.x).abs() < 1e-12);
     }
 }

@@ -3,7 +3,7 @@
 //! between the perturbed descriptors.
 
 use super::{eye_mid, Ctx, Desc, FacePrep, MethodResults};
-use crate::pipeline::{field, field_at, perturb, Refs, Region};
+use crate::pipeline::{field, perturb, Refs, Region};
 use crate::polar::{polar_descriptor, Pole};
 use crate::report::par_map;
 use crate::walk::Walker;
@@ -65,7 +65,7 @@ fn one_face(ctx: &Ctx<'_>, prep: &FacePrep, i: usize) -> Result<Run> {
     let (_, _, spr) = draw(&mut rng, w, r0.d, lm.right_eye_outer, r0.q)?;
     let ur = field(s, Source::Point(spr))?;
     let r = f.mesh.point_position(&spr)?;
-    let d2 = 0.5 * (field_at(&f.mesh, &ur, &spq) + field_at(&f.mesh, &uq, &spr));
+    let d2 = 0.5 * (f.mesh.interpolate(&ur, &spq)? + f.mesh.interpolate(&uq, &spr)?);
     let both = Refs {
         ur,
         uq,

@@ -5,7 +5,7 @@
 use super::acquisition::{acquire, snap, Setting};
 use super::variants::{LEAST, VARIANTS};
 use super::Args;
-use crate::pipeline::{field_at, kept_vertices, restrict};
+use crate::pipeline::{kept_vertices, restrict};
 use crate::polar::{polar_descriptor, PolarOptions, Pole};
 use anyhow::{bail, Result};
 use facemodel::{face_frame, static_mask, Face, FaceFrame};
@@ -91,7 +91,7 @@ fn landmark_fields(
     let ur = solve(sp[0])?;
     let uq = solve(sp[1])?;
     let un = solve(sp[2])?;
-    let d = 0.5 * (field_at(mesh, &ur, &sp[1]) + field_at(mesh, &uq, &sp[0]));
+    let d = 0.5 * (mesh.interpolate(&ur, &sp[1])? + mesh.interpolate(&uq, &sp[0])?);
     if !(d.is_finite() && d > 0.0) {
         bail!("the corners are not connected within the cut-off {cut:.1} mm (D = {d})");
     }
