@@ -132,17 +132,12 @@ fn read_field(path: &Path, n: usize) -> anyhow::Result<Vec<f64>> {
     Ok(values)
 }
 
-/// Field value at a source (vertex value or barycentric interpolation).
-fn value_at(mesh: &TriMesh, field: &[f64], src: &Source) -> f64 {
-    match src {
+/// Field value at a source: the vertex's value, or [`TriMesh::interpolate`] at a point.
+fn value_at(mesh: &TriMesh, field: &[f64], src: &Source) -> anyhow::Result<f64> {
+    Ok(match src {
         Source::Vertex(v) => field[*v as usize],
-        Source::Point(sp) => {
-            let t = mesh.triangles()[sp.face as usize];
-            sp.bary.x * field[t[0] as usize]
-                + sp.bary.y * field[t[1] as usize]
-                + sp.bary.z * field[t[2] as usize]
-        }
-    }
+        Source::Point(sp) => mesh.interpolate(field, sp)?,
+    })
 }
 
 fn curves_of(
@@ -222,7 +217,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 let db = solver
                     .distances(&[src_b], &opts)
                     .context("geodesic field of --ref-b")?;
-                let d_ab = value_at(&mesh, &da, &src_b);
+                let d_ab = value_at(&mesh, &da, &src_b).context("--ref-b")?;
                 if !(d_ab.is_finite() && d_ab > 0.0) {
                     bail!("the reference points are not connected on the surface (geodesic distance {d_ab})");
                 }
