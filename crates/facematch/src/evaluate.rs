@@ -103,11 +103,7 @@ pub fn evaluate(
         let cs = gallery.compare_all(d, options);
         for (t, c) in gallery.templates.iter().zip(&cs) {
             e.fallbacks.add(&c.fallback_kinds());
-            let score = if c.score.is_finite() {
-                c.score
-            } else {
-                f64::INFINITY
-            };
+            let score = crate::metrics::worst_if_failed(c.score);
             if t.identity == identity {
                 e.genuine.push(score);
             } else {

@@ -8,7 +8,7 @@
 //! identifies a probe and is never accepted.
 
 /// A score as the figures count it: a failed comparison (not finite) is infinitely far.
-fn worst_if_failed(v: f64) -> f64 {
+pub(crate) fn worst_if_failed(v: f64) -> f64 {
     if v.is_finite() {
         v
     } else {
