@@ -1,6 +1,7 @@
 //! Where the time of enrolling one scan goes: `cargo run --release -p facematch --example
-//! enroll_timing -- SCAN.bnt [RUNS]` prints, per run, the preparation's steps (with the
-//! cleaning's own steps), the description and the views, as the median over the runs.
+//! enroll_timing -- SCAN.bnt [RUNS] [METHOD]` prints, per run, the preparation's steps (with the
+//! cleaning's own steps), the description and the views, as the median over the runs. METHOD
+//! (default: the options' exact) is the geodesic method of the fields, to time another one.
 
 use facematch::{describe_view, view_directions, MatchOptions, ScanInput, Template};
 use landmarks::GenericModel;
@@ -8,10 +9,15 @@ use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
-    let path = args.next().ok_or("usage: enroll_timing SCAN.bnt [RUNS]")?;
+    let path = args
+        .next()
+        .ok_or("usage: enroll_timing SCAN.bnt [RUNS] [METHOD]")?;
     let runs: usize = args.next().map_or(Ok(5), |s| s.parse())?;
+    let mut options = MatchOptions::default();
+    if let Some(m) = args.next() {
+        options.method = m.parse()?;
+    }
     let grid = mesh_io::read_bnt_grid(&path)?;
-    let options = MatchOptions::default();
     let generic = GenericModel::default_model()?;
     let mut rows: Vec<Vec<(String, f64)>> = Vec::new();
     for _ in 0..runs {
