@@ -8,6 +8,7 @@ use crate::{
 use glam::DVec3;
 use levelcurves::isolines_uniform;
 use levelcurves::Isoline;
+use meshcore::SurfacePoint;
 use std::f64::consts::{PI, TAU};
 
 impl Ctx<'_> {
@@ -158,11 +159,12 @@ impl Ctx<'_> {
         let mine = &mut out[start..];
         sort_points(mine);
         let n = mine.len();
+        // The second field at a point ([`meshcore::TriMesh::interpolate`]: an unreached corner of zero
+        // weight does not make it NaN); the points were made on this mesh, so it is valid.
         let ub_at = |p: &DescriptorPoint| {
-            let t = self.mesh.triangles()[p.face as usize];
-            (0..3)
-                .map(|k| p.bary[k] * pair.fb[t[k] as usize])
-                .sum::<f64>()
+            self.mesh
+                .interpolate(pair.fb, &SurfacePoint::new(p.face, p.bary))
+                .unwrap_or(f64::NAN)
         };
         let margin = 0.25 * self.step;
         let mut drop = vec![false; n];
