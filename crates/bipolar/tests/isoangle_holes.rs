@@ -46,8 +46,9 @@ fn ambiguous_share(d: &Descriptor) -> f64 {
 
 /// Second field at a descriptor point (linear in its face).
 fn ub_at(face: &Face, uq: &[f64], p: &bipolar::DescriptorPoint) -> f64 {
-    let t = face.mesh.triangles()[p.face as usize];
-    (0..3).map(|k| p.bary[k] * uq[t[k] as usize]).sum()
+    face.mesh
+        .interpolate(uq, &meshcore::SurfacePoint::new(p.face, p.bary))
+        .unwrap()
 }
 
 #[test]
