@@ -12,6 +12,10 @@ pub struct PrepareOptions {
     pub clean: CleanOptions,
     /// Radius (mm) of the crop around the detected nose tip (`None`: no crop, one cleaning).
     pub crop_radius_mm: Option<f64>,
+    /// How the crop is made: the first cleaned (decimated) scan cropped, the first detection's
+    /// landmarks kept (true); or the input's cleaning finished again with the crop and the
+    /// landmarks detected again on it (false).
+    pub crop_keeps_detection: bool,
     /// Taubin smoothing iterations of a copy of the cleaned scan that detection runs on (the
     /// landmarks keep their vertices and are placed on the scan itself); 0: on the scan.
     pub detect_smoothing: usize,
@@ -33,6 +37,7 @@ impl Default for PrepareOptions {
                 ..CleanOptions::default()
             },
             crop_radius_mm: Some(scanprep::DEFAULT_CROP_RADIUS_MM),
+            crop_keeps_detection: false,
             detect_smoothing: 0,
             detect: landmarks::DetectOptions::default(),
         }
@@ -71,7 +76,9 @@ pub struct ViewOptions {
     /// template's frame) and the template's own, the template's own description is used.
     pub min_angle_deg: f64,
     /// The turns (degrees, about the face's vertical axis) of the template's views; each is
-    /// taken to both sides.
+    /// taken to both sides. Default 25 alone: of the turn sets tried on match-eval's tuning
+    /// set, the best rank-1 and ratio at the same EER as 15, 25, 35 and 45, at a quarter of
+    /// the views' enrolment cost (docs/matching.md, "Two views").
     pub yaws_deg: Vec<f64>,
     /// Incidence (degrees) beyond which a view loses its faces: the middle of the
     /// structured-light scanner model's grazing dropouts (70-80 degrees).
@@ -84,7 +91,7 @@ impl Default for ViewOptions {
     fn default() -> Self {
         Self {
             min_angle_deg: 10.0,
-            yaws_deg: vec![15.0, 25.0, 35.0, 45.0],
+            yaws_deg: vec![25.0],
             incidence_deg: 75.0,
             pitch_mm: 0.5,
         }
@@ -228,7 +235,7 @@ impl MatchOptions {
     pub fn template_settings(&self) -> String {
         let p = &self.prepare;
         format!(
-            "method={} levels={} cutoff={} margin={:?} incidence={:?} side_pair={:?} predicted_corners={} snap={} view={:?} crop={:?} detect_smoothing={} clean={:?} detect={:?}",
+            "method={} levels={} cutoff={} margin={:?} incidence={:?} side_pair={:?} predicted_corners={} snap={} view={:?} crop={:?}{} detect_smoothing={} clean={:?} detect={:?}",
             self.method.name(),
             self.levels,
             self.field_cutoff,
@@ -239,6 +246,7 @@ impl MatchOptions {
             self.snap_mm,
             self.view,
             p.crop_radius_mm,
+            if p.crop_keeps_detection { " (of the first cleaning, its landmarks kept)" } else { "" },
             p.detect_smoothing,
             CleanOptions { crop: None, ..p.clean.clone() },
             p.detect,

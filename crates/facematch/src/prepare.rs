@@ -172,6 +172,22 @@ pub fn prepare_with(
             .map_err(|u| MatchError::NoFace(format!("the nose tip is {u}")))?
             .vertex,
     );
+    if p.crop_keeps_detection {
+        let (mesh, detected) = crop_keeping(&found_on, found, nose_mm, radius_mm, &p.clean)?;
+        return Ok(PreparedScan {
+            mesh,
+            scanner,
+            units: used,
+            detected,
+            notes,
+            times: StepTimes {
+                clean: t1 - t0,
+                detect: t2 - t1,
+                crop_clean: t2.elapsed(),
+                crop_detect: Duration::ZERO,
+            },
+        });
+    }
     let centre = nose_mm / used.mm_per_unit();
     let cropped = staged.finish(Some(Crop { centre, radius_mm }))?;
     let t3 = Instant::now();
@@ -195,6 +211,44 @@ pub fn prepare_with(
             crop_detect,
         },
     })
+}
+
+/// `mesh` cropped to `radius_mm` around `centre` (mm) and cleared of the small components the
+/// crop leaves (`clean.min_component_ratio`), with `found`'s landmarks carried to the kept
+/// vertices. A placed landmark the crop removes is an error naming it.
+fn crop_keeping(
+    mesh: &TriMesh,
+    mut found: VisibleLandmarks,
+    centre: DVec3,
+    radius_mm: f64,
+    clean: &CleanOptions,
+) -> Result<(TriMesh, VisibleLandmarks), MatchError> {
+    let (mut cropped, _) = scanprep::crop_sphere(mesh, centre, radius_mm)?;
+    if let Some(r) = clean.min_component_ratio {
+        cropped = scanprep::remove_small_components(&cropped, r)?.0;
+    }
+    // Both steps keep the surviving vertices in order and their positions bit for bit.
+    let mut k = 0usize;
+    let new_of: Vec<Option<u32>> = mesh
+        .positions()
+        .iter()
+        .map(|p| {
+            (cropped.positions().get(k) == Some(p)).then(|| {
+                k += 1;
+                (k - 1) as u32
+            })
+        })
+        .collect();
+    for (name, l) in LandmarkName::ALL.iter().zip(found.landmarks.iter_mut()) {
+        if let Ok(l) = l {
+            l.vertex = new_of[l.vertex as usize].ok_or_else(|| {
+                MatchError::NoFace(format!(
+                    "the {name} is outside the crop of {radius_mm} mm around the nose tip"
+                ))
+            })?;
+        }
+    }
+    Ok((cropped, found))
 }
 
 /// The landmarks seen from `scanner` on `mesh` (mm), as [`detect_landmarks`] finds them with

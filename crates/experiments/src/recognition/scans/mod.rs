@@ -194,6 +194,7 @@ fn settings(args: &Args) -> Result<(ScanSetOptions, DescribeOptions, facematch::
             crop_radius_mm: Some(args.scan.crop_radius),
             detect_smoothing: args.detect_smooth,
             detect: scan_opts.detect.unwrap_or_default(),
+            ..dopt.matching.prepare.clone()
         },
         ..dopt.matching.clone()
     };
