@@ -62,12 +62,18 @@ pub struct DetectOptions {
     /// whose every landmark agrees is preferred. Only a strong fit
     /// ([`DetectOptions::strong_confidence`], [`DetectOptions::strong_symmetry`]) with every
     /// landmark placed is graded (weak agreement and unseen landmarks together are refused),
-    /// and a weak landmark whose template finds less than [`GRADED_COVERAGE`] of its surface
+    /// and a weak landmark whose template finds less than
+    /// [`DetectOptions::graded_coverage`] of its surface
     /// (beside a hole or the edge of a scan) refuses the fit (it would be returned on the
     /// hole's rim). The default 0.75 was chosen on the tuning seeds of `landmarks-eval
     /// --beyond` (true faces refused at 0.82-0.85). Equal to `min_local_agreement`, nothing is
     /// graded (the former default, 0.85).
     pub refuse_local_agreement: f64,
+    /// Least share of a weakly agreeing landmark's template (agreement between
+    /// [`DetectOptions::refuse_local_agreement`] and [`DetectOptions::min_local_agreement`])
+    /// that must find the input surface within the inlier distance for the fit to be graded
+    /// rather than refused; default [`GRADED_COVERAGE`]. `0` disables the check.
+    pub graded_coverage: f64,
     /// Fits costing more than this multiple of the best fit's cost (the best among those that
     /// pass [`DetectOptions::min_confidence`] and [`DetectOptions::min_symmetry`]) are tried
     /// only after every pass over the better fits failed, so that a much worse fit whose
@@ -157,6 +163,7 @@ impl Default for DetectOptions {
             strong_confidence: 0.85,
             strong_symmetry: 0.75,
             refuse_local_agreement: 0.75,
+            graded_coverage: GRADED_COVERAGE,
             comparable_fit_cost: 1.5,
             trace: false,
         }
@@ -238,14 +245,15 @@ struct Hypothesis {
     fit: FitScore,
 }
 
-/// Mirror-symmetry check of a fitted pose: the input vertices matched by the generic face are
-/// mirrored across the model's mid-sagittal plane (`x = 0` of the canonical frame, moved by the
-/// pose) and must land on the input surface again with agreeing normals. A face is nearly
-/// mirror-symmetric about that plane only when the pose is right; a pose rotated about the nose
-/// or fitted on a cheek, a chin or a non-face maps the matched region onto empty space or onto
-/// a differently oriented surface. Returns the share of mirrored vertices that are inliers
-/// (distance below `tau`, normals within 60 degrees), in `[0, 1]`.
-fn symmetry(idx: &SurfaceIndex, face: &[(DVec3, DVec3)], t: &DAffine3, tau: f64) -> f64 {
+/// The input vertices matched by the generic face `face` (points with normals) moved by the
+/// pose `t`: each point's nearest vertex when it is within `tau` and the normals agree (within
+/// 60 degrees); sorted, without repeats.
+fn matched_vertices(
+    idx: &SurfaceIndex,
+    face: &[(DVec3, DVec3)],
+    t: &DAffine3,
+    tau: f64,
+) -> Vec<u32> {
     let tau2 = tau * tau;
     let mut verts: Vec<u32> = face
         .iter()
@@ -257,6 +265,55 @@ fn symmetry(idx: &SurfaceIndex, face: &[(DVec3, DVec3)], t: &DAffine3, tau: f64)
         .collect();
     verts.sort_unstable();
     verts.dedup();
+    verts
+}
+
+/// Most iterations of the ICP that refines the mirror plane ([`mirror_of_input`]).
+const MIRROR_ICP_ITERATIONS: usize = 20;
+
+/// The reflection (input to input) across the input's own mid-sagittal plane: the fitted
+/// pose's plane (`x = 0` of the canonical frame, moved by `t`), refined by a point-to-plane
+/// ICP (band `tau`) of the mirrored matched vertices ([`matched_vertices`]) onto the input.
+/// On a head turned away from the scanner the generic face is fitted mostly to the seen half
+/// and its plane can be several mm off the face's; the part of the face seen on both sides of
+/// the midline (nose, brows, the near side of the far cheek) places the plane. Without enough
+/// pairs for the ICP the fitted plane stays.
+fn mirror_of_input(
+    idx: &SurfaceIndex,
+    face: &[(DVec3, DVec3)],
+    t: &DAffine3,
+    tau: f64,
+) -> DAffine3 {
+    let fitted = *t * DAffine3::from_scale(DVec3::new(-1.0, 1.0, 1.0)) * rigid_inverse(t);
+    let mirrored: Vec<(DVec3, DVec3)> = matched_vertices(idx, face, t, tau)
+        .iter()
+        .map(|&v| {
+            (
+                fitted.transform_point3(idx.pos[v as usize]),
+                fitted.transform_vector3(idx.nrm[v as usize]),
+            )
+        })
+        .collect();
+    icp(
+        idx,
+        &mirrored,
+        &DAffine3::IDENTITY,
+        MIRROR_ICP_ITERATIONS,
+        tau,
+        0.5,
+    ) * fitted
+}
+
+/// Mirror-symmetry check of a fitted pose: the input vertices matched by the generic face are
+/// mirrored across the model's mid-sagittal plane (`x = 0` of the canonical frame, moved by the
+/// pose) and must land on the input surface again with agreeing normals. A face is nearly
+/// mirror-symmetric about that plane only when the pose is right; a pose rotated about the nose
+/// or fitted on a cheek, a chin or a non-face maps the matched region onto empty space or onto
+/// a differently oriented surface. Returns the share of mirrored vertices that are inliers
+/// (distance below `tau`, normals within 60 degrees), in `[0, 1]`.
+fn symmetry(idx: &SurfaceIndex, face: &[(DVec3, DVec3)], t: &DAffine3, tau: f64) -> f64 {
+    let tau2 = tau * tau;
+    let verts = matched_vertices(idx, face, t, tau);
     if verts.is_empty() {
         return 0.0;
     }
@@ -380,9 +437,9 @@ pub fn detect_with(
 /// [`DetectOptions::min_local_agreement`]).
 pub const RIM_AGREEMENT: f64 = 0.9;
 
-/// Least share of a weakly agreeing landmark's template (below
-/// [`DetectOptions::min_local_agreement`]) that must find the input surface for the landmark
-/// to be returned graded: a landmark beside a hole of 12 mm agrees weakly and its template
+/// The default of [`DetectOptions::graded_coverage`]: least share of a weakly agreeing
+/// landmark's template (below [`DetectOptions::min_local_agreement`]) that must find the input
+/// surface for the landmark to be returned graded: a landmark beside a hole of 12 mm agrees weakly and its template
 /// finds the rim (`landmarks/tests/detect.rs`). An outer corner near the border of a mesh
 /// cut close around the eyes (the ICT face area) can find as little as 80 % and is refused.
 pub const GRADED_COVERAGE: f64 = 0.9;
@@ -408,6 +465,26 @@ pub fn detect_visible(
     detect_impl(mesh, model, options, true)
 }
 
+/// `mesh` in model units, `s` mesh units per model unit (borrowed when `s` is 1); an error
+/// when `s` is not positive and finite.
+pub(crate) fn in_model_units(
+    mesh: &TriMesh,
+    s: f64,
+) -> Result<std::borrow::Cow<'_, TriMesh>, LandmarkError> {
+    if !(s.is_finite() && s > 0.0) {
+        return Err(LandmarkError::InvalidOption(format!(
+            "mesh_units_per_model_unit must be positive and finite, got {s}"
+        )));
+    }
+    if s == 1.0 {
+        return Ok(std::borrow::Cow::Borrowed(mesh));
+    }
+    Ok(std::borrow::Cow::Owned(TriMesh::new(
+        mesh.positions().iter().map(|p| *p / s).collect(),
+        mesh.triangles().to_vec(),
+    )?))
+}
+
 /// [`detect_with`] (`partial` false: every landmark must be placed) or [`detect_visible`].
 fn detect_impl(
     mesh: &TriMesh,
@@ -417,22 +494,9 @@ fn detect_impl(
 ) -> Result<VisibleLandmarks, LandmarkError> {
     model.validate()?;
     let s = options.mesh_units_per_model_unit;
-    if !(s.is_finite() && s > 0.0) {
-        return Err(LandmarkError::InvalidOption(format!(
-            "mesh_units_per_model_unit must be positive and finite, got {s}"
-        )));
-    }
     // Work in model units.
-    let work;
-    let mesh_m = if s == 1.0 {
-        mesh
-    } else {
-        work = TriMesh::new(
-            mesh.positions().iter().map(|p| *p / s).collect(),
-            mesh.triangles().to_vec(),
-        )?;
-        &work
-    };
+    let in_model = in_model_units(mesh, s)?;
+    let mesh_m: &TriMesh = &in_model;
     let p = &model.params;
     let debug = options.trace;
     let clock = std::time::Instant::now();
@@ -750,7 +814,7 @@ fn detect_impl(
         }
         // Graded: only one kind of evidence may be weak. The fit itself must be strong, and a
         // weakly agreeing landmark must find the surface expected around it (at least
-        // [`GRADED_COVERAGE`] of its template): one beside a hole or the edge of a scan is most
+        // `graded_coverage` of its template): one beside a hole or the edge of a scan is most
         // likely not on the surface (its template finds the rim), and the fit is refused,
         // never returning it on the rim.
         if graded
@@ -778,7 +842,7 @@ fn detect_impl(
                     continue;
                 }
                 let c = coverage(&idx, &model.patches[k], &f.h.t, out[k].position, tau);
-                if c < GRADED_COVERAGE {
+                if c < options.graded_coverage {
                     bare = bare.or(Some((name, agreement[k], c)));
                 }
             }
@@ -788,7 +852,7 @@ fn detect_impl(
                         "the surface around the landmarks predicted by the best fit does not match their templates: {name} agrees weakly (agreement {a} < {}) and only {} % of the surface expected around it was found (at least {} % to grade it), it is in a hole or outside the input",
                         options.min_local_agreement,
                         100.0 * c,
-                        100.0 * GRADED_COVERAGE
+                        100.0 * options.graded_coverage
                     ),
                     f.conf * a,
                 ));
@@ -880,7 +944,8 @@ fn detect_impl(
                 ..out[k]
             }),
         });
-        let predicted = mirrored_predictions(model, &best.t, &out, &unseen, predicted);
+        let mirror = || mirror_of_input(&idx, &face, &best.t, tau);
+        let predicted = mirrored_predictions(model, &best.t, mirror, &out, &unseen, predicted);
         return Ok(VisibleLandmarks {
             landmarks,
             predicted: predicted.map(|p| p * s),
@@ -896,14 +961,16 @@ fn detect_impl(
 }
 
 /// The predictions of the unseen landmarks whose mirror partner (the other side's same
-/// corner) is placed: the partner mirrored across the fitted face's mid-sagittal plane (`x = 0`
-/// of the canonical frame), plus the generic face's own asymmetry (its mean landmark minus its
-/// mirrored partner's). A face's identity and expression move both corners of a pair alike, so
-/// the placed partner predicts an unseen corner better than the rigid generic face alone; the
-/// others keep `rigid`, the fitted face's prediction. Model units.
+/// corner) is placed: the partner mirrored across the input's own mid-sagittal plane
+/// (`mirror`, [`mirror_of_input`]), plus the generic face's own asymmetry (its mean landmark
+/// minus its mirrored partner's, turned by the pose `t`). A face's identity and expression move
+/// both corners of a pair alike, so the placed partner predicts an unseen corner better than
+/// the rigid generic face alone; the others keep `rigid`, the fitted face's prediction. Model
+/// units.
 fn mirrored_predictions(
     model: &GenericModel,
     t: &DAffine3,
+    mirror: impl Fn() -> DAffine3,
     placed: &[Landmark; 5],
     unseen: &[Option<Unseen>; 5],
     rigid: [DVec3; 5],
@@ -916,8 +983,8 @@ fn mirrored_predictions(
         L::InnerEyeLeft => Some(L::InnerEyeRight),
         L::NoseTip => None,
     };
-    let inv = rigid_inverse(t);
-    let mirror = |v: DVec3| DVec3::new(-v.x, v.y, v.z);
+    let flip = |v: DVec3| DVec3::new(-v.x, v.y, v.z);
+    let mut reflection = None;
     let mut out = rigid;
     for n in L::ALL {
         let (k, Some(m)) = (n as usize, partner(n)) else {
@@ -926,9 +993,9 @@ fn mirrored_predictions(
         if unseen[k].is_none() || unseen[m as usize].is_some() {
             continue;
         }
-        let c = mirror(inv.transform_point3(placed[m as usize].position));
-        let own = model.landmark(n) - mirror(model.landmark(m));
-        out[k] = t.transform_point3(c + own);
+        let r: &DAffine3 = reflection.get_or_insert_with(&mirror);
+        let own = model.landmark(n) - flip(model.landmark(m));
+        out[k] = r.transform_point3(placed[m as usize].position) + t.transform_vector3(own);
     }
     out
 }
@@ -1050,7 +1117,13 @@ fn regressed(
 
 /// Share of the points of a landmark template (offsets from the landmark, turned by the pose
 /// `t`), placed at `at`, whose nearest input vertex is within `tau`.
-fn coverage(idx: &SurfaceIndex, tpl: &crate::Template, t: &DAffine3, at: DVec3, tau: f64) -> f64 {
+pub(crate) fn coverage(
+    idx: &SurfaceIndex,
+    tpl: &crate::Template,
+    t: &DAffine3,
+    at: DVec3,
+    tau: f64,
+) -> f64 {
     let tau2 = tau * tau;
     let n = tpl.points.len();
     let hit = tpl

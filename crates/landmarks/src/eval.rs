@@ -1,13 +1,17 @@
 //! Evaluation of detected landmarks against known positions (a detector's accuracy on annotated
 //! meshes): per-landmark errors of a detection ([`score`]), the errors of a set of detections
 //! ([`scored_errors`]), the errors of the fitted pose alone ([`pose_only_errors`]), the error
-//! vectors in the model's canonical frame ([`canonical_errors`]) and the weakest local template
-//! agreement of a detection ([`weakest_agreement`]).
+//! vectors in the model's canonical frame ([`canonical_errors`]), the weakest local template
+//! agreement of a detection ([`weakest_agreement`]) and the share of each landmark's template
+//! that finds the input surface ([`landmark_coverage`]).
 //!
 //! Distances are in the units of the positions given (the mesh's units).
 
-use crate::{GenericModel, Landmark, LandmarkName, Landmarks, Unseen, VisibleLandmarks};
-use meshcore::DVec3;
+use crate::{
+    DetectOptions, GenericModel, Landmark, LandmarkError, LandmarkName, Landmarks, Unseen,
+    VisibleLandmarks,
+};
+use meshcore::{DAffine3, DVec3, TriMesh};
 
 /// A landmark the detector reported unseen ([`VisibleLandmarks::predicted`]), against the truth.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -110,6 +114,35 @@ pub fn weakest_agreement<'a>(
         .into_iter()
         .map(|l| l.confidence / confidence.max(1e-12))
         .fold(1.0, f64::min)
+}
+
+/// Per landmark in [`LandmarkName::ALL`] order, the share of its local template (the mean
+/// surface around it, turned by the fitted pose and placed at the reported point) that finds
+/// the input surface within the model's inlier distance, as the detector's coverage checks
+/// measure it ([`DetectOptions::min_landmark_coverage`], [`DetectOptions::graded_coverage`]);
+/// `None` for a landmark not placed. `mesh`, `model` and `options.mesh_units_per_model_unit`
+/// are those of the detection `found`.
+pub fn landmark_coverage(
+    mesh: &TriMesh,
+    model: &GenericModel,
+    found: &VisibleLandmarks,
+    options: &DetectOptions,
+) -> Result<[Option<f64>; 5], LandmarkError> {
+    model.validate()?;
+    let s = options.mesh_units_per_model_unit;
+    let mesh_m = crate::detect::in_model_units(mesh, s)?;
+    let idx = crate::detect::surface_index(&mesh_m);
+    let pose = DAffine3::from_mat3_translation(
+        found.model_to_mesh.matrix3,
+        found.model_to_mesh.translation / s,
+    );
+    let tau = model.params.inlier_distance;
+    Ok(LandmarkName::ALL.map(|n| {
+        found.get(n).ok().map(|l| {
+            let tpl = &model.patches[n as usize];
+            crate::detect::coverage(&idx, tpl, &pose, l.position / s, tau)
+        })
+    }))
 }
 
 #[cfg(test)]

@@ -209,8 +209,8 @@ pub struct VisibleLandmarks {
     /// Where each landmark is predicted (input units), seen or not: not a point of the input.
     /// A placed landmark's is where the fitted generic face puts it; an unseen one whose
     /// mirror partner (the other side's same corner) is placed is predicted from the partner
-    /// mirrored across the fitted face's mid-sagittal plane, else where the fitted face puts
-    /// it.
+    /// mirrored across the input's own mid-sagittal plane (the fitted face's, refined by
+    /// aligning the mirrored input with itself), else where the fitted face puts it.
     pub predicted: [DVec3; 5],
     /// Overall confidence in `[0, 1]` of the generic face fit.
     pub confidence: f64,

@@ -1,9 +1,10 @@
 //! Detection: rigid-motion invariance, a small evaluation on the shared paper set (skipped when
 //! the data is absent), and clear failures on non-faces and faces seen from behind.
 
+use landmarks::eval::landmark_coverage;
 use landmarks::{
-    detect, detect_with, io, mesh_units_per_model_unit, DetectOptions, GenericModel, LandmarkError,
-    LandmarkName,
+    detect, detect_visible, detect_with, io, mesh_units_per_model_unit, DetectOptions,
+    GenericModel, LandmarkError, LandmarkName, GRADED_COVERAGE,
 };
 use meshcore::{DAffine3, DQuat, DVec3, TriMesh};
 use std::path::PathBuf;
@@ -434,4 +435,54 @@ fn a_landmark_without_surface_is_not_found_with_its_name() {
             other => panic!("expected NotFound, got {other:?}"),
         }
     }
+}
+
+/// `eval::landmark_coverage` measures what the detector's coverage guards test: on a whole face
+/// every landmark's template finds its surface; with a hole of 1.2 cm at the outer eye corner
+/// and the graded pass's coverage guard off (`graded_coverage` 0), the corner comes back on the
+/// hole's rim, weakly agreeing, and its template finds less than the default guard's
+/// `GRADED_COVERAGE` of its surface: the default options refuse that fit.
+#[test]
+fn landmark_coverage_is_what_the_graded_coverage_guard_tests() {
+    let Some((mesh, truth, model)) = face_with_truth("id2_neutral") else {
+        return;
+    };
+    let options = DetectOptions {
+        mesh_units_per_model_unit: mesh_units_per_model_unit(&mesh, &model).unwrap(),
+        ..DetectOptions::default()
+    };
+    let whole = detect_visible(&mesh, &model, &options).unwrap();
+    let cov = landmark_coverage(&mesh, &model, &whole, &options).unwrap();
+    // Measured: 1.0 at four landmarks, 0.99 at the left inner corner.
+    for (n, c) in LandmarkName::ALL.into_iter().zip(cov) {
+        let c = c.unwrap_or_else(|| panic!("{n} not placed on the whole face"));
+        assert!(c > 0.95, "whole face: {n} coverage {c}");
+    }
+    let corner = truth[LandmarkName::OuterEyeRight as usize];
+    let holed = part(&mesh, |p| (p - corner).length() > 1.2);
+    assert!(detect_visible(&holed, &model, &options).is_err());
+    let unguarded = DetectOptions {
+        graded_coverage: 0.0,
+        ..options
+    };
+    let v = detect_visible(&holed, &model, &unguarded).unwrap();
+    let weak = v.weak_evidence(&unguarded);
+    assert!(
+        weak.iter().any(|w| matches!(
+            w,
+            landmarks::Weakness::Landmark {
+                name: LandmarkName::OuterEyeRight,
+                ..
+            }
+        )),
+        "{weak:?}"
+    );
+    // Measured: 0.69 at the corner on the hole's rim, 0.99-1.0 elsewhere.
+    let cov = landmark_coverage(&holed, &model, &v, &unguarded).unwrap();
+    let at_hole = cov[LandmarkName::OuterEyeRight as usize].unwrap();
+    assert!(at_hole < GRADED_COVERAGE, "coverage at the hole {at_hole}");
+    assert!(
+        cov.iter().flatten().filter(|&&c| c > 0.95).count() == 4,
+        "{cov:?}"
+    );
 }

@@ -193,6 +193,12 @@ fn landmarks_a_turned_head_hides_are_reported_unseen() {
             // Where the fitted face puts every landmark, seen or not.
             let off = (found.predicted[n as usize] - truth[n as usize]).length();
             assert!(off < 10.0, "{case}: {n} predicted {off:.1} mm off");
+            // An unseen corner is predicted from its placed partner mirrored across the face's
+            // own mid-sagittal plane: 1.7 and 2.3 mm off for the far outer corners here (4.4
+            // and 3.1 mm across the fitted face's plane alone), 0.4 mm for the far inner one.
+            if found.get(n).is_err() {
+                assert!(off < 3.0, "{case}: unseen {n} predicted {off:.2} mm off");
+            }
         }
         let why = found.get(unseen[0]).unwrap_err().to_string();
         assert!(
