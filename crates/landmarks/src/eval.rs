@@ -118,9 +118,11 @@ pub fn weakest_agreement<'a>(
 
 /// Per landmark in [`LandmarkName::ALL`] order, the share of its local template (the mean
 /// surface around it, turned by the fitted pose and placed at the reported point) that finds
-/// the input surface within the model's inlier distance, as the detector's coverage checks
-/// measure it ([`DetectOptions::min_landmark_coverage`], [`DetectOptions::graded_coverage`]);
-/// `None` for a landmark not placed. `mesh`, `model` and `options.mesh_units_per_model_unit`
+/// the input surface within the model's inlier distance, as the detector's check that a
+/// landmark is on the surface measures it ([`DetectOptions::min_landmark_coverage`]); `None`
+/// for a landmark not placed. The graded pass's guard ([`DetectOptions::graded_coverage`])
+/// measures the same share at the template search's point, before the learned regression
+/// moves the eye corners, so its value can differ. `mesh`, `model` and `options.mesh_units_per_model_unit`
 /// are those of the detection `found`.
 pub fn landmark_coverage(
     mesh: &TriMesh,

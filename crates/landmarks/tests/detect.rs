@@ -437,13 +437,13 @@ fn a_landmark_without_surface_is_not_found_with_its_name() {
     }
 }
 
-/// `eval::landmark_coverage` measures what the detector's coverage guards test: on a whole face
-/// every landmark's template finds its surface; with a hole of 1.2 cm at the outer eye corner
-/// and the graded pass's coverage guard off (`graded_coverage` 0), the corner comes back on the
-/// hole's rim, weakly agreeing, and its template finds less than the default guard's
-/// `GRADED_COVERAGE` of its surface: the default options refuse that fit.
+/// `eval::landmark_coverage` measures the share the detector's coverage checks test: on a
+/// whole face every landmark's template finds its surface; with a hole of 1.2 cm at the outer
+/// eye corner and the graded pass's coverage guard off (`graded_coverage` 0), the corner comes
+/// back on the hole's rim, weakly agreeing, and its template finds less than the default
+/// guard's `GRADED_COVERAGE` of its surface: the default options refuse that fit.
 #[test]
-fn landmark_coverage_is_what_the_graded_coverage_guard_tests() {
+fn landmark_coverage_finds_a_corner_on_the_rim_of_a_hole() {
     let Some((mesh, truth, model)) = face_with_truth("id2_neutral") else {
         return;
     };
