@@ -8,7 +8,7 @@ use crate::pipeline::bar;
 use crate::report::{write_csv, write_json};
 use anyhow::{Context, Result};
 use facemodel::FaceModel;
-use landmarks::eval::{score, weakest_agreement, Scored};
+use landmarks::eval::{landmark_coverage, score, weakest_agreement, Scored};
 use landmarks::{detect_visible, DetectOptions, GenericModel, LandmarkName, VisibleLandmarks};
 use rayon::prelude::*;
 use std::path::Path;
@@ -22,6 +22,9 @@ struct Outcome {
     scored: Scored,
     /// The detection, or the error message.
     found: Result<Found, String>,
+    /// A face refused: its detection without the coverage guard, if that finds it, and that
+    /// detection's largest landmark error (infinite: a landmark not placed).
+    unguarded: Option<(Found, f64)>,
     vertices: usize,
     detect_ms: f64,
 }
@@ -34,6 +37,8 @@ struct Found {
     weakest: f64,
     /// Why the evidence is weak (empty: strong).
     weak: Vec<String>,
+    /// Per landmark, the share of its template that finds the surface (`None`: not placed).
+    coverage: [Option<f64>; 5],
 }
 
 /// Detection options for a face of `mesh`: the caller's with the mesh's units and viewpoint.
@@ -50,13 +55,28 @@ fn options_for(
     })
 }
 
-/// The numbers of a detection `v` under options `o`.
-fn found(v: &VisibleLandmarks, o: &DetectOptions) -> Found {
+/// The numbers of a detection `v` of `mesh` under options `o`.
+fn found(
+    v: &VisibleLandmarks,
+    o: &DetectOptions,
+    mesh: &meshcore::TriMesh,
+    generic: &GenericModel,
+) -> Found {
     Found {
         confidence: v.confidence,
         symmetry: v.symmetry,
         weakest: weakest_agreement(v.confidence, v.landmarks.iter().flatten()),
         weak: v.weak_evidence(o).iter().map(|w| w.to_string()).collect(),
+        coverage: landmark_coverage(mesh, generic, v, o).unwrap_or([None; 5]),
+    }
+}
+
+/// `o` without the graded pass's coverage guard (`DetectOptions::graded_coverage` 0): a face
+/// or non-face refused with it is detected again so that the guard's effect is measured.
+fn without_coverage_guard(o: &DetectOptions) -> DetectOptions {
+    DetectOptions {
+        graded_coverage: 0.0,
+        ..*o
     }
 }
 
@@ -67,12 +87,23 @@ fn detect_one(f: BeyondFace, kind: Kind, generic: &GenericModel, dopt: &DetectOp
         .and_then(|o| detect_visible(&f.mesh, generic, &o).map(|v| (v, o)));
     let detect_ms = t0.elapsed().as_secs_f64() * 1e3;
     let scored = score(&f.truth, r.as_ref().map(|(v, _)| v));
+    // Refused: what the detection would be without the coverage guard (its coverages).
+    let unguarded = r.as_ref().err().and_then(|_| {
+        let o = without_coverage_guard(&options_for(&f.mesh, generic, dopt, f.toward_viewer).ok()?);
+        let v = detect_visible(&f.mesh, generic, &o).ok()?;
+        let errors = score(&f.truth, Ok::<_, ()>(&v)).errors;
+        let worst = errors.iter().flatten().fold(0.0, |w: f64, &e| w.max(e));
+        Some((found(&v, &o, &f.mesh, generic), worst))
+    });
     Outcome {
         kind,
         name: f.name,
         label: f.label,
         scored,
-        found: r.map(|(v, o)| found(&v, &o)).map_err(|e| e.to_string()),
+        found: r
+            .map(|(v, o)| found(&v, &o, &f.mesh, generic))
+            .map_err(|e| e.to_string()),
+        unguarded,
         vertices: f.mesh.n_vertices(),
         detect_ms,
     }
@@ -257,20 +288,36 @@ fn run_non_faces(
             ..*dopt
         };
         let r = detect_visible(&mesh, generic, &o);
+        let unguarded = detect_visible(&mesh, generic, &without_coverage_guard(&o)).is_ok();
         let what = match &r {
             Ok(v) => format!(
                 "LET THROUGH (confidence {}, symmetry {})",
                 v.confidence, v.symmetry
             ),
-            Err(e) => format!("refused: {e}"),
+            Err(e) => format!(
+                "refused: {e}; without the coverage guard {}",
+                if unguarded { "LET THROUGH" } else { "refused" }
+            ),
         };
         println!("non-face {name}: {what}");
-        out.push(serde_json::json!({"non_face": name, "refused": r.is_err(), "outcome": what}));
+        out.push(serde_json::json!({"non_face": name, "refused": r.is_err(), "refused_without_coverage_guard": !unguarded, "outcome": what}));
     }
     Ok(out)
 }
 
-/// One row per face.
+/// The per-face CSV's coverage columns, in [`LandmarkName::ALL`] order.
+const COVERAGE_COLUMNS: [&str; 5] = [
+    "coverage_outer_eye_right",
+    "coverage_inner_eye_right",
+    "coverage_inner_eye_left",
+    "coverage_outer_eye_left",
+    "coverage_nose_tip",
+];
+
+/// One row per face: errors, the detection's numbers (unrounded), the share of each placed
+/// landmark's template that finds the surface (for a refused face, of its detection without
+/// the coverage guard when that finds it, with that detection's largest landmark error), time
+/// and error.
 fn write_per_face(outcomes: &[Outcome], path: &Path) -> Result<()> {
     let header: Vec<&str> = ["face", "kind"]
         .into_iter()
@@ -282,6 +329,8 @@ fn write_per_face(outcomes: &[Outcome], path: &Path) -> Result<()> {
             "weak",
             "vertices",
         ])
+        .chain(COVERAGE_COLUMNS)
+        .chain(["coverage_from", "without_coverage_guard_max_error"])
         .chain(["detect_ms", "error", "label"])
         .collect();
     let rows: Vec<Vec<String>> = outcomes
@@ -301,7 +350,19 @@ fn write_per_face(outcomes: &[Outcome], path: &Path) -> Result<()> {
             };
             let mut row: Vec<String> = vec![o.name.clone(), o.kind.name().into()];
             row.extend(e.chain(found));
-            row.extend([o.vertices.to_string(), format!("{:.0}", o.detect_ms)]);
+            row.push(o.vertices.to_string());
+            // The coverages unrounded: of the detection, or of a refused face's detection
+            // without the coverage guard.
+            let (coverage, from, worst) = match (&o.found, &o.unguarded) {
+                (Ok(f), _) => (Some(f.coverage), "detection", None),
+                (Err(_), Some((u, w))) => {
+                    (Some(u.coverage), "without the coverage guard", Some(*w))
+                }
+                (Err(_), None) => (None, "", None),
+            };
+            let cell = |c: Option<f64>| c.map_or_else(String::new, |c| c.to_string());
+            row.extend(coverage.unwrap_or([None; 5]).map(cell));
+            row.extend([from.to_string(), cell(worst), format!("{:.0}", o.detect_ms)]);
             row.extend([error, text(&o.label)]);
             row
         })
