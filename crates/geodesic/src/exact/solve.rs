@@ -115,6 +115,9 @@ pub(crate) struct Buffers {
     /// The children of the list being processed, for its left and right target list (appended
     /// to those lists in one step each).
     kids: [Vec<Window>; 2],
+    /// Scratch of [`sort_by_start`]: run boundaries and the merged copy of a long list.
+    runs: Vec<u32>,
+    merged: Vec<Window>,
 }
 
 impl Buffers {
@@ -521,7 +524,7 @@ impl<'a> Solve<'a> {
         // P1: sorted lower-envelope trim (dead windows are skipped below, not removed).
         let mut alive = ws.len();
         if self.prune && ws.len() > 1 {
-            sort_by_start(&mut ws);
+            sort_by_start(&mut ws, &mut self.b.runs, &mut self.b.merged);
             let mut cur = 0;
             for j in 1..ws.len() {
                 let (lo, hi) = ws.split_at_mut(j);
@@ -720,21 +723,81 @@ fn vertex_beats(p: f64, w: &Window, x: f64) -> bool {
     p < w.dist(x) * (1.0 - TAU)
 }
 
-/// Stable sort of a window list by start (`total_cmp`): insertion sort for the short lists of
-/// a solve (same order as `sort_by`, which is stable too), `sort_by` for long ones.
+/// Stable sort of a window list by start (`total_cmp`), the order of `sort_by`: insertion sort
+/// for the short lists of a solve; a long list (appended in sorted batches, so a few
+/// ascending runs) by merging neighbouring runs pass by pass, taking the left run's window on
+/// ties. Each pass writes into `merged`, which is then swapped with `ws` (so `ws` may come
+/// back in another allocation); `runs` and `merged` are scratch buffers.
 #[inline]
-fn sort_by_start(ws: &mut [Window]) {
-    if ws.len() > 24 {
-        ws.sort_by(|x, y| x.b0.total_cmp(&y.b0));
+fn sort_by_start(ws: &mut Vec<Window>, runs: &mut Vec<u32>, merged: &mut Vec<Window>) {
+    let n = ws.len();
+    if n <= 24 {
+        for i in 1..n {
+            let mut j = i;
+            while j > 0 && ws[j - 1].b0.total_cmp(&ws[j].b0) == Ordering::Greater {
+                ws.swap(j - 1, j);
+                j -= 1;
+            }
+        }
         return;
     }
-    for i in 1..ws.len() {
-        let mut j = i;
-        while j > 0 && ws[j - 1].b0.total_cmp(&ws[j].b0) == Ordering::Greater {
-            ws.swap(j - 1, j);
-            j -= 1;
+    merge_runs_in_place(ws, runs, merged);
+}
+
+/// [`sort_by_start`] of a list longer than 24 windows: its ascending runs merged pass by pass
+/// (kept out of line: the short lists' insertion sort stays small in `process`).
+#[inline(never)]
+fn merge_runs_in_place(ws: &mut Vec<Window>, runs: &mut Vec<u32>, merged: &mut Vec<Window>) {
+    let n = ws.len();
+    runs.clear();
+    runs.push(0);
+    for (i, p) in ws.windows(2).enumerate() {
+        if p[0].b0.total_cmp(&p[1].b0) == Ordering::Greater {
+            runs.push(i as u32 + 1);
         }
     }
+    if runs.len() == 1 {
+        return;
+    }
+    runs.push(n as u32);
+    while runs.len() > 2 {
+        merged.clear();
+        let mut k = 0;
+        let mut w = 1;
+        while k + 1 < runs.len() {
+            let (a, b) = (runs[k] as usize, runs[k + 1] as usize);
+            if k + 2 < runs.len() {
+                let c = runs[k + 2] as usize;
+                merge_runs(&ws[a..b], &ws[b..c], merged);
+                runs[w] = c as u32;
+            } else {
+                merged.extend_from_slice(&ws[a..b]);
+                runs[w] = b as u32;
+            }
+            w += 1;
+            k += 2;
+        }
+        runs.truncate(w);
+        std::mem::swap(ws, merged);
+    }
+}
+
+/// Appends the stable merge of the sorted runs `x` and `y` (by start, `total_cmp`; `x` first
+/// on ties) to `out`.
+#[inline]
+fn merge_runs(x: &[Window], y: &[Window], out: &mut Vec<Window>) {
+    let (mut i, mut j) = (0, 0);
+    while i < x.len() && j < y.len() {
+        if y[j].b0.total_cmp(&x[i].b0) == Ordering::Less {
+            out.push(y[j]);
+            j += 1;
+        } else {
+            out.push(x[i]);
+            i += 1;
+        }
+    }
+    out.extend_from_slice(&x[i..]);
+    out.extend_from_slice(&y[j..]);
 }
 
 pub(super) fn classify_point(g: &ExactGeodesic, sp: &SurfacePoint) -> Result<Seed, GeodesicError> {
@@ -822,6 +885,43 @@ mod tests {
             *p *= 1.0 + rng.random_range(-amp..=amp);
         }
         TriMesh::new(v, f).unwrap()
+    }
+
+    /// The list sort gives the order of a stable `sort_by` with `total_cmp` (ties in input
+    /// order, -0 before +0, infinities), for short and long lists of few or many runs.
+    #[test]
+    fn sort_by_start_is_the_stable_sort() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let (mut runs, mut merged) = (Vec::new(), Vec::new());
+        for n in (0..120).chain([500, 2000]) {
+            for kind in 0..5 {
+                let ws: Vec<Window> = (0..n)
+                    .map(|i| {
+                        let b0 = match kind {
+                            0 => rng.random_range(-1.0..1.0),
+                            1 => f64::from(rng.random_range(0..5u32)) - 2.0,
+                            2 => [0.0, -0.0, 1.0, f64::INFINITY, -f64::INFINITY][i % 5],
+                            3 => (i % 17) as f64 + 0.5 * (i % 3) as f64,
+                            _ => -(i as f64),
+                        };
+                        Window {
+                            b0,
+                            b1: b0,
+                            sigma: 0.0,
+                            sx: 0.0,
+                            sy: -1.0,
+                            id: i as u32,
+                        }
+                    })
+                    .collect();
+                let mut want = ws.clone();
+                want.sort_by(|x, y| x.b0.total_cmp(&y.b0));
+                let mut got = ws;
+                sort_by_start(&mut got, &mut runs, &mut merged);
+                let ids = |v: &[Window]| v.iter().map(|w| w.id).collect::<Vec<_>>();
+                assert_eq!(ids(&got), ids(&want), "n {n} kind {kind}");
+            }
+        }
     }
 
     /// The pruned propagation equals the oracle mode (vertex filter only, no pairwise trim,
