@@ -22,7 +22,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let me = std::path::PathBuf::from(args.next().ok_or("usage")?);
     let out = std::path::PathBuf::from(args.next().ok_or("usage")?);
     std::fs::create_dir_all(&out)?;
-    // The turns of the study (every default turn since 2026-12-03 until ±25 was chosen).
+    // The turns the study compares (the default ones).
     let mut options = MatchOptions::default();
     if let Some(v) = &mut options.view {
         v.yaws_deg = vec![15.0, 25.0, 35.0, 45.0];

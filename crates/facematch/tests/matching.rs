@@ -41,7 +41,7 @@ fn enrol_then_identify_ranks_the_same_person_first_and_templates_round_trip() {
     {
         let g = scan(m, 0.0, 11 + k as u64);
         let t = enroll(ScanInput::Grid(&g), id, &format!("{id}.bnt"), &o).unwrap();
-        assert_eq!(t.views.len(), 2);
+        assert_eq!(t.views.len(), 8);
         assert!(
             t.description.sets.iter().all(Result::is_ok),
             "{id}: {:?}",
