@@ -151,19 +151,21 @@ pub fn prepare_with(
         (Err(e), _) => return Err(e),
     };
     let t2 = Instant::now();
+    let done = |mesh, detected, crop_clean, crop_detect| PreparedScan {
+        mesh,
+        scanner,
+        units: used,
+        detected,
+        notes,
+        times: StepTimes {
+            clean: t1 - t0,
+            detect: t2 - t1,
+            crop_clean,
+            crop_detect,
+        },
+    };
     let Some(radius_mm) = p.crop_radius_mm else {
-        return Ok(PreparedScan {
-            mesh: found_on,
-            scanner,
-            units: used,
-            detected: found,
-            notes,
-            times: StepTimes {
-                clean: t1 - t0,
-                detect: t2 - t1,
-                ..StepTimes::default()
-            },
-        });
+        return Ok(done(found_on, found, Duration::ZERO, Duration::ZERO));
     };
     // The crop's centre in the input's units and frame.
     let nose_mm = found_on.position(
@@ -174,19 +176,7 @@ pub fn prepare_with(
     );
     if p.crop_keeps_detection {
         let (mesh, detected) = crop_keeping(&found_on, found, nose_mm, radius_mm, &p.clean)?;
-        return Ok(PreparedScan {
-            mesh,
-            scanner,
-            units: used,
-            detected,
-            notes,
-            times: StepTimes {
-                clean: t1 - t0,
-                detect: t2 - t1,
-                crop_clean: t2.elapsed(),
-                crop_detect: Duration::ZERO,
-            },
-        });
+        return Ok(done(mesh, detected, t2.elapsed(), Duration::ZERO));
     }
     let centre = nose_mm / used.mm_per_unit();
     let cropped = staged.finish(Some(Crop { centre, radius_mm }))?;
@@ -198,19 +188,7 @@ pub fn prepare_with(
     } else {
         (detect(&cropped.mesh, generic, scanner, p)?, t3.elapsed())
     };
-    Ok(PreparedScan {
-        mesh: cropped.mesh,
-        scanner,
-        units: used,
-        detected,
-        notes,
-        times: StepTimes {
-            clean: t1 - t0,
-            detect: t2 - t1,
-            crop_clean: t3 - t2,
-            crop_detect,
-        },
-    })
+    Ok(done(cropped.mesh, detected, t3 - t2, crop_detect))
 }
 
 /// `mesh` cropped to `radius_mm` around `centre` (mm) and cleared of the small components the

@@ -183,26 +183,27 @@ fn a_face_before_a_wall_is_found() {
     );
 }
 
+fn with_prepare(prepare: facematch::PrepareOptions) -> MatchOptions {
+    MatchOptions {
+        prepare,
+        ..MatchOptions::default()
+    }
+}
+
 #[test]
-fn a_crop_that_changes_nothing_keeps_the_first_detection() {
+fn the_crop_around_the_detected_nose_tip() {
     let Some([a]) = testsupport::paper_meshes(["id2_neutral.obj"]) else {
         return;
     };
     let grid = scan(&a, 0.0, 31);
-    let uncropped = MatchOptions {
-        prepare: facematch::PrepareOptions {
-            crop_radius_mm: None,
-            ..MatchOptions::default().prepare
-        },
-        ..MatchOptions::default()
-    };
-    let wide = MatchOptions {
-        prepare: facematch::PrepareOptions {
-            crop_radius_mm: Some(400.0),
-            ..MatchOptions::default().prepare
-        },
-        ..MatchOptions::default()
-    };
+    let uncropped = with_prepare(facematch::PrepareOptions {
+        crop_radius_mm: None,
+        ..MatchOptions::default().prepare
+    });
+    let wide = with_prepare(facematch::PrepareOptions {
+        crop_radius_mm: Some(400.0),
+        ..MatchOptions::default().prepare
+    });
     let first = prepare(ScanInput::Grid(&grid), &uncropped).unwrap();
     let kept = prepare(ScanInput::Grid(&grid), &wide).unwrap();
     // 400 mm around the nose tip holds the whole scan: the same mesh, the same landmarks,
@@ -214,28 +215,11 @@ fn a_crop_that_changes_nothing_keeps_the_first_detection() {
     let cut = prepare(ScanInput::Grid(&grid), &MatchOptions::default()).unwrap();
     assert!(cut.mesh.n_vertices() < first.mesh.n_vertices());
     assert!(cut.times.crop_detect > std::time::Duration::ZERO);
-}
-
-#[test]
-fn a_crop_that_keeps_the_detection_cuts_the_first_cleaning() {
-    let Some([a]) = testsupport::paper_meshes(["id2_neutral.obj"]) else {
-        return;
-    };
-    let grid = scan(&a, 0.0, 31);
-    let uncropped = MatchOptions {
-        prepare: facematch::PrepareOptions {
-            crop_radius_mm: None,
-            ..MatchOptions::default().prepare
-        },
-        ..MatchOptions::default()
-    };
-    let keep = MatchOptions {
-        prepare: facematch::PrepareOptions {
-            crop_keeps_detection: true,
-            ..MatchOptions::default().prepare
-        },
-        ..MatchOptions::default()
-    };
+    // `crop_keeps_detection` crops the first cleaning instead and keeps its landmarks.
+    let keep = with_prepare(facematch::PrepareOptions {
+        crop_keeps_detection: true,
+        ..MatchOptions::default().prepare
+    });
     assert_ne!(
         keep.template_settings(),
         MatchOptions::default().template_settings()
