@@ -193,7 +193,7 @@ pub fn prepare_with(
 
 /// `mesh` cropped to `radius_mm` around `centre` (mm) and cleared of the small components the
 /// crop leaves (`clean.min_component_ratio`), with `found`'s landmarks carried to the kept
-/// vertices. A placed landmark the crop removes is an error naming it.
+/// vertices. A placed landmark the crop removes is [`MatchError::Landmarks`] naming it.
 fn crop_keeping(
     mesh: &TriMesh,
     mut found: VisibleLandmarks,
@@ -205,22 +205,18 @@ fn crop_keeping(
     if let Some(r) = clean.min_component_ratio {
         cropped = scanprep::remove_small_components(&cropped, r)?.0;
     }
-    // Both steps keep the surviving vertices in order and their positions bit for bit.
-    let mut k = 0usize;
-    let new_of: Vec<Option<u32>> = mesh
-        .positions()
-        .iter()
-        .map(|p| {
-            (cropped.positions().get(k) == Some(p)).then(|| {
-                k += 1;
-                (k - 1) as u32
-            })
-        })
-        .collect();
+    // Both steps only drop vertices: each kept one is found in `mesh`.
+    let mut new_of = vec![None; mesh.n_vertices()];
+    let kept = scanprep::surviving_vertices(mesh, &cropped).ok_or_else(|| {
+        MatchError::Landmarks("the crop is not a subset of the cleaned scan".into())
+    })?;
+    for (new, &old) in kept.iter().enumerate() {
+        new_of[old as usize] = Some(new as u32);
+    }
     for (name, l) in LandmarkName::ALL.iter().zip(found.landmarks.iter_mut()) {
         if let Ok(l) = l {
             l.vertex = new_of[l.vertex as usize].ok_or_else(|| {
-                MatchError::NoFace(format!(
+                MatchError::Landmarks(format!(
                     "the {name} is outside the crop of {radius_mm} mm around the nose tip"
                 ))
             })?;

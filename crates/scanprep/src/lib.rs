@@ -38,7 +38,7 @@ pub use grid::{
 };
 pub use mesh::{
     close_mesh_gaps, compact, crop_sphere, fill_mesh_holes, incidence_mask, remove_mesh_spikes,
-    remove_small_components, taubin_smooth,
+    remove_small_components, surviving_vertices, taubin_smooth,
 };
 pub use remesh::{remesh, MAX_SUBDIVISIONS};
 
@@ -567,24 +567,12 @@ impl Uncropped {
     }
 }
 
-/// Keeps the grid sample of each vertex that survives a step that only drops vertices (the
-/// rest keep their order; positions are matched to be safe). Forgets the index when a vertex
-/// cannot be matched.
+/// Keeps the grid sample of each vertex that survives a step that only drops vertices
+/// ([`surviving_vertices`]). Forgets the index when a vertex cannot be matched.
 fn track_grid_index(grid_index: &mut Option<Vec<u32>>, before: &TriMesh, after: &TriMesh) {
     if let Some(gi) = grid_index.take() {
-        let mut out = Vec::with_capacity(after.n_vertices());
-        let mut k = 0usize;
-        for p in after.positions() {
-            while k < before.n_vertices() && before.positions()[k] != *p {
-                k += 1;
-            }
-            if k == before.n_vertices() {
-                return;
-            }
-            out.push(gi[k]);
-            k += 1;
-        }
-        *grid_index = Some(out);
+        *grid_index = surviving_vertices(before, after)
+            .map(|kept| kept.iter().map(|&k| gi[k as usize]).collect());
     }
 }
 

@@ -344,6 +344,25 @@ fn clip_ears(
     true
 }
 
+/// For each vertex of `after`, a mesh made from `before` by steps that only drop vertices
+/// and keep the rest in order ([`crop_sphere`], [`remove_small_components`]), its index in
+/// `before` (positions matched bit for bit); `None` when `after` is not such a subset.
+pub fn surviving_vertices(before: &TriMesh, after: &TriMesh) -> Option<Vec<u32>> {
+    let mut out = Vec::with_capacity(after.n_vertices());
+    let mut k = 0usize;
+    for p in after.positions() {
+        while k < before.n_vertices() && before.positions()[k] != *p {
+            k += 1;
+        }
+        if k == before.n_vertices() {
+            return None;
+        }
+        out.push(k as u32);
+        k += 1;
+    }
+    Some(out)
+}
+
 /// Keeps the faces whose three vertices lie within `radius` of `centre` (then drops unused
 /// vertices). Returns the mesh and the number of vertices removed; an error when nothing is
 /// left or the centre or radius is not finite.

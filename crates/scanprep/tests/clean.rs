@@ -7,8 +7,8 @@ use meshcore::{shapes, DVec3, TriMesh};
 use rangescan::{scan, Artifacts, HeadPose, ScanOptions, Spikes};
 use scanprep::{
     check_grid, clean, clean_uncropped, close_mesh_gaps, crop_sphere, decimate, fill_grid_holes,
-    fill_mesh_holes, incidence_mask, remove_grid_spikes, remove_mesh_spikes, CleanOptions, Crop,
-    Input, ScanPrepError, SpikeOptions,
+    fill_mesh_holes, incidence_mask, remove_grid_spikes, remove_mesh_spikes, surviving_vertices,
+    CleanOptions, Crop, Input, ScanPrepError, SpikeOptions,
 };
 
 /// The plane z = 5 over [0, 60]^2 mm.
@@ -401,6 +401,20 @@ fn the_crop_radius_is_honoured() {
     for (k, &s) in gi.iter().enumerate() {
         assert_eq!(g.xyz[s as usize], c.mesh.positions()[k]);
     }
+    // The crop keeps the surviving vertices in order: each is found in the uncropped mesh,
+    // and a mesh with a moved vertex is not a subset.
+    let (cut, removed) = crop_sphere(&full, full.positions()[full.n_vertices() / 2], 5.0).unwrap();
+    assert!(removed > 0);
+    let kept = surviving_vertices(&full, &cut).unwrap();
+    assert_eq!(kept.len(), cut.n_vertices());
+    assert!(kept.windows(2).all(|k| k[0] < k[1]));
+    for (p, &k) in cut.positions().iter().zip(&kept) {
+        assert_eq!(full.positions()[k as usize], *p);
+    }
+    let mut moved = cut.positions().to_vec();
+    moved[0].x += 1e-3;
+    let moved = TriMesh::new(moved, cut.triangles().to_vec()).unwrap();
+    assert_eq!(surviving_vertices(&full, &moved), None);
     // Crop a bare mesh; nothing inside is an error.
     assert!(matches!(
         crop_sphere(&full, DVec3::splat(1e4), 1.0),
