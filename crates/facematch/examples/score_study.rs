@@ -17,15 +17,28 @@ use rayon::prelude::*;
 use std::io::Write;
 use std::path::Path;
 
+/// The template's turned views, by column label and turn (degrees).
+const TURNS: [(&str, f64); 8] = [
+    ("m15", -15.0),
+    ("p15", 15.0),
+    ("m25", -25.0),
+    ("p25", 25.0),
+    ("m35", -35.0),
+    ("p35", 35.0),
+    ("m45", -45.0),
+    ("p45", 45.0),
+];
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
-    let me = std::path::PathBuf::from(args.next().ok_or("usage")?);
-    let out = std::path::PathBuf::from(args.next().ok_or("usage")?);
+    let usage = "usage: score_study MATCH_EVAL_DIR OUT_DIR [--no-probe-views]";
+    let me = std::path::PathBuf::from(args.next().ok_or(usage)?);
+    let out = std::path::PathBuf::from(args.next().ok_or(usage)?);
     std::fs::create_dir_all(&out)?;
     // The turns the study compares (the default ones).
     let mut options = MatchOptions::default();
     if let Some(v) = &mut options.view {
-        v.yaws_deg = vec![15.0, 25.0, 35.0, 45.0];
+        v.yaws_deg = TURNS.iter().map(|t| t.1).filter(|y| *y > 0.0).collect();
     }
     // `--no-probe-views`: the probes' templates without views (no reverse comparison).
     let probe_views = args.next().as_deref() != Some("--no-probe-views");
@@ -39,12 +52,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         csv,
         "set,gallery,probe,template,score,view,rev_score,angle_own"
     )?;
-    for v in ["m15", "p15", "m25", "p25", "m35", "p35", "m45", "p45"] {
+    for (v, _) in TURNS {
         write!(csv, ",off_{v}")?;
     }
-    for v in [
-        "own", "m15", "p15", "m25", "p25", "m35", "p35", "m45", "p45",
-    ] {
+    for v in std::iter::once("own").chain(TURNS.map(|t| t.0)) {
         for p in ["c", "r", "l"] {
             write!(csv, ",{v}_{p}")?;
         }
@@ -124,9 +135,12 @@ fn row(set: &str, probe: &str, p: &Template, t: &Template, o: &MatchOptions) -> 
     );
     let ang = |d: DVec3| toward.map_or(f64::NAN, |w| w.angle_between(d).to_degrees());
     s.push_str(&format!(",{}", ang(t.description.scanner)));
-    for yaw in [-15.0, 15.0, -25.0, 25.0, -35.0, 35.0, -45.0, 45.0] {
-        let v = t.views.iter().find(|v| v.yaw_deg == yaw);
-        s.push_str(&format!(",{}", v.map_or(f64::NAN, |v| ang(v.toward))));
+    let view = |yaw: f64| t.views.iter().find(|v| v.yaw_deg == yaw);
+    for (_, yaw) in TURNS {
+        s.push_str(&format!(
+            ",{}",
+            view(yaw).map_or(f64::NAN, |v| ang(v.toward))
+        ));
     }
     let mut plain = o.clone();
     plain.view = None;
@@ -136,9 +150,8 @@ fn row(set: &str, probe: &str, p: &Template, t: &Template, o: &MatchOptions) -> 
     for u in d.pairs {
         s.push_str(&format!(",{}", u.distance));
     }
-    for yaw in [-15.0, 15.0, -25.0, 25.0, -35.0, 35.0, -45.0, 45.0] {
-        let v = t.views.iter().find(|v| v.yaw_deg == yaw);
-        match v.map(|v| &v.sets) {
+    for (_, yaw) in TURNS {
+        match view(yaw).map(|v| &v.sets) {
             Some(Ok(sets)) => {
                 let mut tv = own.clone();
                 tv.description.sets = sets.clone();
