@@ -333,7 +333,7 @@ fn describe_fields(
     // unreachable (+inf, faces skipped).
     let band = opts
         .boundary_margin
-        .map(|m| band(mesh, topo, m))
+        .map(|m| band(mesh, topo, m, None))
         .transpose()?;
     let keep = |v: usize| {
         opts.vertex_mask.as_ref().is_none_or(|m| m[v]) && band.as_ref().is_none_or(|b| !b[v])
@@ -450,7 +450,32 @@ pub(crate) fn check_field(field: usize, values: &[f64], n: usize) -> Result<(), 
 /// `2 * margin` (pinholes) get no band. All `false` on a closed surface.
 pub fn boundary_band(surface: &Surface, margin: f64) -> Result<Vec<bool>, BipolarError> {
     check_margin(margin)?;
-    band(surface.mesh(), surface.topology(), margin)
+    band(surface.mesh(), surface.topology(), margin, None)
+}
+
+/// [`boundary_band`] solved by `exact`, an exact solver of the surface's mesh that the caller
+/// already has (one preparation fewer; the band is the same). An error when `exact` is not an
+/// exact solver or is of a mesh with another number of vertices.
+pub fn boundary_band_with(
+    surface: &Surface,
+    exact: &dyn GeodesicSolver,
+    margin: f64,
+) -> Result<Vec<bool>, BipolarError> {
+    check_margin(margin)?;
+    if exact.method() != geodesic::Method::Exact {
+        return Err(BipolarError::InvalidOption(format!(
+            "the boundary band needs an exact solver, not {:?}",
+            exact.method()
+        )));
+    }
+    if exact.n_vertices() != surface.mesh().n_vertices() {
+        return Err(BipolarError::InvalidOption(format!(
+            "a solver of {} vertices for a surface of {}",
+            exact.n_vertices(),
+            surface.mesh().n_vertices()
+        )));
+    }
+    band(surface.mesh(), surface.topology(), margin, Some(exact))
 }
 
 fn check_margin(margin: f64) -> Result<(), BipolarError> {
@@ -463,7 +488,12 @@ fn check_margin(margin: f64) -> Result<(), BipolarError> {
     }
 }
 
-fn band(mesh: &TriMesh, topo: &Topology, margin: f64) -> Result<Vec<bool>, BipolarError> {
+fn band(
+    mesh: &TriMesh,
+    topo: &Topology,
+    margin: f64,
+    exact: Option<&dyn GeodesicSolver>,
+) -> Result<Vec<bool>, BipolarError> {
     let n = mesh.n_vertices();
     if margin == 0.0 {
         return Ok(vec![false; n]);
@@ -481,7 +511,14 @@ fn band(mesh: &TriMesh, topo: &Topology, margin: f64) -> Result<Vec<bool>, Bipol
     if sources.is_empty() {
         return Ok(vec![false; n]);
     }
-    let solver = geodesic::new_solver(mesh, geodesic::Method::Exact)?;
+    let own;
+    let solver = match exact {
+        Some(s) => s,
+        None => {
+            own = geodesic::new_solver(mesh, geodesic::Method::Exact)?;
+            own.as_ref()
+        }
+    };
     let u = solver.distances(
         &sources,
         &SolveOptions {

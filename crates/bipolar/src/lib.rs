@@ -36,7 +36,7 @@ mod search;
 pub mod synthetic;
 mod types;
 
-pub use build::{boundary_band, describe, solve_fields, Fields};
+pub use build::{boundary_band, boundary_band_with, describe, solve_fields, Fields};
 pub use error::BipolarError;
 pub use geodesic::Source;
 pub use key::Key;

@@ -5,8 +5,8 @@
 
 use bipolar::synthetic::{grid_plane, icosphere};
 use bipolar::{
-    boundary_band, describe, BipolarError, Descriptor, DescriptorOptions, Fields, LevelSpec,
-    SelectionRule, Source,
+    boundary_band, boundary_band_with, describe, BipolarError, Descriptor, DescriptorOptions,
+    Fields, LevelSpec, SelectionRule, Source,
 };
 use glam::{DAffine3, DQuat, DVec3};
 use meshcore::{Surface, Topology, TriMesh};
@@ -220,6 +220,19 @@ fn pinholes_shorter_than_twice_the_margin_get_no_band() {
     // A margin below half the perimeter bands the pinhole too.
     let small = boundary_band(&surface, 0.4 * p).unwrap();
     assert!(pinhole.iter().all(|&v| small[v as usize]));
+    // The caller's exact solver gives the same bands; another method or mesh is refused.
+    let exact = geodesic::new_solver(&mesh, geodesic::Method::Exact).unwrap();
+    for m in [0.25, 0.4 * p] {
+        let with = boundary_band_with(&surface, exact.as_ref(), m).unwrap();
+        assert_eq!(with, boundary_band(&surface, m).unwrap(), "margin {m}");
+    }
+    let fmm = geodesic::new_solver(&mesh, geodesic::Method::Fmm).unwrap();
+    assert!(boundary_band_with(&surface, fmm.as_ref(), 0.25).is_err());
+    let (other, _) = holed_plane();
+    if other.n_vertices() != mesh.n_vertices() {
+        let e = geodesic::new_solver(&other, geodesic::Method::Exact).unwrap();
+        assert!(boundary_band_with(&surface, e.as_ref(), 0.25).is_err());
+    }
 }
 
 #[test]

@@ -133,19 +133,26 @@ fn static_descriptor(
 }
 
 /// The vertices the descriptors of `surface` may use: those of `seen` (all without it) outside
-/// the band of `margin` along the boundary ([`bipolar::boundary_band`]). For many descriptors
-/// of one surface, pass this as their vertex mask with no `boundary_margin`:
+/// the band of `margin` along the boundary ([`bipolar::boundary_band`], solved by `solver` when
+/// it is an exact solver of the surface's mesh, else by a new one). For many descriptors of
+/// one surface, pass this as their vertex mask with no `boundary_margin`:
 /// `DescriptorOptions::boundary_margin` builds the band again (an exact solve from the
 /// boundary) on every call, and the two leave out the same vertices.
 pub fn kept_vertices(
     surface: &Surface,
+    solver: Option<&dyn GeodesicSolver>,
     seen: Option<Vec<bool>>,
     margin: Option<f64>,
 ) -> Result<Option<Vec<bool>>, bipolar::BipolarError> {
     let Some(m) = margin else {
         return Ok(seen);
     };
-    let band = bipolar::boundary_band(surface, m)?;
+    let band = match solver {
+        Some(s) if s.method() == geodesic::Method::Exact => {
+            bipolar::boundary_band_with(surface, s, m)?
+        }
+        _ => bipolar::boundary_band(surface, m)?,
+    };
     Ok(Some(match seen {
         Some(s) => band.iter().zip(&s).map(|(&b, &s)| !b && s).collect(),
         None => band.iter().map(|&b| !b).collect(),
@@ -226,7 +233,7 @@ pub fn describe_with_fields(
         None => None,
     };
     let pair = Pair::for_probe(r, q, scanner, options.side_pair_deg, poles.lost);
-    let kept = kept_vertices(surface, seen, options.boundary_margin_mm)
+    let kept = kept_vertices(surface, Some(solver), seen, options.boundary_margin_mm)
         .map_err(|e| crate::MatchError::Describe(format!("boundary band: {e}")))?;
     let refs = Pair::ALL.map(|p| pair_refs(mesh, f, poles, p, frame));
     let sets = Pair::ALL.map(|p| {
@@ -427,15 +434,23 @@ pub(crate) mod tests {
         let (m, ..) = plane_face(20, 20, [(5, 10), (15, 10), (10, 5)]);
         let surface = Surface::new(m);
         let n = surface.mesh().n_vertices();
-        assert_eq!(kept_vertices(&surface, None, None).unwrap(), None);
-        let kept = kept_vertices(&surface, None, Some(5.0)).unwrap().unwrap();
+        assert_eq!(kept_vertices(&surface, None, None, None).unwrap(), None);
+        let kept = kept_vertices(&surface, None, None, Some(5.0))
+            .unwrap()
+            .unwrap();
         let at = |i: usize, j: usize| kept[j * 21 + i];
         assert!(!at(0, 10) && !at(2, 10) && at(3, 10) && at(10, 10) && !at(20, 20));
+        // The caller's exact solver gives the same band; another method is not used for it.
+        for method in [geodesic::Method::Exact, geodesic::Method::Fmm] {
+            let s = geodesic::new_solver(surface.mesh(), method).unwrap();
+            let by = kept_vertices(&surface, Some(s.as_ref()), None, Some(5.0)).unwrap();
+            assert_eq!(by.as_deref(), Some(&kept[..]), "{method:?}");
+        }
         // The seen mask is kept as it is without a margin and joined with the band's.
         let seen: Vec<bool> = (0..n).map(|v| v % 2 == 0).collect();
-        let only_seen = kept_vertices(&surface, Some(seen.clone()), None).unwrap();
+        let only_seen = kept_vertices(&surface, None, Some(seen.clone()), None).unwrap();
         assert_eq!(only_seen.as_deref(), Some(&seen[..]));
-        let both = kept_vertices(&surface, Some(seen.clone()), Some(5.0))
+        let both = kept_vertices(&surface, None, Some(seen.clone()), Some(5.0))
             .unwrap()
             .unwrap();
         assert!((0..n).all(|v| both[v] == (kept[v] && seen[v])));

@@ -12,12 +12,15 @@ pub fn seen_within(
     toward: Option<DVec3>,
     max_incidence_deg: f64,
 ) -> Result<Vec<bool>, scanprep::ScanPrepError> {
-    let own = scanprep::incidence_mask(mesh, scanner, max_incidence_deg)?;
-    Ok(match toward {
-        Some(t) => {
-            let other = scanprep::incidence_mask(mesh, t, max_incidence_deg)?;
-            own.iter().zip(&other).map(|(a, b)| *a && *b).collect()
-        }
+    // One set of smoothed normals for both directions.
+    let mut masks = match toward {
+        Some(t) => scanprep::incidence_masks(mesh, &[scanner, t], max_incidence_deg)?,
+        None => scanprep::incidence_masks(mesh, &[scanner], max_incidence_deg)?,
+    }
+    .into_iter();
+    let own = masks.next().unwrap_or_default();
+    Ok(match masks.next() {
+        Some(other) => own.iter().zip(&other).map(|(a, b)| *a && *b).collect(),
         None => own,
     })
 }

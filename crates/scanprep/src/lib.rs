@@ -37,8 +37,8 @@ pub use grid::{
     SpikeOptions, MAX_COORDINATE_MM,
 };
 pub use mesh::{
-    close_mesh_gaps, compact, crop_sphere, fill_mesh_holes, incidence_mask, remove_mesh_spikes,
-    remove_small_components, surviving_vertices, taubin_smooth,
+    close_mesh_gaps, compact, crop_sphere, fill_mesh_holes, incidence_mask, incidence_masks,
+    remove_mesh_spikes, remove_small_components, surviving_vertices, taubin_smooth,
 };
 pub use remesh::{remesh, MAX_SUBDIVISIONS};
 

@@ -440,11 +440,27 @@ pub fn incidence_mask(
     toward_scanner: DVec3,
     max_incidence_deg: f64,
 ) -> Result<Vec<bool>, ScanPrepError> {
-    let d = toward_scanner.normalize_or_zero();
-    if !(d.is_finite() && d != DVec3::ZERO) {
-        return Err(ScanPrepError::InvalidOption(format!(
-            "scanner direction {toward_scanner:?} (expected a finite, non-zero vector)"
-        )));
+    let mut masks = incidence_masks(mesh, &[toward_scanner], max_incidence_deg)?;
+    Ok(masks.pop().unwrap_or_default())
+}
+
+/// [`incidence_mask`] for each of the directions `towards`, with the smoothed normals computed
+/// once: the masks are those of one call per direction. An error when a direction is zero or
+/// not finite, or the angle is not within [0, 180].
+pub fn incidence_masks(
+    mesh: &TriMesh,
+    towards: &[DVec3],
+    max_incidence_deg: f64,
+) -> Result<Vec<Vec<bool>>, ScanPrepError> {
+    let mut dirs = Vec::with_capacity(towards.len());
+    for t in towards {
+        let d = t.normalize_or_zero();
+        if !(d.is_finite() && d != DVec3::ZERO) {
+            return Err(ScanPrepError::InvalidOption(format!(
+                "scanner direction {t:?} (expected a finite, non-zero vector)"
+            )));
+        }
+        dirs.push(d);
     }
     if !(0.0..=180.0).contains(&max_incidence_deg) {
         return Err(ScanPrepError::InvalidOption(format!(
@@ -465,7 +481,12 @@ pub fn incidence_mask(
             .collect();
     }
     let c = max_incidence_deg.to_radians().cos();
-    Ok(n.iter()
-        .map(|n| *n != DVec3::ZERO && n.dot(d) >= c)
+    Ok(dirs
+        .iter()
+        .map(|d| {
+            n.iter()
+                .map(|n| *n != DVec3::ZERO && n.dot(*d) >= c)
+                .collect()
+        })
         .collect())
 }

@@ -7,8 +7,8 @@ use meshcore::{shapes, DVec3, TriMesh};
 use rangescan::{scan, Artifacts, HeadPose, ScanOptions, Spikes};
 use scanprep::{
     check_grid, clean, clean_uncropped, close_mesh_gaps, crop_sphere, decimate, fill_grid_holes,
-    fill_mesh_holes, incidence_mask, remove_grid_spikes, remove_mesh_spikes, surviving_vertices,
-    CleanOptions, Crop, Input, ScanPrepError, SpikeOptions,
+    fill_mesh_holes, incidence_mask, incidence_masks, remove_grid_spikes, remove_mesh_spikes,
+    surviving_vertices, CleanOptions, Crop, Input, ScanPrepError, SpikeOptions,
 };
 
 /// The plane z = 5 over [0, 60]^2 mm.
@@ -344,6 +344,26 @@ fn the_incidence_mask_follows_the_sphere() {
     assert!(incidence_mask(&m, DVec3::ZERO, 60.0).is_err());
     assert!(incidence_mask(&m, DVec3::Z, f64::NAN).is_err());
     assert!(incidence_mask(&m, DVec3::Z, 181.0).is_err());
+    // Several directions at once: each mask follows the sphere about its own direction.
+    let turned = DVec3::new(30f64.to_radians().sin(), 0.0, 30f64.to_radians().cos());
+    let masks = incidence_masks(&m, &[DVec3::Z, turned], 40.0).unwrap();
+    assert_eq!(masks[0], incidence_mask(&m, DVec3::Z, 40.0).unwrap());
+    let (mut inside, mut outside) = (0, 0);
+    for (p, &seen) in m.positions().iter().zip(&masks[1]) {
+        let incidence = (p.dot(turned) / p.length()).acos().to_degrees();
+        if incidence < 36.0 {
+            assert!(
+                seen,
+                "{incidence} degrees from the turned direction left out"
+            );
+            inside += 1;
+        } else if incidence > 44.0 {
+            assert!(!seen, "{incidence} degrees from the turned direction kept");
+            outside += 1;
+        }
+    }
+    assert!(inside > 1000 && outside > 1000, "{inside} {outside}");
+    assert!(incidence_masks(&m, &[DVec3::Z, DVec3::ZERO], 60.0).is_err());
 }
 
 #[test]
