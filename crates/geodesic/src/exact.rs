@@ -138,9 +138,35 @@ pub struct ExactGeodesic {
     vopp: Vec<u32>,
     pseudo: Vec<bool>,
     report: ExactMeshReport,
+    schedule: ExactSchedule,
+}
+
+/// How one exact solve orders its work ([`ExactGeodesic::with_schedule`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum ExactSchedule {
+    /// One vertex at a time, each followed by every list step it queues, on the calling thread.
+    #[default]
+    Serial,
+    /// Vertices taken in bands of up to 32, and the queued lists processed generation by
+    /// generation, each generation's list steps in parallel on the rayon pool the solve runs
+    /// in (the global one, or the pool of a `ThreadPool::install`). The field is the same bit
+    /// for bit for every number of threads; it is exact like the serial one but may differ
+    /// from it in the last bits (another processing order).
+    Banded,
 }
 
 impl ExactGeodesic {
+    /// The solver with another [`ExactSchedule`] (the default is [`ExactSchedule::Serial`]).
+    pub fn with_schedule(mut self, schedule: ExactSchedule) -> Self {
+        self.schedule = schedule;
+        self
+    }
+
+    /// The [`ExactSchedule`] of its solves.
+    pub fn schedule(&self) -> ExactSchedule {
+        self.schedule
+    }
+
     /// What was found and repaired when preparing the mesh.
     pub fn report(&self) -> &ExactMeshReport {
         &self.report
@@ -172,7 +198,10 @@ impl ExactGeodesic {
         let mut s = Solve::with_buffers(self, cut, false, std::mem::take(&mut ws.buf));
         let seeded = s.seed(sources);
         if seeded.is_ok() {
-            s.run();
+            match self.schedule {
+                ExactSchedule::Serial => s.run(),
+                ExactSchedule::Banded => s.run_banded(),
+            }
         }
         let props = s.propagations;
         let (d, buf) = s.finish_into();

@@ -30,7 +30,7 @@ pub mod straightest;
 
 pub use dijkstra::Dijkstra;
 pub use error::GeodesicError;
-pub use exact::{ExactGeodesic, ExactMeshReport, ExactWorkspace};
+pub use exact::{ExactGeodesic, ExactMeshReport, ExactSchedule, ExactWorkspace};
 #[doc(hidden)]
 pub use fmm::trace_curved_front;
 pub use fmm::{FastMarching, FmmUpdate};

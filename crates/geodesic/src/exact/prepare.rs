@@ -152,6 +152,7 @@ impl ExactGeodesic {
             vopp,
             pseudo,
             report,
+            schedule: ExactSchedule::Serial,
         })
     }
 }

@@ -6,6 +6,7 @@ use super::*;
 use crate::solver::Item;
 use std::cmp::Ordering;
 use std::collections::{BinaryHeap, VecDeque};
+use std::sync::Mutex;
 
 /// How a vertex got its current distance (recorded for path tracing).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -75,7 +76,6 @@ pub(crate) struct Solve<'a> {
     pub(crate) d: Vec<f64>,
     /// The per-solve arrays, reusable by the next solve ([`Solve::finish_into`]).
     b: Buffers,
-    bound_stats: BoundStats,
     draining: bool,
     /// Pairwise trim and apex split enabled (off only in the differential tests' oracle mode,
     /// which keeps just the vertex filter).
@@ -111,13 +111,12 @@ pub(crate) struct Buffers {
     heap: BinaryHeap<Item>,
     pool: Vec<Vec<Window>>,
     pending_emit: Vec<u32>,
-    tc_buf: Vec<f64>,
-    /// The children of the list being processed, for its left and right target list (appended
-    /// to those lists in one step each).
-    kids: [Vec<Window>; 2],
-    /// Scratch of [`sort_by_start`]: run boundaries and the merged copy of a long list.
-    runs: Vec<u32>,
-    merged: Vec<Window>,
+    /// Scratch of the list steps run on this thread.
+    step: StepScratch,
+    /// Scratch of the list steps run by rayon workers ([`Solve::run_banded`]).
+    spare: Mutex<Vec<StepScratch>>,
+    /// The lists of one generation of [`Solve::run_banded`].
+    batch: Vec<BatchItem>,
 }
 
 impl Buffers {
@@ -156,8 +155,35 @@ impl Buffers {
         self.fifo.clear();
         self.heap.clear();
         self.pending_emit.clear();
-        self.tc_buf.clear();
-        self.kids.iter_mut().for_each(Vec::clear);
+        self.step.kids.iter_mut().for_each(Vec::clear);
+        self.step.bound_stats = BoundStats::default();
+        self.batch.clear();
+    }
+}
+
+impl Buffers {
+    /// The window list of half-edge `h`, given a slot if it has none; with `pooled`, an
+    /// unallocated list takes an emptied one from the pool.
+    #[inline]
+    fn list_of(&mut self, h: u32, pooled: bool) -> &mut Vec<Window> {
+        let mut i = self.slot[h as usize];
+        if i == 0 {
+            i = match self.free.pop() {
+                Some(i) => i,
+                None => {
+                    self.held.push(Vec::new());
+                    self.held.len() as u32
+                }
+            };
+            self.slot[h as usize] = i;
+        }
+        let list = &mut self.held[i as usize - 1];
+        if pooled && list.capacity() == 0 {
+            if let Some(v) = self.pool.pop() {
+                *list = v;
+            }
+        }
+        list
     }
 }
 
@@ -183,7 +209,6 @@ impl<'a> Solve<'a> {
             cut,
             d: vec![f64::INFINITY; n],
             b: buf,
-            bound_stats: BoundStats::default(),
             draining: false,
             prune: true,
             propagations: 0,
@@ -335,25 +360,27 @@ impl<'a> Solve<'a> {
     /// end vertices is inside (or while draining).
     #[inline]
     fn append(&mut self, h: u32, ws: &[Window]) {
-        let b = &mut self.b;
-        let mut i = b.slot[h as usize];
-        if i == 0 {
-            i = match b.free.pop() {
-                Some(i) => i,
-                None => {
-                    b.held.push(Vec::new());
-                    b.held.len() as u32
-                }
-            };
-            b.slot[h as usize] = i;
+        self.b.list_of(h, true).extend_from_slice(ws);
+        self.filled(h);
+    }
+
+    /// [`Solve::append`] of the windows of `ws`, which it leaves empty: moved into the list
+    /// of `h` without a copy when that list is empty.
+    fn append_vec(&mut self, h: u32, ws: &mut Vec<Window>) {
+        let list = self.b.list_of(h, false);
+        if list.is_empty() {
+            std::mem::swap(list, ws);
+        } else {
+            list.extend_from_slice(ws);
         }
-        let list = &mut b.held[i as usize - 1];
-        if list.capacity() == 0 {
-            if let Some(v) = b.pool.pop() {
-                *list = v;
-            }
-        }
-        list.extend_from_slice(ws);
+        ws.clear();
+        self.filled(h);
+    }
+
+    /// Marks the list of `h` filled and queues it if one of its end vertices is inside (or
+    /// while draining).
+    #[inline]
+    fn filled(&mut self, h: u32) {
         let f = &mut self.b.flags[h as usize];
         *f |= FILLED;
         if *f & QUEUED == 0 {
@@ -464,23 +491,25 @@ impl<'a> Solve<'a> {
                 popped = true;
                 break;
             }
-            if popped {
-                continue;
-            }
-            // Heap exhausted (or beyond the cut-off): drain every list still holding windows.
-            self.draining = true;
-            let mut any = false;
-            for (h, f) in self.b.flags.iter_mut().enumerate() {
-                if *f == FILLED {
-                    *f = FILLED | QUEUED;
-                    self.b.fifo.push_back(h as u32);
-                    any = true;
-                }
-            }
-            if !any {
+            if !popped && !self.queue_for_drain() {
                 break;
             }
         }
+    }
+
+    /// Heap exhausted (or beyond the cut-off): switches to draining and queues every list
+    /// still holding windows; false when there is none.
+    fn queue_for_drain(&mut self) -> bool {
+        self.draining = true;
+        let mut any = false;
+        for (h, f) in self.b.flags.iter_mut().enumerate() {
+            if *f == FILLED {
+                *f = FILLED | QUEUED;
+                self.b.fifo.push_back(h as u32);
+                any = true;
+            }
+        }
+        any
     }
 
     #[cfg(test)]
@@ -500,132 +529,146 @@ impl<'a> Solve<'a> {
         (self.d, self.b)
     }
 
-    /// The triangle step: filters the list of `h` and pushes its windows across face(h).
-    fn process(&mut self, h: u32) {
+    /// Takes the window list of `h` out of its slot (clearing the slot and the filled flag);
+    /// `None` when the half-edge holds no windows.
+    fn take_list(&mut self, h: u32) -> Option<Vec<Window>> {
         let i = std::mem::take(&mut self.b.slot[h as usize]);
         self.b.flags[h as usize] &= !FILLED;
         if i == 0 {
-            return;
+            return None;
         }
         self.b.free.push(i);
-        let mut ws = std::mem::take(&mut self.b.held[i as usize - 1]);
+        let ws = std::mem::take(&mut self.b.held[i as usize - 1]);
         if ws.is_empty() {
+            return None;
+        }
+        Some(ws)
+    }
+
+    /// The triangle step: filters the list of `h` and pushes its windows across face(h).
+    fn process(&mut self, h: u32) {
+        let Some(mut ws) = self.take_list(h) else {
             return;
-        }
-        let g = self.g;
-        let geo = g.geom[h as usize];
-        let (a, b, c) = (g.tail(h), g.head(h), g.apex(h));
-        let (da, db) = (self.d[a as usize], self.d[b as usize]);
-        let l = geo.l;
-        // P0: vertex filter.
-        ws.retain(|w| {
-            !(vertex_beats(da + w.b1, w, w.b1) || vertex_beats(db + (l - w.b0), w, w.b0))
-        });
-        // P1: sorted lower-envelope trim (dead windows are skipped below, not removed).
-        let mut alive = ws.len();
-        if self.prune && ws.len() > 1 {
-            sort_by_start(&mut ws, &mut self.b.runs, &mut self.b.merged);
-            let mut cur = 0;
-            for j in 1..ws.len() {
-                let (lo, hi) = ws.split_at_mut(j);
-                match pair_trim(&mut lo[cur], &mut hi[0], &mut self.bound_stats) {
-                    Trim::FirstDead => {
-                        cur = j;
-                        alive -= 1;
-                    }
-                    Trim::SecondDead => alive -= 1,
-                    Trim::Both => {
-                        if hi[0].b1 > lo[cur].b1 {
-                            cur = j;
-                        }
-                    }
-                }
-            }
-        }
-        if alive == 0 {
-            self.recycle(ws);
-            return;
-        }
-        // P2: best window for the apex and the split point.
-        let geo = geo.frame();
-        let (cx, cy) = (geo.cx, geo.cy);
-        let mut tcs = std::mem::take(&mut self.b.tc_buf);
-        tcs.clear();
-        let mut best = f64::INFINITY;
-        let mut p_star = 0.0;
-        let mut best_id = u32::MAX;
-        let mut best_sigma = f64::INFINITY;
-        for w in &ws {
-            let tc = w.sx + (-w.sy) * (cx - w.sx) / (cy - w.sy);
-            tcs.push(tc);
-            if w.is_dead() {
-                continue;
-            }
-            let t = tc.clamp(w.b0, w.b1);
-            let dc = if t == tc {
-                w.sigma + ((cx - w.sx) * (cx - w.sx) + (cy - w.sy) * (cy - w.sy)).sqrt()
-            } else {
-                w.dist(t) + ((cx - t) * (cx - t) + cy * cy).sqrt()
-            };
-            if dc < best || (dc == best && w.sigma < best_sigma) {
-                best = dc;
-                p_star = t;
-                best_id = w.id;
-                best_sigma = w.sigma;
-            }
-        }
-        if best < self.d[c as usize] {
-            self.relax(c, best, Pred::Window(best_id, p_star));
-        }
-        // P3: split rule and propagation.
-        if !self.prune {
-            // Oracle mode: every ray goes to the side it actually exits through.
-            p_star = f64::NAN;
-        }
-        // The children are collected per target list and appended in one step each, the list
-        // that received the first child first (the order of single pushes).
-        let tl_tw = g.twin[prev(h) as usize];
-        let tr_tw = g.twin[next(h) as usize];
-        let mut right_first = None;
-        for (i, w) in ws.iter().enumerate() {
-            if w.is_dead() {
-                continue;
-            }
-            let tc = tcs[i];
-            if tl_tw != NONE {
-                let tl = w.b1.min(tc).min(if p_star.is_nan() { tc } else { p_star });
-                if tl > w.b0 {
-                    self.emit_left(&geo, tl_tw, w, w.b0, tl, tl == tc);
-                }
-            }
-            if tr_tw != NONE {
-                let tr = w.b0.max(tc).max(if p_star.is_nan() { tc } else { p_star });
-                if tr < w.b1 {
-                    self.emit_right(&geo, tr_tw, w, tr, w.b1, tr == tc);
-                }
-            }
-            if right_first.is_none() {
-                let [l, r] = &self.b.kids;
-                if !(l.is_empty() && r.is_empty()) {
-                    right_first = Some(l.is_empty());
-                }
-            }
-        }
-        let order = if right_first == Some(true) {
-            [(1, tr_tw), (0, tl_tw)]
-        } else {
-            [(0, tl_tw), (1, tr_tw)]
         };
-        let mut kids = std::mem::take(&mut self.b.kids);
-        for (side, tw) in order {
-            if !kids[side].is_empty() {
-                self.append(tw & IDX, &kids[side]);
-                kids[side].clear();
+        let mut sc = std::mem::take(&mut self.b.step);
+        let out = list_step(self.g, &self.d, self.cut, self.prune, h, &mut ws, &mut sc);
+        self.recycle(ws);
+        if let Some(out) = out {
+            self.apply(&out, &mut sc.kids, false);
+        }
+        self.b.step = sc;
+    }
+
+    /// Applies what a list step found: relaxes its apex, then appends its children to their
+    /// lists (recording them first in path-tracing mode) and empties `kids` (`moved`: a child
+    /// buffer may be moved into an empty list and replaced by that list's buffer).
+    fn apply(&mut self, out: &StepOut, kids: &mut [Vec<Window>; 2], moved: bool) {
+        if out.best < self.d[out.apex as usize] {
+            self.relax(out.apex, out.best, Pred::Window(out.best_id, out.p_star));
+        }
+        for (side, tw) in out.order {
+            let ks = &mut kids[side];
+            if ks.is_empty() {
+                continue;
+            }
+            self.propagations += ks.len() as u64;
+            if self.records.is_some() {
+                for k in ks.iter_mut() {
+                    let parent = k.id;
+                    self.record(tw & IDX, k, Origin::Window(parent));
+                }
+            }
+            if moved {
+                self.append_vec(tw & IDX, ks);
+            } else {
+                self.append(tw & IDX, ks);
+                ks.clear();
             }
         }
-        self.b.kids = kids;
-        self.b.tc_buf = tcs;
-        self.recycle(ws);
+    }
+
+    /// The banded schedule of [`ExactSchedule::Banded`]: vertices are popped [`BAND`] at a
+    /// time, and the queued lists are processed generation by generation, each generation's
+    /// list steps in parallel on the current rayon pool against the distances as they were
+    /// when the generation began, and then applied in queue order. A list step reads nothing
+    /// its generation writes, so the field does not depend on the number of threads.
+    pub(crate) fn run_banded(&mut self) {
+        loop {
+            if let Some(v) = self.b.pending_emit.pop() {
+                self.emit_from_vertex(v);
+                continue;
+            }
+            if !self.b.fifo.is_empty() {
+                self.generation();
+                continue;
+            }
+            let mut popped = 0;
+            while let Some(&Item(dv, v)) = self.b.heap.peek() {
+                if dv != self.d[v as usize] || self.b.state[v as usize] == INSIDE {
+                    self.b.heap.pop();
+                    continue;
+                }
+                if dv > self.cut || popped == BAND {
+                    break;
+                }
+                self.b.heap.pop();
+                self.pop_vertex(v);
+                popped += 1;
+            }
+            if popped == 0 && !self.queue_for_drain() {
+                break;
+            }
+        }
+    }
+
+    /// Processes every queued list (one generation) as described in [`Solve::run_banded`].
+    fn generation(&mut self) {
+        use rayon::prelude::*;
+        let mut items = std::mem::take(&mut self.b.batch);
+        while let Some(h) = self.b.fifo.pop_front() {
+            self.b.flags[h as usize] &= !QUEUED;
+            if let Some(ws) = self.take_list(h) {
+                let kids = [self.pooled(), self.pooled()];
+                items.push(BatchItem {
+                    h,
+                    ws,
+                    kids,
+                    out: None,
+                });
+            }
+        }
+        let (g, d, cut, prune) = (self.g, &self.d, self.cut, self.prune);
+        let run = |sc: &mut StepScratch, it: &mut BatchItem| {
+            std::mem::swap(&mut sc.kids, &mut it.kids);
+            it.out = list_step(g, d, cut, prune, it.h, &mut it.ws, sc);
+            std::mem::swap(&mut sc.kids, &mut it.kids);
+        };
+        if items.len() < PARALLEL_MIN || rayon::current_num_threads() < 2 {
+            let mut sc = std::mem::take(&mut self.b.step);
+            items.iter_mut().for_each(|it| run(&mut sc, it));
+            self.b.step = sc;
+        } else {
+            let spare = &self.b.spare;
+            items
+                .par_iter_mut()
+                .with_min_len(2)
+                .for_each_init(|| Lease::new(spare), |l, it| run(&mut l.sc, it));
+        }
+        for mut it in items.drain(..) {
+            if let Some(out) = it.out {
+                self.apply(&out, &mut it.kids, true);
+            }
+            self.recycle(it.ws);
+            let [k0, k1] = it.kids;
+            self.recycle(k0);
+            self.recycle(k1);
+        }
+        self.b.batch = items;
+    }
+
+    /// An empty window list from the pool (or a new one).
+    fn pooled(&mut self) -> Vec<Window> {
+        self.b.pool.pop().unwrap_or_default()
     }
 
     fn recycle(&mut self, mut ws: Vec<Window>) {
@@ -634,7 +677,197 @@ impl<'a> Solve<'a> {
             self.b.pool.push(ws);
         }
     }
+}
 
+/// Most vertices [`Solve::run_banded`] pops before processing the lists they queue.
+pub(crate) const BAND: usize = 32;
+/// Fewest list steps of a generation that [`Solve::run_banded`] hands to rayon.
+const PARALLEL_MIN: usize = 4;
+
+/// One queued list of a generation of the banded schedule: its windows, the children its step
+/// emits and what else the step found.
+#[derive(Debug)]
+pub(crate) struct BatchItem {
+    h: u32,
+    ws: Vec<Window>,
+    kids: [Vec<Window>; 2],
+    out: Option<StepOut>,
+}
+
+/// A [`StepScratch`] taken from the spare ones for one rayon job and given back when dropped.
+struct Lease<'a> {
+    spare: &'a Mutex<Vec<StepScratch>>,
+    sc: StepScratch,
+}
+
+impl<'a> Lease<'a> {
+    fn new(spare: &'a Mutex<Vec<StepScratch>>) -> Self {
+        let sc = spare
+            .lock()
+            .ok()
+            .and_then(|mut v| v.pop())
+            .unwrap_or_default();
+        Self { spare, sc }
+    }
+}
+
+impl Drop for Lease<'_> {
+    fn drop(&mut self) {
+        if let Ok(mut v) = self.spare.lock() {
+            v.push(std::mem::take(&mut self.sc));
+        }
+    }
+}
+
+/// Scratch buffers of one list step: the rays' apex crossings, the sort's runs and merged
+/// copy, the children for the left and right target list, the trim's shortcut counters
+/// (which change only the speed) and the cut-off of the step's solve.
+#[derive(Debug, Default)]
+pub(crate) struct StepScratch {
+    tcs: Vec<f64>,
+    runs: Vec<u32>,
+    merged: Vec<Window>,
+    kids: [Vec<Window>; 2],
+    bound_stats: BoundStats,
+    /// The solve's cut-off (children beyond it are not emitted).
+    cut: f64,
+}
+
+/// What a list step found besides its children: the apex, its best distance through the list
+/// with the window (record id) and edge point it came from, and the order in which the
+/// children's two target lists (side 0 left, 1 right, with their half-edges) are appended.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct StepOut {
+    apex: u32,
+    best: f64,
+    best_id: u32,
+    p_star: f64,
+    order: [(usize, u32); 2],
+}
+
+/// The triangle step on the windows `ws` of half-edge `h` against the vertex distances `d`:
+/// the vertex filter, the sorted pairwise trim, the apex's best window and split point, and the
+/// children, written into `sc.kids` (each child's `id` is its parent's, for path tracing).
+/// Reads only its arguments, so list steps of one generation can run in parallel. `None`
+/// when no window survives (no children).
+fn list_step(
+    g: &ExactGeodesic,
+    d: &[f64],
+    cut: f64,
+    prune: bool,
+    h: u32,
+    ws: &mut Vec<Window>,
+    sc: &mut StepScratch,
+) -> Option<StepOut> {
+    sc.cut = cut;
+    let geo = g.geom[h as usize];
+    let (a, b, c) = (g.tail(h), g.head(h), g.apex(h));
+    let (da, db) = (d[a as usize], d[b as usize]);
+    let l = geo.l;
+    // P0: vertex filter.
+    ws.retain(|w| !(vertex_beats(da + w.b1, w, w.b1) || vertex_beats(db + (l - w.b0), w, w.b0)));
+    // P1: sorted lower-envelope trim (dead windows are skipped below, not removed).
+    let mut alive = ws.len();
+    if prune && ws.len() > 1 {
+        sort_by_start(ws, &mut sc.runs, &mut sc.merged);
+        let mut cur = 0;
+        for j in 1..ws.len() {
+            let (lo, hi) = ws.split_at_mut(j);
+            match pair_trim(&mut lo[cur], &mut hi[0], &mut sc.bound_stats) {
+                Trim::FirstDead => {
+                    cur = j;
+                    alive -= 1;
+                }
+                Trim::SecondDead => alive -= 1,
+                Trim::Both => {
+                    if hi[0].b1 > lo[cur].b1 {
+                        cur = j;
+                    }
+                }
+            }
+        }
+    }
+    if alive == 0 {
+        return None;
+    }
+    // P2: best window for the apex and the split point.
+    let geo = geo.frame();
+    let (cx, cy) = (geo.cx, geo.cy);
+    let tcs = &mut sc.tcs;
+    tcs.clear();
+    let mut best = f64::INFINITY;
+    let mut p_star = 0.0;
+    let mut best_id = u32::MAX;
+    let mut best_sigma = f64::INFINITY;
+    for w in ws.iter() {
+        let tc = w.sx + (-w.sy) * (cx - w.sx) / (cy - w.sy);
+        tcs.push(tc);
+        if w.is_dead() {
+            continue;
+        }
+        let t = tc.clamp(w.b0, w.b1);
+        let dc = if t == tc {
+            w.sigma + ((cx - w.sx) * (cx - w.sx) + (cy - w.sy) * (cy - w.sy)).sqrt()
+        } else {
+            w.dist(t) + ((cx - t) * (cx - t) + cy * cy).sqrt()
+        };
+        if dc < best || (dc == best && w.sigma < best_sigma) {
+            best = dc;
+            p_star = t;
+            best_id = w.id;
+            best_sigma = w.sigma;
+        }
+    }
+    let out_p_star = p_star;
+    // P3: split rule and propagation.
+    if !prune {
+        // Oracle mode: every ray goes to the side it actually exits through.
+        p_star = f64::NAN;
+    }
+    // The children are collected per target list and appended in one step each, the list
+    // that received the first child first (the order of single pushes).
+    let tl_tw = g.twin[prev(h) as usize];
+    let tr_tw = g.twin[next(h) as usize];
+    let mut right_first = None;
+    for (i, w) in ws.iter().enumerate() {
+        if w.is_dead() {
+            continue;
+        }
+        let tc = sc.tcs[i];
+        if tl_tw != NONE {
+            let tl = w.b1.min(tc).min(if p_star.is_nan() { tc } else { p_star });
+            if tl > w.b0 {
+                sc.emit_left(&geo, tl_tw, w, w.b0, tl, tl == tc);
+            }
+        }
+        if tr_tw != NONE {
+            let tr = w.b0.max(tc).max(if p_star.is_nan() { tc } else { p_star });
+            if tr < w.b1 {
+                sc.emit_right(&geo, tr_tw, w, tr, w.b1, tr == tc);
+            }
+        }
+        if right_first.is_none() {
+            let [l, r] = &sc.kids;
+            if !(l.is_empty() && r.is_empty()) {
+                right_first = Some(l.is_empty());
+            }
+        }
+    }
+    let order = if right_first == Some(true) {
+        [(1, tr_tw), (0, tl_tw)]
+    } else {
+        [(0, tl_tw), (1, tr_tw)]
+    };
+    Some(StepOut {
+        apex: c,
+        best,
+        best_id,
+        p_star: out_p_star,
+        order,
+    })
+}
+
+impl StepScratch {
     /// Child on the left edge a -> c: frame origin a, x towards c.
     #[inline]
     fn emit_left(&mut self, geo: &Frame, tw: u32, w: &Window, t0: f64, t1: f64, apex_end: bool) {
@@ -690,20 +923,18 @@ impl<'a> Solve<'a> {
         } else {
             (x0, x1, sx)
         };
-        let mut child = Window {
+        let child = Window {
             b0,
             b1,
             sigma: w.sigma,
             sx,
             sy,
-            id: u32::MAX,
+            id: w.id,
         };
         if self.cut.is_finite() && child.min_dist() > self.cut {
             return;
         }
-        self.propagations += 1;
-        self.record(tw & IDX, &mut child, Origin::Window(w.id));
-        self.b.kids[side].push(child);
+        self.kids[side].push(child);
     }
 }
 
