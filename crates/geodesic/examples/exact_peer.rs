@@ -10,9 +10,11 @@
 //! that face (compare with libigl's `exact_geodesic` face sources); `0,17,40` are several
 //! sources at once. Prints one line per comparison (timings, propagations, peak RSS, the
 //! largest relative difference) and panics when a difference exceeds `EXACT_PEER_TOL`
-//! (default 1e-9); `EXACT_PEER_REPEAT` repeats each solve (medians printed).
+//! (default 1e-9); `EXACT_PEER_REPEAT` repeats each solve (medians printed);
+//! `EXACT_PEER_SCHEDULE=banded` solves with [`ExactSchedule::Banded`] (threads:
+//! `RAYON_NUM_THREADS`).
 
-use geodesic::{ExactGeodesic, GeodesicSolver, SolveOptions, Source};
+use geodesic::{ExactGeodesic, ExactSchedule, GeodesicSolver, SolveOptions, Source};
 use std::time::Instant;
 
 fn main() {
@@ -28,6 +30,10 @@ fn main() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(1e-9);
+    let schedule = match std::env::var("EXACT_PEER_SCHEDULE").as_deref() {
+        Ok("banded") => ExactSchedule::Banded,
+        _ => ExactSchedule::Serial,
+    };
     let mut worst = 0.0f64;
     for ((mesh, rf), src) in meshes.split(';').zip(refs.split(';')).zip(srcs.split(';')) {
         let m = testsupport::read_mesh(mesh);
@@ -59,7 +65,7 @@ fn main() {
         let mut out = None;
         for _ in 0..repeat {
             let (t0, c0) = (Instant::now(), thread_cpu());
-            let solver = ExactGeodesic::new(&m).unwrap();
+            let solver = ExactGeodesic::new(&m).unwrap().with_schedule(schedule);
             let (t1, c1) = (Instant::now(), thread_cpu());
             let r = solver
                 .distances_with_stats(&sources, &SolveOptions::default())
@@ -91,7 +97,7 @@ fn main() {
             }
         }
         println!(
-            "{mesh} src {src}: nV {} setup wall {sw:.4} s cpu {sc:.4} s | solve wall {vw:.4} s cpu {vc:.4} s (median of {repeat}) | propagations {props} | peak RSS {} MB | max rel diff {rel:.3e} (vertex {imax}: ours {} peer {})",
+            "{mesh} src {src} ({schedule:?}): nV {} setup wall {sw:.4} s cpu {sc:.4} s | solve wall {vw:.4} s cpu {vc:.4} s (median of {repeat}) | propagations {props} | peak RSS {} MB | max rel diff {rel:.3e} (vertex {imax}: ours {} peer {})",
             m.n_vertices(),
             peak_rss_mb(),
             d[imax],
