@@ -164,7 +164,7 @@ impl Buffers {
 impl Buffers {
     /// The window list of half-edge `h`, given a slot if it has none; with `pooled`, an
     /// unallocated list takes an emptied one from the pool.
-    #[inline]
+    #[inline(always)]
     fn list_of(&mut self, h: u32, pooled: bool) -> &mut Vec<Window> {
         let mut i = self.slot[h as usize];
         if i == 0 {
@@ -379,7 +379,7 @@ impl<'a> Solve<'a> {
 
     /// Marks the list of `h` filled and queues it if one of its end vertices is inside (or
     /// while draining).
-    #[inline]
+    #[inline(always)]
     fn filled(&mut self, h: u32) {
         let f = &mut self.b.flags[h as usize];
         *f |= FILLED;
@@ -550,39 +550,53 @@ impl<'a> Solve<'a> {
         let Some(mut ws) = self.take_list(h) else {
             return;
         };
-        let mut sc = std::mem::take(&mut self.b.step);
-        let out = list_step(self.g, &self.d, self.cut, self.prune, h, &mut ws, &mut sc);
+        let out = list_step(
+            self.g,
+            &self.d,
+            self.cut,
+            self.prune,
+            h,
+            &mut ws,
+            &mut self.b.step,
+        );
         self.recycle(ws);
         if let Some(out) = out {
-            self.apply(&out, &mut sc.kids, false);
+            self.apply(&out, None);
         }
-        self.b.step = sc;
     }
 
     /// Applies what a list step found: relaxes its apex, then appends its children to their
-    /// lists (recording them first in path-tracing mode) and empties `kids` (`moved`: a child
-    /// buffer may be moved into an empty list and replaced by that list's buffer).
-    fn apply(&mut self, out: &StepOut, kids: &mut [Vec<Window>; 2], moved: bool) {
+    /// lists (recording them first in path-tracing mode) and empties their buffers: `kids`,
+    /// whose buffers may be moved into empty lists (and replaced by those lists' buffers), or
+    /// without it the children of this thread's scratch, which are copied.
+    #[inline]
+    fn apply(&mut self, out: &StepOut, mut kids: Option<&mut [Vec<Window>; 2]>) {
         if out.best < self.d[out.apex as usize] {
             self.relax(out.apex, out.best, Pred::Window(out.best_id, out.p_star));
         }
         for (side, tw) in out.order {
-            let ks = &mut kids[side];
-            if ks.is_empty() {
-                continue;
-            }
-            self.propagations += ks.len() as u64;
-            if self.records.is_some() {
-                for k in ks.iter_mut() {
-                    let parent = k.id;
-                    self.record(tw & IDX, k, Origin::Window(parent));
+            let mut ks = match kids.as_deref_mut() {
+                Some(k) => std::mem::take(&mut k[side]),
+                None => std::mem::take(&mut self.b.step.kids[side]),
+            };
+            if !ks.is_empty() {
+                self.propagations += ks.len() as u64;
+                if self.records.is_some() {
+                    for k in ks.iter_mut() {
+                        let parent = k.id;
+                        self.record(tw & IDX, k, Origin::Window(parent));
+                    }
+                }
+                if kids.is_some() {
+                    self.append_vec(tw & IDX, &mut ks);
+                } else {
+                    self.append(tw & IDX, &ks);
+                    ks.clear();
                 }
             }
-            if moved {
-                self.append_vec(tw & IDX, ks);
-            } else {
-                self.append(tw & IDX, ks);
-                ks.clear();
+            match kids.as_deref_mut() {
+                Some(k) => k[side] = ks,
+                None => self.b.step.kids[side] = ks,
             }
         }
     }
@@ -656,7 +670,7 @@ impl<'a> Solve<'a> {
         }
         for mut it in items.drain(..) {
             if let Some(out) = it.out {
-                self.apply(&out, &mut it.kids, true);
+                self.apply(&out, Some(&mut it.kids));
             }
             self.recycle(it.ws);
             let [k0, k1] = it.kids;
