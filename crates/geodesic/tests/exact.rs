@@ -796,6 +796,8 @@ fn banded_schedule_is_bit_identical_on_any_thread_count() {
             vec![vec![Source::Vertex(0)]],
             vec![None, Some(2.0)],
         ),
+        // Large enough for many generations to be stepped in parallel.
+        (bumpy_at(5), vec![vec![Source::Vertex(3)]], vec![None]),
     ];
     let pools: Vec<rayon::ThreadPool> = (1..=4)
         .map(|t| {

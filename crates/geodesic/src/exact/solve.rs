@@ -639,9 +639,11 @@ impl<'a> Solve<'a> {
     fn generation(&mut self) {
         use rayon::prelude::*;
         let mut items = std::mem::take(&mut self.b.batch);
+        let mut windows = 0;
         while let Some(h) = self.b.fifo.pop_front() {
             self.b.flags[h as usize] &= !QUEUED;
             if let Some(ws) = self.take_list(h) {
+                windows += ws.len();
                 let kids = [self.pooled(), self.pooled()];
                 items.push(BatchItem {
                     h,
@@ -657,7 +659,7 @@ impl<'a> Solve<'a> {
             it.out = list_step(g, d, cut, prune, it.h, &mut it.ws, sc);
             std::mem::swap(&mut sc.kids, &mut it.kids);
         };
-        if items.len() < PARALLEL_MIN || rayon::current_num_threads() < 2 {
+        if items.len() < 2 || windows < PARALLEL_MIN || rayon::current_num_threads() < 2 {
             let mut sc = std::mem::take(&mut self.b.step);
             items.iter_mut().for_each(|it| run(&mut sc, it));
             self.b.step = sc;
@@ -695,8 +697,10 @@ impl<'a> Solve<'a> {
 
 /// Most vertices [`Solve::run_banded`] pops before processing the lists they queue.
 pub(crate) const BAND: usize = 32;
-/// Fewest list steps of a generation that [`Solve::run_banded`] hands to rayon.
-const PARALLEL_MIN: usize = 4;
+/// Fewest windows in the lists of a generation for [`Solve::run_banded`] to hand their steps
+/// to rayon (about 50 µs of work; smaller generations are stepped on the calling thread, which
+/// changes only the speed).
+const PARALLEL_MIN: usize = 1024;
 
 /// One queued list of a generation of the banded schedule: its windows, the children its step
 /// emits and what else the step found.
