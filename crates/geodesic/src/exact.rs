@@ -149,7 +149,8 @@ pub enum ExactSchedule {
     Serial,
     /// Vertices taken in bands of up to 32, and the queued lists processed generation by
     /// generation, each generation's list steps in parallel on the rayon pool the solve runs
-    /// in (the global one, or the pool of a `ThreadPool::install`). The field is the same bit
+    /// in (the global one, or the pool of a `ThreadPool::install`; a generation of fewer than
+    /// 1024 windows on the calling thread). The field is the same bit
     /// for bit for every number of threads; it is exact like the serial one but may differ
     /// from it in the last bits (another processing order).
     Banded,
