@@ -5,8 +5,9 @@
 
 For each set (tuning, held-out) the probes against their own set's gallery: rank-1, the equal
 error rate and min(other persons) / max(same person), for the compare rule as committed and
-for other view turns, pair combinations and cohort (T-norm) normalisations. The cohort of a
-set's probe is the other set's gallery (other persons). Plain Python 3, no packages.
+for other view turns, pair combinations and cohort normalisations (T-norm: the probe's cohort
+is the other set's gallery; Z-norm: a template's cohort is the other set's probes; S-norm:
+the two averaged). The cohorts are other persons. Plain Python 3, no packages.
 """
 import csv, math, statistics, sys
 
@@ -73,6 +74,16 @@ def cohort_scale(score, stat):
     return lambda r: score(r) / out[(r["set"], r["probe"])]
 
 
+def template_cohort(score, stat):
+    """Z-norm's scale of a template: `stat` of the other set's probes (other persons) against it."""
+    out = {}
+    for r in rows:
+        if r["gallery"] != r["set"] and math.isfinite(score(r)):
+            out.setdefault((r["gallery"], r["template"]), []).append(score(r))
+    out = {k: stat(v) for k, v in out.items()}
+    return lambda r: out[(r["set"], r["template"])]
+
+
 def show(name, score):
     cells = []
     for s in ("tuning", "held-out"):
@@ -100,3 +111,10 @@ for turns in (TURNS, ["m25", "p25"]):
     n = "8 views" if len(turns) == 8 else "views at +-25"
     show(n + ", T-norm by the cohort's median", cohort_scale(base, statistics.median))
     show(n + ", T-norm by the cohort's mean", cohort_scale(base, statistics.fmean))
+base = lambda r: least(pair_distances(r, TURNS))
+for name, stat in (("median", statistics.median), ("mean", statistics.fmean)):
+    z = template_cohort(base, stat)
+    t = cohort_scale(base, stat)
+    show("8 views, Z-norm by the template's cohort " + name, lambda r, z=z: base(r) / z(r))
+    show("8 views, S-norm (T and Z averaged) by the " + name,
+         lambda r, z=z, t=t: 0.5 * (t(r) + base(r) / z(r)))
