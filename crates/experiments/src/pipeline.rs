@@ -1,72 +1,34 @@
-//! Pipeline pieces shared by the experiments: reference configurations, the bipolar descriptor
-//! per region (built by the `bipolar` crate), keyed distances (`facematch::KeyedSet`),
+//! Pipeline pieces shared by the experiments: reference configurations (`facematch::PoleRefs`,
+//! whose descriptor per area `bipolar` builds), keyed distances (`facematch::KeyedSet`),
 //! reference-point perturbation, geodesic method resolution and progress bars.
 
 use crate::walk::Walker;
 use anyhow::{bail, Context, Result};
 use facematch::KeyedSet;
-use facemodel::{face_frame, static_mask, Face, FaceFrame};
+use facemodel::Face;
 use geodesic::{GeodesicSolver, Method, SolveOptions, Source};
 use indicatif::{ProgressBar, ProgressStyle};
 use meshcore::{DVec3, SurfacePoint, TriMesh};
 use shapedist::ShapeDistError;
 
-/// Which area a bipolar descriptor covers.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Region {
-    /// Points within D of both corners and above the nose-tip plane.
-    Static,
-    /// Levels up to 2N of both fields (nearly the whole face).
-    Whole,
-}
+pub use facematch::{Area, PoleRefs};
 
-/// The reference configuration of one face for one method: the two corner fields, D, the
-/// reference and nose positions, and the landmark frame.
-#[derive(Debug, Clone)]
-pub struct Refs {
-    /// Geodesic distance from the right outer eye corner r, per vertex.
-    pub ur: Vec<f64>,
-    /// Geodesic distance from the left outer eye corner q, per vertex.
-    pub uq: Vec<f64>,
-    /// D: the geodesic distance between the two corners (mean of both fields' values).
-    pub d: f64,
-    /// Position of r.
-    pub r: DVec3,
-    /// Position of q.
-    pub q: DVec3,
-    /// Position of the nose tip.
-    pub nose: DVec3,
-    /// Face frame from r, q and the nose tip (for the static-area mask).
-    pub frame: FaceFrame,
-}
-
-impl Refs {
-    /// The reference configuration of a face from its landmark vertices, with `solver` (of
-    /// `face.mesh`), and the nose tip's distance field (the single pole's and the facial
-    /// curves' field).
-    pub fn of_face(face: &Face, solver: &dyn GeodesicSolver) -> Result<(Refs, Vec<f64>)> {
-        let (m, lm) = (&face.mesh, face.landmarks);
-        let ur = field(solver, Source::Vertex(lm.right_eye_outer))?;
-        let uq = field(solver, Source::Vertex(lm.left_eye_outer))?;
-        let un = field(solver, Source::Vertex(lm.nose_tip))?;
-        let d = 0.5 * (ur[lm.left_eye_outer as usize] + uq[lm.right_eye_outer as usize]);
-        let (r, q, nose) = (
-            m.position(lm.right_eye_outer),
-            m.position(lm.left_eye_outer),
-            m.position(lm.nose_tip),
-        );
-        let frame = face_frame(m, r, q, nose);
-        let refs = Refs {
-            ur,
-            uq,
-            d,
-            r,
-            q,
-            nose,
-            frame,
-        };
-        Ok((refs, un))
-    }
+/// The reference configuration of a face from its landmark vertices (the outer eye corners as
+/// the poles r and q, D the mean of each field's value at the other corner), with `solver` (of
+/// `face.mesh`), and the nose tip's distance field (the single pole's and the facial curves'
+/// field).
+pub fn face_refs(face: &Face, solver: &dyn GeodesicSolver) -> Result<(PoleRefs, Vec<f64>)> {
+    let (m, lm) = (&face.mesh, face.landmarks);
+    let ur = field(solver, Source::Vertex(lm.right_eye_outer))?;
+    let uq = field(solver, Source::Vertex(lm.left_eye_outer))?;
+    let un = field(solver, Source::Vertex(lm.nose_tip))?;
+    let d = 0.5 * (ur[lm.left_eye_outer as usize] + uq[lm.right_eye_outer as usize]);
+    let (r, q, nose) = (
+        m.position(lm.right_eye_outer),
+        m.position(lm.left_eye_outer),
+        m.position(lm.nose_tip),
+    );
+    Ok((PoleRefs::new(m, [ur, uq], d, [r, q, nose]), un))
 }
 
 pub use shapedist::landmark_icp_rms;
@@ -87,64 +49,16 @@ pub enum DescriptorRule {
     CrateIsoAngle,
 }
 
-/// The bipolar descriptor of a configuration at `n` levels between the references (step
-/// `D / n`; static region: levels up to n with the static mask; whole: levels up to 2n), built
-/// by `bipolar::describe` (precomputed fields) with `rule`; `boundary_margin` leaves out the
-/// band next to the mesh boundary (`bipolar::DescriptorOptions::boundary_margin`), and `seen`,
-/// when given, keeps only its `true` vertices (with the static mask, both must hold). The
-/// caller builds the surface (mesh and topology) once for all the descriptors of a mesh.
-pub fn bipolar(
-    surface: &bipolar::Surface,
-    refs: &Refs,
-    n: u32,
-    region: Region,
-    rule: DescriptorRule,
-    boundary_margin: Option<f64>,
-    seen: Option<&[bool]>,
-) -> Result<bipolar::Descriptor, bipolar::BipolarError> {
-    let mesh = surface.mesh();
-    let step = refs.d / f64::from(n);
-    let (max_level, mask) = match region {
-        Region::Static => (
-            n,
-            Some(static_mask(
-                mesh,
-                &refs.ur,
-                &refs.uq,
-                refs.d,
-                &refs.frame,
-                refs.nose,
-            )),
-        ),
-        Region::Whole => (2 * n, None),
-    };
-    let mask = restrict(mask, seen);
-    let opts = bipolar::DescriptorOptions {
-        levels: bipolar::LevelSpec::Step(step),
-        max_level: Some(max_level),
-        vertex_mask: mask,
-        boundary_margin,
-        rule: match rule {
-            DescriptorRule::CrateAll => bipolar::SelectionRule::All,
-            DescriptorRule::CrateIsoAngle => bipolar::SelectionRule::IsoAngle,
-        },
-        ..Default::default()
-    };
-    bipolar::describe(
-        surface,
-        bipolar::Fields::Precomputed {
-            fields: &[refs.ur.clone(), refs.uq.clone()],
-            references: None,
-        },
-        &opts,
-    )
-}
-
-/// A vertex mask restricted to the `seen` vertices: both must hold (`None`: no restriction).
-pub fn restrict(mask: Option<Vec<bool>>, seen: Option<&[bool]>) -> Option<Vec<bool>> {
-    match (mask, seen) {
-        (Some(m), Some(s)) => Some(m.iter().zip(s).map(|(&a, &b)| a && b).collect()),
-        (m, s) => m.or_else(|| s.map(<[bool]>::to_vec)),
+impl DescriptorRule {
+    /// `bipolar`'s options of the rule (the rest at their defaults).
+    pub fn options(self) -> bipolar::DescriptorOptions {
+        match self {
+            DescriptorRule::CrateAll => facematch::grid_rule(),
+            DescriptorRule::CrateIsoAngle => bipolar::DescriptorOptions {
+                rule: bipolar::SelectionRule::IsoAngle,
+                ..Default::default()
+            },
+        }
     }
 }
 

@@ -1,8 +1,9 @@
 //! The bipolar descriptions of a face: the three pole pairs on the static area, without the
 //! boundary band and the grazing parts, and the reference-point search's moved descriptors.
 
+use crate::area::{grid_rule, Area, PoleRefs};
 use crate::{KeyedSet, MatchOptions, Pair, Poles};
-use facemodel::{face_frame, static_mask, FaceFrame};
+use facemodel::{face_frame, FaceFrame};
 use geodesic::{GeodesicSolver, SolveOptions};
 use meshcore::{DVec3, Surface, TriMesh};
 
@@ -49,19 +50,6 @@ impl FaceFields {
     }
 }
 
-/// The reference configuration of one pair: its two fields, D, the poles' places, the nose tip
-/// and the landmark frame (the static area's).
-#[derive(Debug, Clone)]
-struct PairRefs {
-    ua: Vec<f64>,
-    ub: Vec<f64>,
-    d: f64,
-    a: DVec3,
-    b: DVec3,
-    nose: DVec3,
-    frame: FaceFrame,
-}
-
 /// The reference fields of `pair`: the poles stand in r and q, D is their geodesic distance.
 /// The frame and the nose tip stay the landmarks' own for every pair, so the static area of a
 /// side pair is its lens above the nose tip's horizontal plane.
@@ -71,7 +59,7 @@ fn pair_refs(
     poles: Poles,
     pair: Pair,
     frame: FaceFrame,
-) -> Result<PairRefs, String> {
+) -> Result<PoleRefs, String> {
     let (ua, ub) = f.of_pair(pair);
     if ua.is_empty() || ub.is_empty() {
         return Err(format!(
@@ -89,47 +77,15 @@ fn pair_refs(
         ));
     }
     let [_, _, nose] = poles.positions(mesh);
-    Ok(PairRefs {
-        ua: ua.to_vec(),
-        ub: ub.to_vec(),
+    Ok(PoleRefs {
+        ur: ua.to_vec(),
+        uq: ub.to_vec(),
         d,
-        a: mesh.position(a),
-        b: mesh.position(b),
+        r: mesh.position(a),
+        q: mesh.position(b),
         nose,
         frame,
     })
-}
-
-/// The bipolar descriptor of `refs` on `surface`: static area (within D of both poles, above
-/// the nose tip's horizontal plane), every intersection of the two level families at step
-/// D / N up to level N, on the vertices `kept`.
-fn static_descriptor(
-    surface: &Surface,
-    refs: &PairRefs,
-    levels: u32,
-    kept: Option<&[bool]>,
-) -> Result<bipolar::Descriptor, bipolar::BipolarError> {
-    let mesh = surface.mesh();
-    let mask = static_mask(mesh, &refs.ua, &refs.ub, refs.d, &refs.frame, refs.nose);
-    let mask = match kept {
-        Some(k) => mask.iter().zip(k).map(|(&a, &b)| a && b).collect(),
-        None => mask,
-    };
-    let opts = bipolar::DescriptorOptions {
-        levels: bipolar::LevelSpec::Step(refs.d / f64::from(levels)),
-        max_level: Some(levels),
-        vertex_mask: Some(mask),
-        rule: bipolar::SelectionRule::All,
-        ..Default::default()
-    };
-    bipolar::describe(
-        surface,
-        bipolar::Fields::Precomputed {
-            fields: &[refs.ua.clone(), refs.ub.clone()],
-            references: None,
-        },
-        &opts,
-    )
 }
 
 /// The vertices the descriptors of `surface` may use: those of `seen` (all without it) outside
@@ -238,9 +194,15 @@ pub fn describe_with_fields(
     let refs = Pair::ALL.map(|p| pair_refs(mesh, f, poles, p, frame));
     let sets = Pair::ALL.map(|p| {
         let refs = refs[p as usize].as_ref().map_err(Clone::clone)?;
-        static_descriptor(surface, refs, options.levels, kept.as_deref())
-            .map(|d| KeyedSet::of(&d))
-            .map_err(|e| format!("bipolar descriptor: {e}"))
+        refs.descriptor(
+            surface,
+            options.levels,
+            Area::Static,
+            kept.as_deref(),
+            grid_rule(),
+        )
+        .map(|d| KeyedSet::of(&d))
+        .map_err(|e| format!("bipolar descriptor: {e}"))
     });
     let (moved, moved_failed) = match (search, &options.search) {
         (true, Some(s)) => {
@@ -289,7 +251,7 @@ fn moved_descriptors(
     surface: &Surface,
     solver: &dyn GeodesicSolver,
     poles: Poles,
-    refs: &[Result<PairRefs, String>; 3],
+    refs: &[Result<PoleRefs, String>; 3],
     searched: [bool; 3],
     shared: bool,
     s: &crate::SearchOptions,
@@ -299,14 +261,14 @@ fn moved_descriptors(
     let mut out: [Vec<KeyedSet>; 3] = Default::default();
     let mut failed = [0usize; 3];
     let mesh = surface.mesh();
-    let search: Vec<(Pair, &PairRefs)> = Pair::ALL
+    let search: Vec<(Pair, &PoleRefs)> = Pair::ALL
         .into_iter()
         .filter(|p| searched[*p as usize])
         .filter_map(|p| refs[p as usize].as_ref().ok().map(|r| (p, r)))
         .collect();
     let Some(span) = search
         .iter()
-        .map(|(_, r)| (r.b - r.a).length())
+        .map(|(_, r)| (r.q - r.r).length())
         .reduce(f64::max)
     else {
         return (out, failed);
@@ -345,7 +307,7 @@ fn moved_descriptors(
         (true, 1) => pr,
         (true, _) => 0.5 * (pr + pq),
     };
-    let jobs: Vec<(Pair, &PairRefs, usize, usize)> = search
+    let jobs: Vec<(Pair, &PoleRefs, usize, usize)> = search
         .into_iter()
         .map(|(pair, refs)| {
             let (ka, kb) = match pair {
@@ -353,8 +315,8 @@ fn moved_descriptors(
                 Pair::RightNose => (0, 2),
                 Pair::LeftNose => (1, 2),
             };
-            let ia = moved(ka, toward(ka, refs.b), &refs.ua);
-            let ib = moved(kb, toward(kb, refs.a), &refs.ub);
+            let ia = moved(ka, toward(ka, refs.q), &refs.ur);
+            let ib = moved(kb, toward(kb, refs.r), &refs.uq);
             (pair, refs, ia, ib)
         })
         .collect();
@@ -369,19 +331,19 @@ fn moved_descriptors(
         let mut built = 0;
         for m in bipolar::moved_pairs(a, b) {
             let (pa, pb) = (mesh.position(m.r), mesh.position(m.q));
-            let moved = PairRefs {
-                ua: m.ur.to_vec(),
-                ub: m.uq.to_vec(),
+            let moved = PoleRefs {
+                ur: m.ur.to_vec(),
+                uq: m.uq.to_vec(),
                 d: m.d,
-                a: pa,
-                b: pb,
+                r: pa,
+                q: pb,
                 nose: refs.nose,
                 frame: match pair {
                     Pair::Corners => face_frame(mesh, pa, pb, refs.nose),
                     _ => refs.frame,
                 },
             };
-            if let Ok(d) = static_descriptor(surface, &moved, o.levels, kept) {
+            if let Ok(d) = moved.descriptor(surface, o.levels, Area::Static, kept, grid_rule()) {
                 out[pair as usize].push(KeyedSet::of(&d));
                 built += 1;
             }
@@ -540,7 +502,7 @@ pub(crate) mod tests {
         for (pair, corner) in [(Pair::RightNose, r), (Pair::LeftNose, q)] {
             let side = pair_refs(&m, &f, poles, pair, frame).unwrap();
             assert!((side.d - (corner - nose).length()).abs() < 1e-9, "{pair:?}");
-            assert_eq!((side.a, side.b, side.nose), (corner, nose, nose));
+            assert_eq!((side.r, side.q, side.nose), (corner, nose, nose));
             // The frame stays the landmarks' own.
             assert_eq!(side.frame, frame);
         }

@@ -25,6 +25,7 @@
 //! The options and their defaults (the benchmark's) are written once, in [`MatchOptions`]. The
 //! figures a set of scores is judged by (rank-1, EER, ROC, McNemar, Wilson) are in [`metrics`].
 
+mod area;
 mod compare;
 mod describe;
 mod error;
@@ -40,6 +41,7 @@ mod prepare;
 mod template;
 mod view;
 
+pub use area::{grid_rule, Area, PoleRefs};
 pub use compare::{compare, pair_score, Comparison, PairUse, ViewUse};
 pub use describe::{describe, describe_with_fields, kept_vertices, Description, FaceFields};
 pub use error::MatchError;

@@ -3,12 +3,11 @@
 //! the single-pole matrix).
 
 use super::{eye_mid, n_keys, Ctx, Desc, FacePrep, MethodResults, RESOLUTIONS};
-use crate::pipeline::{bar, Region};
+use crate::pipeline::{bar, Area};
 use crate::polar::{polar_descriptor, Pole};
 use crate::report::{markers, polylines, render_face as render};
 use anyhow::Result;
 use bipolar::PolarDescriptor;
-use facemodel::static_mask;
 use meshcore::{DVec3, Topology, TriMesh};
 use rayon::prelude::*;
 use std::path::Path;
@@ -79,7 +78,7 @@ pub(super) fn renders(ctx: &Ctx<'_>, prep: &[FacePrep], out: &Path) -> Result<()
             .map(|i| f64::from(i) * step)
             .take_while(|l| *l < maxu)
             .collect();
-        let desc = ctx.describe(&f.mesh, rf, nl, Region::Whole, || {
+        let desc = ctx.describe(&f.mesh, rf, nl, Area::Whole, || {
             format!("{} (whole, N = {nl})", f.name)
         });
         let mut scene = Scene::new(&f.mesh);
@@ -96,11 +95,11 @@ pub(super) fn renders(ctx: &Ctx<'_>, prep: &[FacePrep], out: &Path) -> Result<()
             rf.frame.forward,
         )?;
     }
-    let mask = static_mask(&f.mesh, &rf.ur, &rf.uq, rf.d, &rf.frame, rf.nose);
-    let ds = ctx.describe(&f.mesh, rf, n, Region::Static, || {
+    let mask = rf.static_area(&f.mesh);
+    let ds = ctx.describe(&f.mesh, rf, n, Area::Static, || {
         format!("{} (static, N = {n})", f.name)
     });
-    let dw = ctx.describe(&f.mesh, rf, n, Region::Whole, || {
+    let dw = ctx.describe(&f.mesh, rf, n, Area::Whole, || {
         format!("{} (whole, N = {n})", f.name)
     });
     let mut scene = Scene::new(&f.mesh);
@@ -127,12 +126,12 @@ pub(super) fn renders(ctx: &Ctx<'_>, prep: &[FacePrep], out: &Path) -> Result<()
 pub(super) fn run(ctx: &Ctx<'_>, prep: &[FacePrep], res: &mut MethodResults) -> Result<Base> {
     let (faces, test, n) = (ctx.faces, ctx.test, ctx.args.set.res.levels);
     let nf = faces.len();
-    let describe_all = |nl: u32, region: Region, label: &'static str| -> Vec<Desc> {
+    let describe_all = |nl: u32, area: Area, label: &'static str| -> Vec<Desc> {
         faces
             .par_iter()
             .zip(prep)
             .map(|(f, p)| {
-                ctx.describe(&f.mesh, &p.refs, nl, region, || {
+                ctx.describe(&f.mesh, &p.refs, nl, area, || {
                     format!("{} ({label}, N = {nl})", f.name)
                 })
             })
@@ -145,7 +144,7 @@ pub(super) fn run(ctx: &Ctx<'_>, prep: &[FacePrep], res: &mut MethodResults) -> 
     let sweep: Vec<Vec<Desc>> = RESOLUTIONS
         .iter()
         .map(|&nl| {
-            let v = describe_all(nl, Region::Static, "static");
+            let v = describe_all(nl, Area::Static, "static");
             pb.inc(1);
             v
         })
@@ -168,8 +167,8 @@ pub(super) fn run(ctx: &Ctx<'_>, prep: &[FacePrep], res: &mut MethodResults) -> 
             .collect();
         res.sweep.push((nl, row));
     }
-    let static_ = describe_all(n, Region::Static, "static");
-    let whole = describe_all(n, Region::Whole, "whole");
+    let static_ = describe_all(n, Area::Static, "static");
+    let whole = describe_all(n, Area::Whole, "whole");
     res.n_points = static_
         .iter()
         .zip(&whole)

@@ -5,7 +5,7 @@
 use super::base::Base;
 use super::stats::{max, mean, min};
 use super::{eye_mid, Ctx, FacePrep, MethodResults, RESOLUTIONS};
-use crate::pipeline::{error_grid, Refs, Region};
+use crate::pipeline::{error_grid, Area, PoleRefs};
 use crate::polar::{polar_descriptor, Pole};
 use crate::report::par_map;
 use anyhow::Result;
@@ -15,7 +15,7 @@ use rayon::prelude::*;
 /// One perturbation cell: moved-corner references, moved-pole polar descriptor, and whether
 /// each walk met the boundary.
 struct Cell {
-    refs: Refs,
+    refs: PoleRefs,
     polar: PolarDescriptor,
     cut_q: bool,
     cut_nose: bool,
@@ -66,7 +66,7 @@ pub(super) fn run(
         let db = if g.cut_q {
             f64::NAN
         } else {
-            let moved = ctx.describe(&tf.mesh, &g.refs, n, Region::Static, || cell_name(c));
+            let moved = ctx.describe(&tf.mesh, &g.refs, n, Area::Static, || cell_name(c));
             ctx.dist(&base.static_[test], &moved, || cell_name(c))
         };
         res.grid_bip.push((c.0, c.1, db));
@@ -102,7 +102,7 @@ pub(super) fn run(
             .filter(|(g, _)| !g.cut_q)
             .map(|(g, c)| {
                 let what = || format!("{}, N = {nl}", cell_name(c));
-                let moved = ctx.describe(&tf.mesh, &g.refs, nl, Region::Static, what);
+                let moved = ctx.describe(&tf.mesh, &g.refs, nl, Area::Static, what);
                 ctx.dist(&ds[test], &moved, what)
             })
             .collect();

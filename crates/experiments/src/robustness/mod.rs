@@ -18,14 +18,13 @@ pub(crate) mod stats;
 
 use crate::paths::FaceSetArgs;
 use crate::pipeline::{
-    bipolar, dist, field, perturb, resolve_methods, DescriptorRule, Keyed, Refs, Region,
+    dist, face_refs, field, perturb, resolve_methods, Area, DescriptorRule, Keyed, PoleRefs,
 };
 use crate::polar::PolarOptions;
 use crate::report::{par_map, Failures};
 use crate::walk::Walker;
 use anyhow::{bail, Result};
 use bipolar::PolarDescriptor;
-use facemodel::face_frame;
 use facemodel::Face;
 use geodesic::Source;
 use geodesic::{GeodesicSolver, Method};
@@ -94,41 +93,37 @@ struct Ctx<'a> {
 /// nose-tip field (also `section6`'s).
 pub(crate) struct FacePrep {
     pub(crate) solver: Box<dyn GeodesicSolver>,
-    pub(crate) refs: Refs,
+    pub(crate) refs: PoleRefs,
     pub(crate) un: Vec<f64>,
 }
 
 /// One cell of the reference-point error grid on a face ([`FacePrep::moved_cell`]): the
 /// references with q moved, the moved nose tip with its field, and whether the walk of q and of
 /// the nose tip met the boundary before the full radius.
-pub(crate) type MovedCell = (Refs, (SurfacePoint, Vec<f64>), (bool, bool));
+pub(crate) type MovedCell = (PoleRefs, (SurfacePoint, Vec<f64>), (bool, bool));
 
 impl FacePrep {
     /// The solver of `method` on the face and its references from the landmark vertices.
     pub(crate) fn new(face: &Face, method: Method) -> Result<Self> {
         let solver = geodesic::new_solver(&face.mesh, method)?;
-        let (refs, un) = Refs::of_face(face, solver.as_ref())?;
+        let (refs, un) = face_refs(face, solver.as_ref())?;
         Ok(Self { solver, refs, un })
     }
 
     /// The references with the left outer eye corner q moved to `sp`: its field from the
     /// face's solver, D the mean of both fields at the other corner, the frame rebuilt.
-    pub(crate) fn with_q_moved(&self, face: &Face, sp: SurfacePoint) -> Result<Refs> {
+    pub(crate) fn with_q_moved(&self, face: &Face, sp: SurfacePoint) -> Result<PoleRefs> {
         let (m, r, nose) = (&face.mesh, self.refs.r, self.refs.nose);
         let uq = field(self.solver.as_ref(), Source::Point(sp))?;
         let q = m.point_position(&sp)?;
         let right = face.landmarks.right_eye_outer as usize;
         let d = 0.5 * (uq[right] + m.interpolate(&self.refs.ur, &sp)?);
-        let (ur, frame) = (self.refs.ur.clone(), face_frame(m, r, q, nose));
-        Ok(Refs {
-            ur,
-            uq,
+        Ok(PoleRefs::new(
+            m,
+            [self.refs.ur.clone(), uq],
             d,
-            r,
-            q,
-            nose,
-            frame,
-        })
+            [r, q, nose],
+        ))
     }
 
     /// The grid cell `(pct, theta)`: q ([`FacePrep::with_q_moved`]) and the nose tip each
@@ -158,13 +153,13 @@ impl Ctx<'_> {
     fn describe(
         &self,
         mesh: &TriMesh,
-        refs: &Refs,
+        refs: &PoleRefs,
         n: u32,
-        region: Region,
+        area: Area,
         what: impl FnOnce() -> String,
     ) -> Desc {
         let surface = bipolar::Surface::new(mesh.clone());
-        match bipolar(&surface, refs, n, region, self.args.descriptor, None, None) {
+        match refs.descriptor(&surface, n, area, None, self.args.descriptor.options()) {
             Ok(d) => Some(d),
             Err(e) => {
                 let msg = format!("{}: descriptor of {}: {e}", self.mname(), what());
@@ -214,7 +209,7 @@ impl Ctx<'_> {
     }
 
     /// Options of the single-pole descriptor for a configuration.
-    fn polar_opts(&self, r: &Refs) -> PolarOptions {
+    fn polar_opts(&self, r: &PoleRefs) -> PolarOptions {
         PolarOptions {
             step: r.d / f64::from(self.args.set.res.levels),
             levels: self.args.set.res.levels,
@@ -246,7 +241,7 @@ impl AsKeyed for PolarDescriptor {
 }
 
 /// Midpoint of the two outer eye corners (angular origin of the single pole).
-pub(crate) fn eye_mid(r: &Refs) -> DVec3 {
+pub(crate) fn eye_mid(r: &PoleRefs) -> DVec3 {
     0.5 * (r.r + r.q)
 }
 

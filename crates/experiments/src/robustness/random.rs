@@ -3,13 +3,12 @@
 //! between the perturbed descriptors.
 
 use super::{eye_mid, Ctx, Desc, FacePrep, MethodResults};
-use crate::pipeline::{field, perturb, Refs, Region};
+use crate::pipeline::{field, perturb, Area, PoleRefs};
 use crate::polar::{polar_descriptor, Pole};
 use crate::report::par_map;
 use crate::walk::Walker;
 use anyhow::Result;
 use bipolar::PolarDescriptor;
-use facemodel::face_frame;
 use geodesic::Source;
 use meshcore::{DVec3, SurfacePoint};
 use rand::{Rng, SeedableRng};
@@ -58,7 +57,7 @@ fn one_face(ctx: &Ctx<'_>, prep: &FacePrep, i: usize) -> Result<Run> {
     let (rad, th, spq) = draw(&mut rng, w, r0.d, lm.left_eye_outer, r0.r)?;
     let one = prep.with_q_moved(f, spq)?;
     let (uq, q) = (one.uq.clone(), one.q);
-    let one = ctx.describe(&f.mesh, &one, n, Region::Static, || {
+    let one = ctx.describe(&f.mesh, &one, n, Area::Static, || {
         format!("{} (random error on q)", f.name)
     });
     // Both corners (q as above, r moved independently).
@@ -66,16 +65,8 @@ fn one_face(ctx: &Ctx<'_>, prep: &FacePrep, i: usize) -> Result<Run> {
     let ur = field(s, Source::Point(spr))?;
     let r = f.mesh.point_position(&spr)?;
     let d2 = 0.5 * (f.mesh.interpolate(&ur, &spq)? + f.mesh.interpolate(&uq, &spr)?);
-    let both = Refs {
-        ur,
-        uq,
-        d: d2,
-        r,
-        q,
-        nose: r0.nose,
-        frame: face_frame(&f.mesh, r, q, r0.nose),
-    };
-    let both = ctx.describe(&f.mesh, &both, n, Region::Static, || {
+    let both = PoleRefs::new(&f.mesh, [ur, uq], d2, [r, q, r0.nose]);
+    let both = ctx.describe(&f.mesh, &both, n, Area::Static, || {
         format!("{} (random errors on r and q)", f.name)
     });
     // Nose tip, with the same radius/direction draw as the single corner.

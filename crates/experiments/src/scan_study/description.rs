@@ -5,10 +5,10 @@
 use super::acquisition::{acquire, snap, Setting};
 use super::variants::{LEAST, VARIANTS};
 use super::Args;
-use crate::pipeline::{kept_vertices, restrict};
+use crate::pipeline::{kept_vertices, Area, PoleRefs};
 use crate::polar::{polar_descriptor, PolarOptions, Pole};
 use anyhow::{bail, Result};
-use facemodel::{face_frame, static_mask, Face, FaceFrame};
+use facemodel::Face;
 use geodesic::{GeodesicSolver, Method, SolveOptions, Source};
 use meshcore::{DVec3, FaceLocator, SurfacePoint, TriMesh};
 use std::time::Instant;
@@ -59,16 +59,8 @@ pub(super) fn describe_scan(face: &Face, setting: &Setting, args: &Args) -> Resu
     Ok(d)
 }
 
-/// The fields of the snapped landmarks: from the right and left outer eye corners and the nose
-/// tip, cut off at `cut`, and D.
-struct Fields {
-    ur: Vec<f64>,
-    uq: Vec<f64>,
-    un: Vec<f64>,
-    d: f64,
-}
-
-/// The fields of the snapped landmarks `sp`. The static area lies within D of both corners and
+/// The references of the snapped landmarks `sp` at `pos` (the outer eye corners' fields, D,
+/// the frame) and the nose tip's field. The static area lies within D of both corners and
 /// the polar rays reach D from the nose tip; D is about 1.2 times the straight distance between
 /// the corners. The fields are cut off past that (values within the cut are exact); a cut that
 /// turns out too short is an error, never a silently smaller region.
@@ -77,7 +69,7 @@ fn landmark_fields(
     solver: &dyn GeodesicSolver,
     sp: &[SurfacePoint; 3],
     pos: &[DVec3; 3],
-) -> Result<Fields> {
+) -> Result<(PoleRefs, Vec<f64>)> {
     let max_edge = mesh.longest_edge();
     let cut = 1.4 * (pos[0] - pos[1]).length() + max_edge;
     let solve = |s: SurfacePoint| -> Result<Vec<f64>> {
@@ -98,7 +90,7 @@ fn landmark_fields(
     if d + 2.0 * max_edge > cut {
         bail!("D = {d:.1} mm exceeds the fields' cut-off {cut:.1} mm");
     }
-    Ok(Fields { ur, uq, un, d })
+    Ok((PoleRefs::new(mesh, [ur, uq], d, *pos), un))
 }
 
 /// The descriptions of an acquired mesh (mm) with landmarks `lms` (r, q, nose; `hidden`: those
@@ -114,31 +106,30 @@ pub(super) fn describe_mesh(
     let (sp, off) = snap(&loc, lms, args.landmark_tolerance_mm)?;
     let pos = sp.map(|s| mesh.point_position(&s).unwrap_or(DVec3::NAN));
     let solver = geodesic::new_solver(&mesh, Method::Exact)?;
-    let f = landmark_fields(&mesh, solver.as_ref(), &sp, &pos)?;
-    let frame = face_frame(&mesh, pos[0], pos[1], pos[2]);
+    let (refs, un) = landmark_fields(&mesh, solver.as_ref(), &sp, &pos)?;
     let mut notes: Vec<String> = hidden
         .iter()
         .map(|h| format!("landmark {h}, snapped to the cleaned surface"))
         .collect();
     let surface = bipolar::Surface::new(mesh.clone());
-    let bip = variant_descriptors(&surface, &f, &frame, pos[2], args, &mut notes);
+    let bip = variant_descriptors(&surface, &refs, args, &mut notes);
     let matched = matched_description(&surface, solver.as_ref(), &sp, args);
     if let Err(e) = &matched {
         notes.push(format!("{}: {e}", VARIANTS[LEAST].name));
     }
     let polar_opts = PolarOptions {
-        step: f.d / f64::from(args.set.res.levels),
+        step: refs.d / f64::from(args.set.res.levels),
         levels: args.set.res.levels,
         sectors: args.set.res.sectors,
     };
     let polar = polar_descriptor(
         &geodesic::straightest::Walker::new(&mesh),
-        &f.un,
+        &un,
         Pole::Point(sp[2]),
         0.5 * (pos[0] + pos[1]),
         &polar_opts,
     )?;
-    let mask = static_mask(&mesh, &f.ur, &f.uq, f.d, &frame, pos[2]);
+    let mask = refs.static_area(&mesh);
     let inside: Vec<DVec3> = (0..mesh.n_vertices())
         .filter(|&v| mask[v])
         .map(|v| mesh.position(v as u32))
@@ -148,7 +139,7 @@ pub(super) fn describe_mesh(
     Ok(Described {
         vertices: mesh.n_vertices(),
         mean_edge_mm: mesh.mean_edge_length(),
-        d_mm: f.d,
+        d_mm: refs.d,
         landmark_offsets_mm: off,
         bip,
         matched,
@@ -176,7 +167,7 @@ fn variant_mask(
         .transpose()
         .map_err(|e| format!("{}: {e}", v.name))?;
     let Some(m) = v.margin_mm else {
-        return Ok(restrict(seen, None));
+        return Ok(seen);
     };
     let i = bands.iter().position(|(b, _)| *b == m).unwrap_or_else(|| {
         let kept = match kept_vertices(surface, None, Some(m)) {
@@ -188,25 +179,25 @@ fn variant_mask(
         bands.len() - 1
     });
     match &bands[i].1 {
-        Ok(band) => Ok(restrict(seen, Some(band))),
+        Ok(band) => Ok(Some(match seen {
+            Some(s) => s.iter().zip(band).map(|(&s, &b)| s && b).collect(),
+            None => band.clone(),
+        })),
         Err(e) => Err(format!("{}: {e}", v.name)),
     }
 }
 
-/// The corners' descriptor of each entry of [`VARIANTS`] on the snapped landmarks' fields `f`
-/// (static area, the variant's rule and vertex mask; the band along the holes built once per
+/// The corners' descriptor of each entry of [`VARIANTS`] on the snapped landmarks' references
+/// `refs` (static area, the variant's rule and vertex mask; the band along the holes built once per
 /// margin and left out through the vertex mask, `pipeline::kept_vertices`). A variant described
 /// like an earlier one (another distance rule over the same descriptors) takes that one's
 /// descriptor. Refusals are `None`, their reasons pushed on `notes`.
 fn variant_descriptors(
     surface: &bipolar::Surface,
-    f: &Fields,
-    frame: &FaceFrame,
-    nose: DVec3,
+    refs: &PoleRefs,
     args: &Args,
     notes: &mut Vec<String>,
 ) -> Vec<Option<bipolar::Descriptor>> {
-    let mesh = surface.mesh();
     let levels = args.set.res.levels;
     let mut bip: Vec<Option<bipolar::Descriptor>> = Vec::new();
     let mut bands = Vec::new();
@@ -223,18 +214,7 @@ fn variant_descriptors(
                 continue;
             }
         };
-        let mask = static_mask(mesh, &f.ur, &f.uq, f.d, frame, nose);
-        let opts = bipolar::DescriptorOptions {
-            levels: bipolar::LevelSpec::Step(f.d / f64::from(levels)),
-            max_level: Some(levels),
-            vertex_mask: restrict(Some(mask), seen.as_deref()),
-            ..v.options()
-        };
-        let fields = bipolar::Fields::Precomputed {
-            fields: &[f.ur.clone(), f.uq.clone()],
-            references: None,
-        };
-        match bipolar::describe(surface, fields, &opts) {
+        match refs.descriptor(surface, levels, Area::Static, seen.as_deref(), v.options()) {
             Ok(d) => bip.push(Some(d)),
             Err(e) => {
                 notes.push(format!("{}: {e}", v.name));

@@ -2,7 +2,7 @@
 //! the refusals listed instead of stopping the run.
 
 use super::Args;
-use crate::pipeline::{bipolar, dist, DescriptorRule, Refs, Region};
+use crate::pipeline::{dist, Area, PoleRefs};
 use crate::polar::{self, polar_descriptor, PolarOptions, Pole};
 use crate::report::Failures;
 use crate::walk::Walker;
@@ -37,20 +37,12 @@ impl Ctx<'_> {
     pub(super) fn bipolar(
         &self,
         mesh: &TriMesh,
-        refs: &Refs,
+        refs: &PoleRefs,
         name: &str,
     ) -> Option<bipolar::Descriptor> {
         let surface = bipolar::Surface::new(mesh.clone());
         let n = self.args.set.res.levels;
-        let d = bipolar(
-            &surface,
-            refs,
-            n,
-            Region::Static,
-            DescriptorRule::CrateAll,
-            None,
-            None,
-        );
+        let d = refs.descriptor(&surface, n, Area::Static, None, facematch::grid_rule());
         self.failures
             .ok(d, || format!("bipolar descriptor of {name}"))
     }
@@ -60,7 +52,7 @@ impl Ctx<'_> {
     pub(super) fn nose_descs(
         &self,
         (mesh, walker): (&TriMesh, &Walker<'_>),
-        refs: &Refs,
+        refs: &PoleRefs,
         un: &[f64],
         nose: Pole,
         name: &str,
@@ -92,7 +84,7 @@ impl Ctx<'_> {
     pub(super) fn describe(
         &self,
         mesh_walker: (&TriMesh, &Walker<'_>),
-        refs: &Refs,
+        refs: &PoleRefs,
         un: &[f64],
         nose: Pole,
         name: &str,
