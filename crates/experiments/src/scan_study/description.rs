@@ -170,7 +170,7 @@ fn variant_mask(
         return Ok(seen);
     };
     let i = bands.iter().position(|(b, _)| *b == m).unwrap_or_else(|| {
-        let kept = match kept_vertices(surface, None, Some(m)) {
+        let kept = match kept_vertices(surface, None, None, Some(m)) {
             Ok(Some(kept)) => Ok(kept),
             Ok(None) => Err("no band mask".to_string()),
             Err(e) => Err(e.to_string()),
