@@ -566,9 +566,10 @@ impl<'a> Solve<'a> {
     }
 
     /// Applies what a list step found: relaxes its apex, then appends its children to their
-    /// lists (recording them first in path-tracing mode) and empties their buffers: `kids`,
-    /// whose buffers may be moved into empty lists (and replaced by those lists' buffers), or
-    /// without it the children of this thread's scratch, which are copied.
+    /// lists (recording them first in path-tracing mode) and empties their buffers: `kids`, or
+    /// without it the children of this thread's scratch. A buffer appended to an empty list is
+    /// moved into it without a copy (and replaced by that list's buffer, or for this thread's
+    /// scratch by a pooled one when that has no capacity).
     #[inline]
     fn apply(&mut self, out: &StepOut, mut kids: Option<&mut [Vec<Window>; 2]>) {
         if out.best < self.d[out.apex as usize] {
@@ -587,11 +588,11 @@ impl<'a> Solve<'a> {
                         self.record(tw & IDX, k, Origin::Window(parent));
                     }
                 }
-                if kids.is_some() {
-                    self.append_vec(tw & IDX, &mut ks);
-                } else {
-                    self.append(tw & IDX, &ks);
-                    ks.clear();
+                self.append_vec(tw & IDX, &mut ks);
+                if kids.is_none() && ks.capacity() == 0 {
+                    // This thread's scratch gave its buffer to an empty list: an emptied
+                    // one from the pool replaces it.
+                    ks = self.pooled();
                 }
             }
             match kids.as_deref_mut() {
@@ -918,7 +919,7 @@ impl StepScratch {
     }
 
     #[allow(clippy::too_many_arguments)]
-    #[inline]
+    #[inline(always)]
     fn push_child(
         &mut self,
         side: usize,

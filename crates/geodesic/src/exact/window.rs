@@ -174,6 +174,7 @@ fn equal_distance_roots(w1: &Window, w2: &Window, out: &mut [f64; 2]) -> usize {
 /// than [`TAU`] relative); windows are never split in the middle. Identical distance functions
 /// whose intervals overlap or touch (functions within `1e-12` times `w1`'s [`Window::scale`])
 /// are merged into `w1`. `bs` steers the bounding shortcut (speed only).
+#[inline(always)]
 pub(crate) fn pair_trim(w1: &mut Window, w2: &mut Window, bs: &mut BoundStats) -> Trim {
     let l = w1.b0.max(w2.b0);
     let r = w1.b1.min(w2.b1);
