@@ -103,6 +103,8 @@ pub(crate) struct Buffers {
     slot: Vec<u32>,
     /// The window lists of the half-edges that hold one; emptied entries are in `free`.
     held: Vec<Vec<Window>>,
+    /// The half-edge of each entry of `held` (stale for emptied entries).
+    owner: Vec<u32>,
     free: Vec<u32>,
     /// Per half-edge: [`QUEUED`] (in `fifo`) and [`FILLED`] (its list is not empty), one byte
     /// so that the queue checks do not load the list headers.
@@ -145,6 +147,7 @@ impl Buffers {
                 }
             }
         }
+        self.owner.clear();
         for mut l in self.held.drain(..) {
             if l.capacity() > 0 && self.pool.len() < POOL_MAX {
                 l.clear();
@@ -172,10 +175,12 @@ impl Buffers {
                 Some(i) => i,
                 None => {
                     self.held.push(Vec::new());
+                    self.owner.push(h);
                     self.held.len() as u32
                 }
             };
             self.slot[h as usize] = i;
+            self.owner[i as usize - 1] = h;
         }
         let list = &mut self.held[i as usize - 1];
         if pooled && list.capacity() == 0 {
@@ -498,18 +503,20 @@ impl<'a> Solve<'a> {
     }
 
     /// Heap exhausted (or beyond the cut-off): switches to draining and queues every list
-    /// still holding windows; false when there is none.
+    /// still holding windows, in half-edge order; false when there is none. The lists in use
+    /// are found from `held` (the non-empty entries), not by a scan of every half-edge.
     fn queue_for_drain(&mut self) -> bool {
         self.draining = true;
-        let mut any = false;
-        for (h, f) in self.b.flags.iter_mut().enumerate() {
-            if *f == FILLED {
-                *f = FILLED | QUEUED;
-                self.b.fifo.push_back(h as u32);
-                any = true;
+        let b = &mut self.b;
+        let start = b.fifo.len();
+        for (l, &h) in b.held.iter().zip(&b.owner) {
+            if !l.is_empty() && b.flags[h as usize] == FILLED {
+                b.flags[h as usize] = FILLED | QUEUED;
+                b.fifo.push_back(h);
             }
         }
-        any
+        b.fifo.make_contiguous()[start..].sort_unstable();
+        b.fifo.len() > start
     }
 
     #[cfg(test)]
@@ -819,11 +826,13 @@ fn list_step(
     let mut best_id = u32::MAX;
     let mut best_sigma = f64::INFINITY;
     for w in ws.iter() {
-        let tc = w.sx + (-w.sy) * (cx - w.sx) / (cy - w.sy);
-        tcs.push(tc);
         if w.is_dead() {
+            // Not read: dead windows emit no children.
+            tcs.push(f64::NAN);
             continue;
         }
+        let tc = w.sx + (-w.sy) * (cx - w.sx) / (cy - w.sy);
+        tcs.push(tc);
         let t = tc.clamp(w.b0, w.b1);
         let dc = if t == tc {
             w.sigma + ((cx - w.sx) * (cx - w.sx) + (cy - w.sy) * (cy - w.sy)).sqrt()
