@@ -205,7 +205,16 @@ fn twins(tris: &[[u32; 3]], live: &[bool], n: usize, report: &mut ExactMeshRepor
     let tail = |h: u32| tris[(h / 3) as usize][(h % 3) as usize];
     for v in 0..n {
         let bucket = &mut keys[start[v] as usize..start[v + 1] as usize];
-        bucket.sort_unstable();
+        // Sorted by upper end: a bucket holds its half-edges in ascending order, so a stable
+        // insertion sort by the upper end gives the order of `(upper end, half-edge)` (the
+        // buckets are short: about 6 half-edges).
+        for i in 1..bucket.len() {
+            let mut j = i;
+            while j > 0 && bucket[j - 1].0 > bucket[j].0 {
+                bucket.swap(j - 1, j);
+                j -= 1;
+            }
+        }
         let mut i = 0;
         while i < bucket.len() {
             let mut j = i + 1;
