@@ -321,6 +321,7 @@ impl<'a> Solve<'a> {
 
     /// Starts a full-edge window on the twin of `h` from the point `(px, py)` of `h`'s frame
     /// (a point of face(h)) with distance `sigma`.
+    #[inline(always)]
     fn emit_vertex_like(&mut self, h: u32, px: f64, py: f64, sigma: f64) {
         let g = self.g;
         let tw = g.twin[h as usize];
@@ -400,7 +401,7 @@ impl<'a> Solve<'a> {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn relax(&mut self, v: u32, dist: f64, pred: Pred) {
         let vi = v as usize;
         if dist < self.d[vi] {
@@ -577,7 +578,7 @@ impl<'a> Solve<'a> {
     /// without it the children of this thread's scratch. A buffer appended to an empty list is
     /// moved into it without a copy (and replaced by that list's buffer, or for this thread's
     /// scratch by a pooled one when that has no capacity).
-    #[inline]
+    #[inline(always)]
     fn apply(&mut self, out: &StepOut, mut kids: Option<&mut [Vec<Window>; 2]>) {
         if out.best < self.d[out.apex as usize] {
             self.relax(out.apex, out.best, Pred::Window(out.best_id, out.p_star));
