@@ -232,15 +232,131 @@ pub fn curvatures_at(
     vertices: &[u32],
 ) -> Vec<Curvature> {
     let pos = mesh.positions();
-    let n = pos.len();
-    let radius = options.radius.max(0.0);
-    let min_count = options.min_neighbours.max(5) + 1;
     // The neighbour lists once, indexed here (the walks of the balls read them millions of
     // times).
     let adj: Vec<&[u32]> = adj.iter().collect();
-    let adj = adj.as_slice();
-    // Vertices are independent: in parallel, each result computed exactly as on one thread
-    // (the ball collector's state only marks visited vertices), collected in vertex order.
+    fit_balls(pos, &adj, options, vertices, |v| {
+        Some((v, *pos.get(v as usize)?, *normals.get(v as usize)?))
+    })
+}
+
+/// The vertices of a mesh thinned to one per occupied cube of side `spacing` (cubes of the
+/// grid through the origin): the first vertex (lowest id) of each cube stands for it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CubeThinning {
+    kept: Vec<u32>,
+    cube_of: Vec<u32>,
+}
+
+impl CubeThinning {
+    /// Thins `positions` to one vertex per occupied cube of side `spacing` (positive and
+    /// finite; otherwise every vertex is kept). Non-finite positions share one cube.
+    pub fn new(positions: &[DVec3], spacing: f64) -> Self {
+        if !(spacing > 0.0 && spacing.is_finite()) {
+            let all: Vec<u32> = (0..positions.len() as u32).collect();
+            return Self {
+                kept: all.clone(),
+                cube_of: all,
+            };
+        }
+        let mut cubes = std::collections::HashMap::new();
+        let mut kept = Vec::new();
+        let cube_of = positions
+            .iter()
+            .enumerate()
+            .map(|(v, p)| {
+                let c = (*p / spacing).floor();
+                *cubes
+                    .entry((c.x as i64, c.y as i64, c.z as i64))
+                    .or_insert_with(|| {
+                        kept.push(v as u32);
+                        kept.len() as u32 - 1
+                    })
+            })
+            .collect();
+        Self { kept, cube_of }
+    }
+
+    /// The kept vertices (the cubes' first vertices), in increasing order.
+    pub fn kept(&self) -> &[u32] {
+        &self.kept
+    }
+
+    /// For every vertex thinned, the index in [`CubeThinning::kept`] of its cube's vertex.
+    pub fn cube_of(&self) -> &[u32] {
+        &self.cube_of
+    }
+}
+
+/// [`curvatures_at`] on a dense mesh, each fit over the mesh's vertices thinned to one per
+/// cube ([`CubeThinning`] of its positions): the kept vertices within `options.radius` of the
+/// vertex, reached through cubes joined by an edge of the mesh (two cubes are joined when an
+/// edge joins two of their vertices) inside the ball, with the vertex's own position and
+/// normal at the centre. A fit then costs about `(radius / spacing)^2` neighbours whatever the
+/// mesh's density (at a spacing of a sixth of the radius, about 110). Vertex ids out of range,
+/// or beyond the thinning (of another mesh), get zero curvatures.
+pub fn curvatures_at_thinned(
+    mesh: &TriMesh,
+    normals: &[DVec3],
+    adj: &VertexAdjacency,
+    options: &CurvatureOptions,
+    vertices: &[u32],
+    thin: &CubeThinning,
+) -> Vec<Curvature> {
+    let pos = mesh.positions();
+    let kept_pos: Vec<DVec3> = thin
+        .kept
+        .iter()
+        .map(|&v| pos.get(v as usize).copied().unwrap_or(DVec3::ZERO))
+        .collect();
+    // The edges between cubes, once each way, sorted: the neighbour lists of the thinned mesh.
+    let cube_of = &thin.cube_of;
+    let mut joins: Vec<(u32, u32)> = adj
+        .iter()
+        .enumerate()
+        .filter_map(|(v, nb)| Some((*cube_of.get(v)?, nb)))
+        .flat_map(|(a, nb)| {
+            nb.iter().filter_map(move |&w| {
+                let b = *cube_of.get(w as usize)?;
+                (a != b).then_some((a, b))
+            })
+        })
+        .collect();
+    joins.sort_unstable();
+    joins.dedup();
+    let mut start = vec![0usize; thin.kept.len() + 1];
+    for &(a, _) in &joins {
+        start[a as usize + 1] += 1;
+    }
+    for i in 0..thin.kept.len() {
+        start[i + 1] += start[i];
+    }
+    let targets: Vec<u32> = joins.iter().map(|&(_, b)| b).collect();
+    let thin_adj: Vec<&[u32]> = start.windows(2).map(|w| &targets[w[0]..w[1]]).collect();
+    fit_balls(&kept_pos, &thin_adj, options, vertices, |v| {
+        Some((
+            *thin.cube_of.get(v as usize)?,
+            *pos.get(v as usize)?,
+            *normals.get(v as usize)?,
+        ))
+    })
+}
+
+/// The fits of [`curvatures_at`] over the graph `adj` of the points `pos`: for each vertex,
+/// `site` gives the point its ball walk starts from, the centre and the unit normal (`None`,
+/// or a zero normal, gives zero curvatures). Vertices are independent: in parallel, each
+/// result computed exactly as on one thread (the ball collector's state only marks visited
+/// points), collected in vertex order.
+fn fit_balls(
+    pos: &[DVec3],
+    adj: &[&[u32]],
+    options: &CurvatureOptions,
+    vertices: &[u32],
+    site: impl Fn(u32) -> Option<(u32, DVec3, DVec3)> + Sync,
+) -> Vec<Curvature> {
+    let n = pos.len();
+    let radius = options.radius.max(0.0);
+    let min_count = options.min_neighbours.max(5) + 1;
     vertices
         .par_iter()
         .copied()
@@ -248,13 +364,13 @@ pub fn curvatures_at(
         .map_init(
             || (BallCollector::new(n), Vec::new(), Vec::new()),
             |(ball, nb, offsets), v| {
-                let (Some(&p), Some(&nrm)) = (pos.get(v as usize), normals.get(v as usize)) else {
+                let Some((s, p, nrm)) = site(v) else {
                     return flat(DVec3::Z);
                 };
                 if nrm == DVec3::ZERO {
                     return flat(DVec3::Z);
                 }
-                ball.collect(adj, pos, v, p, radius, min_count, nb, offsets);
+                ball.collect(adj, pos, s, p, radius, min_count, nb, offsets);
                 fit_vertex(nrm, offsets, radius).unwrap_or_else(|| flat(nrm))
             },
         )

@@ -4,7 +4,9 @@
 
 #![allow(clippy::needless_range_loop)] // Dense small linear algebra reads best with indices.
 
-use crate::curvature::{curvatures_at, CurvatureOptions, VertexAdjacency};
+use crate::curvature::{
+    curvatures_at, curvatures_at_thinned, CubeThinning, CurvatureOptions, VertexAdjacency,
+};
 use crate::geom::{icp, score, FitScore, SurfaceIndex};
 use crate::model::GenericModel;
 use crate::{Landmark, LandmarkError, LandmarkName, Landmarks, Unseen, VisibleLandmarks};
@@ -194,23 +196,11 @@ pub(crate) fn surface_index(mesh: &TriMesh) -> SurfaceIndex {
     SurfaceIndex::new(pos, nrm, reach)
 }
 
-/// The vertices at which candidates are looked for, in increasing order: every vertex when the
-/// mesh's mean edge is at least `spacing` (a mesh as coarse as the training faces), else the
-/// first vertex (lowest id) in each occupied cube of side `spacing`.
-fn spaced_vertices(mesh: &TriMesh, spacing: f64) -> Vec<u32> {
-    let n = mesh.n_vertices() as u32;
-    if !(spacing > 0.0 && spacing.is_finite()) || mesh.mean_edge_length() >= spacing {
-        return (0..n).collect();
-    }
-    let mut seen = std::collections::HashSet::new();
-    let mut out = Vec::new();
-    for (v, p) in mesh.positions().iter().enumerate() {
-        let c = (*p / spacing).floor();
-        if seen.insert((c.x as i64, c.y as i64, c.z as i64)) {
-            out.push(v as u32);
-        }
-    }
-    out
+/// The thinning of a mesh denser than `spacing` (mean edge shorter) to one vertex per cube of
+/// side `spacing`; `None` for a mesh as coarse as the training faces (every vertex is used).
+fn dense_thinning(mesh: &TriMesh, spacing: f64) -> Option<CubeThinning> {
+    (spacing > 0.0 && spacing.is_finite() && mesh.mean_edge_length() < spacing)
+        .then(|| CubeThinning::new(mesh.positions(), spacing))
 }
 
 /// Greedy non-maximum suppression: vertices sorted by decreasing score (ties by index), kept
@@ -502,13 +492,18 @@ fn detect_impl(
     let clock = std::time::Instant::now();
     // The index, the adjacency and the vertices to fit are independent, and so are the rims
     // of unseen surface, the far marks and the curvature fits: each group in parallel.
-    let ((mut idx, adj), at) = rayon::join(
+    let ((mut idx, adj), thin) = rayon::join(
         || rayon::join(|| surface_index(mesh_m), || VertexAdjacency::new(mesh_m)),
         // Candidates come from the curvature at vertices about a sixth of the curvature radius
-        // apart: every vertex of a mesh as coarse as the training faces, a subsample of a
-        // dense scan (its fits still use every neighbour).
-        || spaced_vertices(mesh_m, p.curvature_radius / 6.0),
+        // apart: every vertex of a mesh as coarse as the training faces, one vertex per cube of
+        // that side on a denser mesh (a dense scan), where the fits use those vertices only,
+        // so that a fit costs about as much as on a training face whatever the density.
+        || dense_thinning(mesh_m, p.curvature_radius / 6.0),
     );
+    let at: Vec<u32> = match &thin {
+        Some(t) => t.kept().to_vec(),
+        None => (0..mesh_m.n_vertices() as u32).collect(),
+    };
     if debug {
         eprintln!(
             "[{:.1} ms] index and adjacency built; curvature at {} of {} vertices",
@@ -526,13 +521,11 @@ fn detect_impl(
             })
         },
         || {
-            curvatures_at(
-                mesh_m,
-                &idx.nrm,
-                &adj,
-                &CurvatureOptions::with_radius(p.curvature_radius),
-                &at,
-            )
+            let copt = CurvatureOptions::with_radius(p.curvature_radius);
+            match &thin {
+                Some(t) => curvatures_at_thinned(mesh_m, &idx.nrm, &adj, &copt, &at, t),
+                None => curvatures_at(mesh_m, &idx.nrm, &adj, &copt, &at),
+            }
         },
     );
     (idx.unseen_rim, idx.far) = marks?;

@@ -196,3 +196,81 @@ fn curvature_at_chosen_vertices_equals_the_whole_mesh_computation() {
     let out = landmarks::curvature::curvatures_at(&mesh, &normals, &adj, &opts, &[u32::MAX]);
     assert_eq!((out[0].k1, out[0].k2), (0.0, 0.0));
 }
+
+#[test]
+fn cube_thinning_keeps_the_first_vertex_of_each_cube() {
+    let mesh = testsupport::jittered_unit_plane(25, 0.3, 7);
+    let pos = mesh.positions();
+    let spacing = 0.13;
+    let thin = landmarks::curvature::CubeThinning::new(pos, spacing);
+    let cube = |v: u32| (pos[v as usize] / spacing).floor();
+    assert!(thin.kept().windows(2).all(|w| w[0] < w[1]));
+    assert!(thin.kept().len() > 20 && thin.kept().len() < pos.len() / 4);
+    for (v, &c) in thin.cube_of().iter().enumerate() {
+        let k = thin.kept()[c as usize];
+        assert_eq!(cube(k), cube(v as u32), "vertex {v}");
+        assert!(k <= v as u32, "vertex {v} precedes its cube's vertex {k}");
+    }
+    for (i, &k) in thin.kept().iter().enumerate() {
+        assert_eq!(thin.cube_of()[k as usize], i as u32);
+    }
+}
+
+#[test]
+fn thinned_fits_of_a_dense_sphere_find_its_curvature() {
+    let r = 30.0;
+    // About 0.8 mesh units between neighbours; fits at 7.5 over cubes of 1.25.
+    let m = sphere(r, 120, 240);
+    let normals = m.vertex_normals();
+    let adj = landmarks::curvature::VertexAdjacency::new(&m);
+    let opts = CurvatureOptions::with_radius(0.25 * r);
+    // Vertices away from the poles.
+    let at: Vec<u32> = (0..m.n_vertices() as u32)
+        .filter(|&v| m.positions()[v as usize].z.abs() < 0.8 * r)
+        .step_by(97)
+        .collect();
+    assert!(at.len() > 100);
+    let thin = landmarks::curvature::CubeThinning::new(m.positions(), r / 24.0);
+    let c = landmarks::curvature::curvatures_at_thinned(&m, &normals, &adj, &opts, &at, &thin);
+    for (v, k) in at.iter().zip(&c) {
+        assert!(
+            (k.k1 * r - 1.0).abs() < 0.03 && (k.k2 * r - 1.0).abs() < 0.03,
+            "vertex {v}: k1 r = {}, k2 r = {}",
+            k.k1 * r,
+            k.k2 * r
+        );
+    }
+}
+
+#[test]
+fn thinned_fits_follow_the_edges_not_the_space_between_sheets() {
+    // A flat sheet and, 0.1 above it, a bowl that is not connected to it: within a ball of 0.25
+    // around the flat sheet's centre, but reached through no edge.
+    let flat = height_field(80, |_, _| 0.0);
+    let bowl = height_field(80, |x, y| 0.1 + 2.0 * (x * x + y * y));
+    let n = flat.n_vertices() as u32;
+    let mut pos = flat.positions().to_vec();
+    pos.extend_from_slice(bowl.positions());
+    let mut tris = flat.triangles().to_vec();
+    tris.extend(bowl.triangles().iter().map(|t| t.map(|i| i + n)));
+    let m = TriMesh::new(pos, tris).unwrap();
+    let normals = m.vertex_normals();
+    let adj = landmarks::curvature::VertexAdjacency::new(&m);
+    let opts = CurvatureOptions::with_radius(0.25);
+    let centre = testsupport::nearest_vertex(&flat, DVec3::ZERO);
+    let bowl_centre = centre + n;
+    let at = [centre, bowl_centre];
+    let cubes = landmarks::curvature::CubeThinning::new(m.positions(), 0.05);
+    let thin = landmarks::curvature::curvatures_at_thinned(&m, &normals, &adj, &opts, &at, &cubes);
+    let full = landmarks::curvature::curvatures_at(&m, &normals, &adj, &opts, &at);
+    for c in [&thin[0], &full[0]] {
+        assert!(c.k1.abs() < 1e-6 && c.k2.abs() < 1e-6, "flat: {c:?}");
+    }
+    // The bowl's own curvature (4 at its bottom, outward normals up: a cup) is found.
+    for c in [&thin[1], &full[1]] {
+        assert!(
+            (c.k1 + 4.0).abs() < 0.4 && (c.k2 + 4.0).abs() < 0.4,
+            "bowl: {c:?}"
+        );
+    }
+}
