@@ -250,7 +250,8 @@ pub struct CubeThinning {
 
 impl CubeThinning {
     /// Thins `positions` to one vertex per occupied cube of side `spacing` (positive and
-    /// finite; otherwise every vertex is kept). Non-finite positions share one cube.
+    /// finite; otherwise every vertex is kept). A `TriMesh`'s positions are finite; a
+    /// non-finite coordinate would get the saturated integer cube index (NaN: 0).
     pub fn new(positions: &[DVec3], spacing: f64) -> Self {
         if !(spacing > 0.0 && spacing.is_finite()) {
             let all: Vec<u32> = (0..positions.len() as u32).collect();
