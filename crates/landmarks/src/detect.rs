@@ -492,14 +492,20 @@ fn detect_impl(
     let clock = std::time::Instant::now();
     // The index, the adjacency and the vertices to fit are independent, and so are the rims
     // of unseen surface, the far marks and the curvature fits: each group in parallel.
+    let spacing = p.curvature_radius / 6.0;
     let ((mut idx, adj), thin) = rayon::join(
         || rayon::join(|| surface_index(mesh_m), || VertexAdjacency::new(mesh_m)),
         // Candidates come from the curvature at vertices about a sixth of the curvature radius
         // apart: every vertex of a mesh as coarse as the training faces, one vertex per cube of
-        // that side on a denser mesh (a dense scan), where the fits use those vertices only,
-        // so that a fit costs about as much as on a training face whatever the density.
-        || dense_thinning(mesh_m, p.curvature_radius / 6.0),
+        // that side on a denser mesh. On a mesh at least twice as dense (a raw scan), the fits
+        // use those vertices only, so that a fit costs about as much as on a training face
+        // whatever the density; between the two (a scan decimated to about 1.5 mm, as
+        // `facematch` prepares it) thinned fits would save little and move the candidates
+        // (one probe of the scan benchmark's seed 7 was then not found), so they use every
+        // vertex.
+        || dense_thinning(mesh_m, spacing),
     );
+    let thin_fits = thin.is_some() && mesh_m.mean_edge_length() < 0.5 * spacing;
     let at: Vec<u32> = match &thin {
         Some(t) => t.kept().to_vec(),
         None => (0..mesh_m.n_vertices() as u32).collect(),
@@ -523,8 +529,10 @@ fn detect_impl(
         || {
             let copt = CurvatureOptions::with_radius(p.curvature_radius);
             match &thin {
-                Some(t) => curvatures_at_thinned(mesh_m, &idx.nrm, &adj, &copt, &at, t),
-                None => curvatures_at(mesh_m, &idx.nrm, &adj, &copt, &at),
+                Some(t) if thin_fits => {
+                    curvatures_at_thinned(mesh_m, &idx.nrm, &adj, &copt, &at, t)
+                }
+                _ => curvatures_at(mesh_m, &idx.nrm, &adj, &copt, &at),
             }
         },
     );
