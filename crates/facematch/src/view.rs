@@ -13,16 +13,12 @@ pub fn seen_within(
     max_incidence_deg: f64,
 ) -> Result<Vec<bool>, scanprep::ScanPrepError> {
     // One set of smoothed normals for both directions.
-    let mut masks = match toward {
-        Some(t) => scanprep::incidence_masks(mesh, &[scanner, t], max_incidence_deg)?,
-        None => scanprep::incidence_masks(mesh, &[scanner], max_incidence_deg)?,
-    }
-    .into_iter();
-    let own = masks.next().unwrap_or_default();
-    Ok(match masks.next() {
-        Some(other) => own.iter().zip(&other).map(|(a, b)| *a && *b).collect(),
-        None => own,
-    })
+    let dirs: Vec<DVec3> = std::iter::once(scanner).chain(toward).collect();
+    let masks = scanprep::incidence_masks(mesh, &dirs, max_incidence_deg)?;
+    Ok(masks
+        .into_iter()
+        .reduce(|a, b| a.iter().zip(&b).map(|(a, b)| *a && *b).collect())
+        .unwrap_or_default())
 }
 
 /// The part of a face that a scanner from another direction would have measured.
